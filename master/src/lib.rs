@@ -1,0 +1,1 @@
+//! The co-simulation master (see issue 3).
