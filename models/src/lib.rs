@@ -1,4 +1,6 @@
 //! Ship-control physics in pure Rust: every model the FMUs expose lives here and is tested here.
 //! No FFI: the FMU crates under `fmus/` map these types onto FMI variables.
 
+pub mod hull;
+pub mod integrate;
 pub mod steering_gear;

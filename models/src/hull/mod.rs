@@ -1,0 +1,85 @@
+//! Hull (ship) models of the sources.
+//!
+//! Each ship is a plain `Clone + Debug + Serialize + Deserialize` struct holding its parameters
+//! and state, built by a validating constructor (`Result<_, ParamError>`) or a named preset, and
+//! advanced by `step(&mut self, inputs, h)`, which advances exactly `h` seconds with a fixed
+//! internal step (RK4, see [`crate::integrate`]) or an exact ZOH discretisation for the linear
+//! models. Interfaces are SI with angles in rad; prime-system (nondimensional) quantities are
+//! extra outputs. Earth frame: x north, y east, heading ψ from north positive clockwise
+//! (to starboard). The heading state is continuous (not wrapped); `heading_wrapped` gives
+//! (−π, π].
+//!
+//! | type | source |
+//! | --- | --- |
+//! | [`container_ship::ContainerShip`], [`container_ship::LinearContainerShip`] | spec `container_ship.md` §2, §4 (Son & Nomoto 1982 via MSS) |
+//! | [`mariner::Mariner`] | spec `container_ship.md` §3 (Chislett & Strøm-Tejsen 1965 via MSS) |
+
+pub mod container_ship;
+pub mod mariner;
+
+/// One degree in radians.
+pub const DEG: f64 = std::f64::consts::PI / 180.0;
+/// One knot in m/s (1852 m / 3600 s).
+pub const KNOT: f64 = 1852.0 / 3600.0;
+
+/// Wraps an angle to (−π, π].
+pub fn wrap_pi(a: f64) -> f64 {
+    let two_pi = 2.0 * std::f64::consts::PI;
+    let mut w = a % two_pi;
+    if w > std::f64::consts::PI {
+        w -= two_pi;
+    } else if w <= -std::f64::consts::PI {
+        w += two_pi;
+    }
+    w
+}
+
+/// First-order rudder servo of the MSS ships (spec `container_ship.md` §2.6, also used by the
+/// Mariner §3.1 and the linear container ship §4.1): the command is saturated to ±`max`, the rate
+/// is `(δ_c,sat − δ)/1 s` clipped to ±`rate_max`. There is no separate limit on the state.
+#[inline]
+pub(crate) fn mss_rudder_rate(command: f64, delta: f64, max: f64, rate_max: f64) -> f64 {
+    let dc = command.clamp(-max, max);
+    (dc - delta).clamp(-rate_max, rate_max)
+}
+
+pub(crate) fn check_positive(
+    name: &'static str,
+    v: f64,
+) -> Result<(), crate::steering_gear::ParamError> {
+    if v.is_finite() && v > 0.0 {
+        Ok(())
+    } else {
+        Err(crate::steering_gear::ParamError {
+            name,
+            value: v,
+            rule: "must be finite and > 0",
+        })
+    }
+}
+
+pub(crate) fn check_finite(
+    name: &'static str,
+    v: f64,
+) -> Result<(), crate::steering_gear::ParamError> {
+    if v.is_finite() {
+        Ok(())
+    } else {
+        Err(crate::steering_gear::ParamError {
+            name,
+            value: v,
+            rule: "must be finite",
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    #[test]
+    fn wrap() {
+        assert!((wrap_pi(3.0 * std::f64::consts::PI) - std::f64::consts::PI).abs() < 1e-12);
+        assert!((wrap_pi(-0.5) + 0.5).abs() < 1e-15);
+        assert!((wrap_pi(7.0) - (7.0 - 2.0 * std::f64::consts::PI)).abs() < 1e-12);
+    }
+}
