@@ -1,1 +1,15 @@
-//! The co-simulation master (see issue 3).
+//! `shipsim`: an FMI 2.0 co-simulation master (see DESIGN.md, "Master").
+//!
+//! - [`fmu`]: FMU import (unzip, modelDescription, libloading, all symbols resolved once).
+//! - [`instance`]: a safe slave instance whose lifecycle is enforced by types.
+//! - [`model_description`]: typed `modelDescription.xml`.
+//! - [`inspect`]: human-readable FMU summary.
+
+pub mod error;
+pub mod fmu;
+pub mod inspect;
+pub mod instance;
+pub mod model_description;
+
+pub use error::{Error, Result};
+pub use fmu::Fmu;

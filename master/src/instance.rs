@@ -1,0 +1,492 @@
+//! A safe co-simulation slave instance whose lifecycle is enforced by types (FMI 2.0 section
+//! 4.2.4, "State Machine of Calling Sequence from Master to Slave"):
+//!
+//! `Fmu::instantiate` -> [`Instance<Instantiated>`] -- `enter_initialization_mode` (after
+//! `fmi2SetupExperiment`) -> [`Instance<Initializing>`] -- `exit_initialization_mode` ->
+//! [`Instance<Stepping>`] -- `do_step`* -- `terminate`.
+//!
+//! A state transition consumes the instance, so no function can be called out of order. Dropping
+//! an instance in any state calls `fmi2Terminate` (if initialized and not failed) and
+//! `fmi2FreeInstance` (unless the FMU returned fmi2Fatal, after which the standard allows no more
+//! calls), so every path, including errors and Ctrl-C, cleans up.
+
+use crate::error::{Error, Result};
+use crate::fmu::{Fmu, FmuLibrary, VR};
+use fmi2::*;
+use std::collections::VecDeque;
+use std::ffi::{c_char, c_int, c_void, CString};
+use std::marker::PhantomData;
+use std::sync::{Arc, Mutex};
+
+/// Type states.
+pub struct Instantiated;
+pub struct Initializing;
+pub struct Stepping;
+
+/// States in which fmi2GetXXX is allowed.
+pub trait Readable {}
+impl Readable for Initializing {}
+impl Readable for Stepping {}
+
+/// One formatted FMU log message.
+#[derive(Debug, Clone)]
+pub struct LogRecord {
+    pub instance: String,
+    pub status: i32,
+    pub category: String,
+    pub message: String,
+}
+
+/// Where FMU log messages go. The default prints warnings and worse to stderr (all with verbose).
+pub type LogSink = Arc<dyn Fn(&LogRecord) + Send + Sync>;
+
+pub fn stderr_sink(verbose: bool) -> LogSink {
+    Arc::new(move |r: &LogRecord| {
+        if verbose || r.status >= fmi2Warning {
+            eprintln!(
+                "[{}] {} {}: {}",
+                r.instance,
+                status_name(r.status),
+                r.category,
+                r.message
+            );
+        }
+    })
+}
+
+struct LogCtx {
+    name: String,
+    sink: LogSink,
+    recent: Mutex<VecDeque<String>>,
+}
+
+const RECENT: usize = 8;
+
+unsafe extern "C" fn log_sink(
+    ctx: *mut c_void,
+    instance: *const c_char,
+    status: c_int,
+    category: *const c_char,
+    message: *const c_char,
+) {
+    // Never unwind into the FMU.
+    let _ = std::panic::catch_unwind(|| {
+        let ctx = &*(ctx as *const LogCtx);
+        let inst = lossy_str(instance);
+        let rec = LogRecord {
+            instance: if inst.is_empty() {
+                ctx.name.clone()
+            } else {
+                inst
+            },
+            status,
+            category: lossy_str(category),
+            message: lossy_str(message),
+        };
+        if let Ok(mut r) = ctx.recent.lock() {
+            if r.len() == RECENT {
+                r.pop_front();
+            }
+            r.push_back(format!(
+                "{} {}: {}",
+                status_name(rec.status),
+                rec.category,
+                rec.message
+            ));
+        }
+        (ctx.sink)(&rec);
+    });
+}
+
+extern "C" {
+    fn calloc(n: usize, size: usize) -> *mut c_void;
+    fn free(p: *mut c_void);
+}
+unsafe extern "C" fn fmi_calloc(n: usize, size: usize) -> *mut c_void {
+    calloc(n, size)
+}
+unsafe extern "C" fn fmi_free(p: *mut c_void) {
+    free(p)
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+enum Phase {
+    Instantiated,
+    Initialized,
+    Terminated,
+    Failed,
+    Fatal,
+}
+
+struct Core {
+    name: String,
+    lib: Arc<FmuLibrary>,
+    comp: fmi2Component,
+    phase: Phase,
+    // Kept alive for the FMU, which may hold pointers to them.
+    _callbacks: Box<fmi2CallbackFunctions>,
+    _target: Box<LogTarget>,
+    log: Box<LogCtx>,
+    _name_c: CString,
+}
+
+impl Core {
+    fn check(
+        &mut self,
+        function: &'static str,
+        status: fmi2Status,
+        time: Option<f64>,
+    ) -> Result<()> {
+        if status == fmi2OK || status == fmi2Warning {
+            return Ok(());
+        }
+        if status == fmi2Fatal {
+            self.phase = Phase::Fatal;
+        } else if status == fmi2Error || !(0..=5).contains(&status) {
+            self.phase = Phase::Failed;
+        }
+        Err(self.fmi_error(function, status, time))
+    }
+
+    fn fmi_error(&self, function: &'static str, status: fmi2Status, time: Option<f64>) -> Error {
+        Error::Fmi {
+            instance: self.name.clone(),
+            function,
+            status,
+            time,
+            log: self
+                .log
+                .recent
+                .lock()
+                .map(|r| r.iter().cloned().collect())
+                .unwrap_or_default(),
+        }
+    }
+}
+
+impl Drop for Core {
+    fn drop(&mut self) {
+        let api = &self.lib.api;
+        unsafe {
+            if self.phase == Phase::Initialized {
+                (api.Terminate)(self.comp);
+            }
+            if self.phase != Phase::Fatal {
+                (api.FreeInstance)(self.comp);
+            }
+        }
+    }
+}
+
+/// A co-simulation slave instance in type state `S`.
+pub struct Instance<S> {
+    core: Box<Core>,
+    _s: PhantomData<S>,
+}
+
+// The FMU is only called from the thread that owns the instance.
+unsafe impl<S> Send for Instance<S> {}
+
+/// Result of a `fmi2DoStep`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum StepOutcome {
+    Ok,
+    /// The slave returned fmi2Discard and reports `fmi2Terminated` = true: it ended the
+    /// simulation early at `last_successful_time` (FMI 2.0 section 4.2.3).
+    Terminated {
+        last_successful_time: f64,
+    },
+}
+
+impl Fmu {
+    /// `fmi2Instantiate` as co-simulation slave (FMI 2.0 section 4.2.1), with the logger proxy,
+    /// `calloc`/`free`, and the resources URI. A NULL result is an error naming the instance.
+    pub fn instantiate(
+        &self,
+        name: &str,
+        logging_on: bool,
+        sink: LogSink,
+    ) -> Result<Instance<Instantiated>> {
+        let name_c = CString::new(name)
+            .map_err(|_| Error::Other(format!("instance name '{name}' contains a NUL byte")))?;
+        let guid = CString::new(self.guid())
+            .map_err(|_| Error::fmu(&self.path, "GUID contains a NUL byte"))?;
+        let res = CString::new(self.resource_uri()).expect("no NUL in a path URI");
+        let log = Box::new(LogCtx {
+            name: name.to_string(),
+            sink,
+            recent: Mutex::new(VecDeque::new()),
+        });
+        let mut target = Box::new(LogTarget {
+            sink: Some(log_sink),
+            ctx: &*log as *const LogCtx as *mut c_void,
+        });
+        let callbacks = Box::new(fmi2CallbackFunctions {
+            logger: logger_proxy(),
+            allocateMemory: Some(fmi_calloc),
+            freeMemory: Some(fmi_free),
+            stepFinished: None,
+            componentEnvironment: &mut *target as *mut LogTarget as *mut c_void,
+        });
+        let comp = unsafe {
+            (self.lib.api.Instantiate)(
+                name_c.as_ptr(),
+                fmi2CoSimulation,
+                guid.as_ptr(),
+                res.as_ptr(),
+                &*callbacks,
+                fmi2False,
+                if logging_on { fmi2True } else { fmi2False },
+            )
+        };
+        if comp.is_null() {
+            let recent: Vec<String> = log
+                .recent
+                .lock()
+                .map(|r| r.iter().cloned().collect())
+                .unwrap_or_default();
+            return Err(Error::fmu(
+                &self.path,
+                format!(
+                    "fmi2Instantiate returned NULL for instance '{name}' (GUID \"{}\"){}",
+                    self.guid(),
+                    if recent.is_empty() {
+                        String::new()
+                    } else {
+                        format!("; FMU log: {}", recent.join(" | "))
+                    }
+                ),
+            ));
+        }
+        Ok(Instance {
+            core: Box::new(Core {
+                name: name.to_string(),
+                lib: self.lib.clone(),
+                comp,
+                phase: Phase::Instantiated,
+                _callbacks: callbacks,
+                _target: target,
+                log,
+                _name_c: name_c,
+            }),
+            _s: PhantomData,
+        })
+    }
+}
+
+impl<S> Instance<S> {
+    pub fn name(&self) -> &str {
+        &self.core.name
+    }
+
+    fn transition<T>(self) -> Instance<T> {
+        Instance {
+            core: self.core,
+            _s: PhantomData,
+        }
+    }
+
+    /// The last few log messages of this instance (for error reports).
+    pub fn recent_log(&self) -> Vec<String> {
+        self.core
+            .log
+            .recent
+            .lock()
+            .map(|r| r.iter().cloned().collect())
+            .unwrap_or_default()
+    }
+
+    /// `fmi2SetReal`, batched.
+    pub fn set_real(&mut self, vrs: &[VR], values: &[f64]) -> Result<()> {
+        debug_assert_eq!(vrs.len(), values.len());
+        if vrs.is_empty() {
+            return Ok(());
+        }
+        let s = unsafe {
+            (self.core.lib.api.SetReal)(self.core.comp, vrs.as_ptr(), vrs.len(), values.as_ptr())
+        };
+        self.core.check("fmi2SetReal", s, None)
+    }
+
+    /// `fmi2SetInteger`, batched.
+    pub fn set_integer(&mut self, vrs: &[VR], values: &[i32]) -> Result<()> {
+        if vrs.is_empty() {
+            return Ok(());
+        }
+        let s = unsafe {
+            (self.core.lib.api.SetInteger)(self.core.comp, vrs.as_ptr(), vrs.len(), values.as_ptr())
+        };
+        self.core.check("fmi2SetInteger", s, None)
+    }
+
+    /// `fmi2SetBoolean`, batched (values are fmi2Boolean, 0 or 1).
+    pub fn set_boolean(&mut self, vrs: &[VR], values: &[i32]) -> Result<()> {
+        if vrs.is_empty() {
+            return Ok(());
+        }
+        let s = unsafe {
+            (self.core.lib.api.SetBoolean)(self.core.comp, vrs.as_ptr(), vrs.len(), values.as_ptr())
+        };
+        self.core.check("fmi2SetBoolean", s, None)
+    }
+
+    /// `fmi2SetString`.
+    pub fn set_string(&mut self, vrs: &[VR], values: &[&str]) -> Result<()> {
+        let cs: Vec<CString> = values
+            .iter()
+            .map(|v| {
+                CString::new(*v)
+                    .map_err(|_| Error::Other(format!("string value {v:?} contains a NUL byte")))
+            })
+            .collect::<Result<_>>()?;
+        let ptrs: Vec<fmi2String> = cs.iter().map(|c| c.as_ptr()).collect();
+        let s = unsafe {
+            (self.core.lib.api.SetString)(self.core.comp, vrs.as_ptr(), vrs.len(), ptrs.as_ptr())
+        };
+        self.core.check("fmi2SetString", s, None)
+    }
+}
+
+impl<S: Readable> Instance<S> {
+    /// `fmi2GetReal`, batched into a caller-provided buffer (no allocation).
+    pub fn get_real(&mut self, vrs: &[VR], out: &mut [f64]) -> Result<()> {
+        debug_assert_eq!(vrs.len(), out.len());
+        if vrs.is_empty() {
+            return Ok(());
+        }
+        let s = unsafe {
+            (self.core.lib.api.GetReal)(self.core.comp, vrs.as_ptr(), vrs.len(), out.as_mut_ptr())
+        };
+        self.core.check("fmi2GetReal", s, None)
+    }
+
+    /// `fmi2GetInteger`, batched.
+    pub fn get_integer(&mut self, vrs: &[VR], out: &mut [i32]) -> Result<()> {
+        if vrs.is_empty() {
+            return Ok(());
+        }
+        let s = unsafe {
+            (self.core.lib.api.GetInteger)(
+                self.core.comp,
+                vrs.as_ptr(),
+                vrs.len(),
+                out.as_mut_ptr(),
+            )
+        };
+        self.core.check("fmi2GetInteger", s, None)
+    }
+
+    /// `fmi2GetBoolean`, batched.
+    pub fn get_boolean(&mut self, vrs: &[VR], out: &mut [i32]) -> Result<()> {
+        if vrs.is_empty() {
+            return Ok(());
+        }
+        let s = unsafe {
+            (self.core.lib.api.GetBoolean)(
+                self.core.comp,
+                vrs.as_ptr(),
+                vrs.len(),
+                out.as_mut_ptr(),
+            )
+        };
+        self.core.check("fmi2GetBoolean", s, None)
+    }
+
+    /// `fmi2GetString` (copies the strings, which the FMU owns only until the next call).
+    pub fn get_string(&mut self, vrs: &[VR]) -> Result<Vec<String>> {
+        let mut ptrs: Vec<fmi2String> = vec![std::ptr::null(); vrs.len()];
+        let s = unsafe {
+            (self.core.lib.api.GetString)(
+                self.core.comp,
+                vrs.as_ptr(),
+                vrs.len(),
+                ptrs.as_mut_ptr(),
+            )
+        };
+        self.core.check("fmi2GetString", s, None)?;
+        Ok(ptrs.iter().map(|p| unsafe { lossy_str(*p) }).collect())
+    }
+}
+
+impl Instance<Instantiated> {
+    /// `fmi2SetupExperiment` then `fmi2EnterInitializationMode` (FMI 2.0 sections 2.1.6, 4.2.4).
+    pub fn enter_initialization_mode(
+        mut self,
+        tolerance: Option<f64>,
+        start_time: f64,
+        stop_time: Option<f64>,
+    ) -> Result<Instance<Initializing>> {
+        let lib = self.core.lib.clone();
+        let api = &lib.api;
+        let s = unsafe {
+            (api.SetupExperiment)(
+                self.core.comp,
+                tolerance.is_some() as fmi2Boolean,
+                tolerance.unwrap_or(0.0),
+                start_time,
+                stop_time.is_some() as fmi2Boolean,
+                stop_time.unwrap_or(0.0),
+            )
+        };
+        self.core
+            .check("fmi2SetupExperiment", s, Some(start_time))?;
+        let s = unsafe { (api.EnterInitializationMode)(self.core.comp) };
+        self.core
+            .check("fmi2EnterInitializationMode", s, Some(start_time))?;
+        self.core.phase = Phase::Initialized;
+        Ok(self.transition())
+    }
+}
+
+impl Instance<Initializing> {
+    /// `fmi2ExitInitializationMode`: the slave is then at its first communication point.
+    pub fn exit_initialization_mode(mut self) -> Result<Instance<Stepping>> {
+        let s = unsafe { (self.core.lib.api.ExitInitializationMode)(self.core.comp) };
+        self.core.check("fmi2ExitInitializationMode", s, None)?;
+        Ok(self.transition())
+    }
+}
+
+impl Instance<Stepping> {
+    /// `fmi2DoStep(t, h, noSetFMUStatePriorToCurrentPoint = true)` (FMI 2.0 section 4.2.2).
+    /// fmi2Discard with `fmi2Terminated` = true is an early end, reported as
+    /// [`StepOutcome::Terminated`]; any other status worse than fmi2Warning is an error naming
+    /// the instance, the time and the status, with the FMU's last log lines.
+    #[inline]
+    pub fn do_step(&mut self, t: f64, h: f64) -> Result<StepOutcome> {
+        let api: *const crate::fmu::Api = &self.core.lib.api;
+        // SAFETY: the Arc'd library outlives this call; a raw pointer avoids an Arc clone per step.
+        let api = unsafe { &*api };
+        let s = unsafe { (api.DoStep)(self.core.comp, t, h, fmi2True) };
+        if s == fmi2OK || s == fmi2Warning {
+            return Ok(StepOutcome::Ok);
+        }
+        if s == fmi2Discard {
+            let mut terminated: fmi2Boolean = fmi2False;
+            let st =
+                unsafe { (api.GetBooleanStatus)(self.core.comp, fmi2Terminated, &mut terminated) };
+            if st <= fmi2Warning && terminated != fmi2False {
+                let mut last = t;
+                let st = unsafe {
+                    (api.GetRealStatus)(self.core.comp, fmi2LastSuccessfulTime, &mut last)
+                };
+                if st > fmi2Warning {
+                    last = t;
+                }
+                self.core.phase = Phase::Initialized;
+                return Ok(StepOutcome::Terminated {
+                    last_successful_time: last,
+                });
+            }
+        }
+        self.core.check("fmi2DoStep", s, Some(t))?;
+        Err(self.core.fmi_error("fmi2DoStep", s, Some(t)))
+    }
+
+    /// `fmi2Terminate` then `fmi2FreeInstance`.
+    pub fn terminate(mut self) -> Result<()> {
+        let s = unsafe { (self.core.lib.api.Terminate)(self.core.comp) };
+        self.core.phase = Phase::Terminated;
+        self.core.check("fmi2Terminate", s, None)
+    }
+}
