@@ -3,4 +3,5 @@
 
 pub mod hull;
 pub mod integrate;
+pub mod manoeuvre;
 pub mod steering_gear;
