@@ -1,1 +1,128 @@
-fn main() {}
+//! `cargo xtask <task>`: the project's build, packaging and test entry points.
+//!
+//! * `build-fmus`: builds every FMU crate (packages with `[package.metadata.fmu]`) in release mode
+//!   in one cargo invocation and writes `target/fmu/<ModelIdentifier>.fmu`.
+//! * `test`: Rust tests, FMUs, a Python venv under `target/venv` with FMPy and libcosimpy, and
+//!   the Python checks in `tests/python`.
+//! * `demo`: the default coupled system (see README).
+
+mod fmu;
+
+use anyhow::{bail, Context, Result};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let result = match args.first().map(String::as_str) {
+        Some("build-fmus") => fmu::build_fmus(&workspace_root()).map(|_| ()),
+        Some("test") => test(&args[1..]),
+        Some("demo") => demo(),
+        _ => {
+            eprintln!(
+                "usage: cargo xtask <task>\n\n\
+                 tasks:\n  \
+                 build-fmus   build every FMU into target/fmu/<ModelIdentifier>.fmu\n  \
+                 test         run every test: Rust, FMU packaging, FMPy and libcosim checks\n  \
+                 demo         run the default coupled system"
+            );
+            std::process::exit(2);
+        }
+    };
+    if let Err(e) = result {
+        eprintln!("xtask: error: {e:#}");
+        std::process::exit(1);
+    }
+}
+
+/// The workspace root (parent of this crate's manifest directory).
+pub fn workspace_root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .expect("xtask lives in the workspace")
+        .to_path_buf()
+}
+
+/// Runs a command, streaming its output; fails with the command line on a non-zero exit.
+pub fn run(cmd: &mut Command) -> Result<()> {
+    let status = cmd
+        .status()
+        .with_context(|| format!("could not start {cmd:?}"))?;
+    if !status.success() {
+        bail!("{cmd:?} failed with {status}");
+    }
+    Ok(())
+}
+
+pub fn cargo() -> Command {
+    Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()))
+}
+
+/// Creates (or refreshes, when requirements.txt changed) the venv under target/venv.
+fn ensure_venv(root: &Path) -> Result<PathBuf> {
+    let venv = root.join("target/venv");
+    let python = venv.join("bin/python");
+    let req = root.join("tests/python/requirements.txt");
+    let req_text =
+        std::fs::read_to_string(&req).with_context(|| format!("reading {}", req.display()))?;
+    let stamp = venv.join(".requirements.txt");
+    if python.exists() && std::fs::read_to_string(&stamp).ok().as_deref() == Some(req_text.as_str())
+    {
+        return Ok(python);
+    }
+    if !python.exists() {
+        eprintln!("xtask: creating the Python venv {}", venv.display());
+        run(Command::new("python3").args(["-m", "venv"]).arg(&venv))?;
+    }
+    eprintln!("xtask: installing tests/python/requirements.txt into the venv");
+    run(Command::new(&python)
+        .args([
+            "-m",
+            "pip",
+            "install",
+            "--quiet",
+            "--disable-pip-version-check",
+            "-r",
+        ])
+        .arg(&req))?;
+    std::fs::write(&stamp, req_text)?;
+    Ok(python)
+}
+
+fn test(extra: &[String]) -> Result<()> {
+    let root = workspace_root();
+    let started = std::time::Instant::now();
+    let fmu_dir = fmu::build_fmus(&root)?;
+    eprintln!("xtask: Rust tests (release, sharing the FMU build)");
+    run(cargo()
+        .current_dir(&root)
+        .args(["test", "--release", "--workspace", "--exclude", "xtask"])
+        .args(extra)
+        .env("SHIPSIM_FMU_DIR", &fmu_dir))?;
+    run(cargo().current_dir(&root).args([
+        "build",
+        "--release",
+        "--workspace",
+        "--exclude",
+        "xtask",
+        "--bins",
+    ]))?;
+    let python = ensure_venv(&root)?;
+    eprintln!("xtask: Python checks (FMPy, libcosim) in tests/python");
+    let bin = root.join("target/release");
+    run(Command::new(&python)
+        .current_dir(&root)
+        .args(["-m", "pytest", "-q", "tests/python"])
+        .env("SHIPSIM_FMU_DIR", &fmu_dir)
+        .env("SHIPSIM_BIN", bin.join("shipsim"))
+        .env("SHIPSIM_REFERENCE_BIN", bin.join("model-reference")))?;
+    eprintln!(
+        "xtask: all tests passed in {:.0} s",
+        started.elapsed().as_secs_f64()
+    );
+    Ok(())
+}
+
+fn demo() -> Result<()> {
+    bail!("the demo system needs the master (issue 3) and the coupled RRS system (issue 8)")
+}

@@ -4,7 +4,7 @@
 //! Also provides [`LogTarget`] and [`logger_proxy`]: the C-variadic `fmi2CallbackLogger` cannot be
 //! defined in stable Rust, so a small C function formats the message and forwards it to a plain
 //! Rust callback.
-#![allow(non_camel_case_types, non_snake_case)]
+#![allow(non_camel_case_types, non_snake_case, non_upper_case_globals)]
 
 use std::ffi::{c_char, c_double, c_int, c_uint, c_void, CStr};
 

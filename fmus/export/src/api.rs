@@ -1,0 +1,995 @@
+//! The generic FMI 2.0 C API. Each function is what the `fmi2*` symbol of the same name does;
+//! [`crate::export_fmu!`] forwards the symbols here. Every entry runs inside `catch_unwind`.
+
+use crate::instance::{
+    fnv1a, log_raw, mask, Core, Instance, LifeState, Snapshot, StateBox, CAT_ERROR, CAT_EVENTS,
+};
+use crate::variables::{Access, Causality, Variability, Variable};
+use crate::{FmuModel, LOG_CATEGORIES};
+use fmi2::*;
+use std::ffi::{c_char, c_void, CStr, CString};
+use std::panic::{catch_unwind, AssertUnwindSafe};
+
+/// Layout version of serialized FMU states (bumped when [`Snapshot`] changes shape).
+const SERIAL_VERSION: u32 = 1;
+
+fn panic_message(p: &(dyn std::any::Any + Send)) -> String {
+    if let Some(s) = p.downcast_ref::<&str>() {
+        (*s).to_string()
+    } else if let Some(s) = p.downcast_ref::<String>() {
+        s.clone()
+    } else {
+        "unknown panic".to_string()
+    }
+}
+
+/// Runs `f` on the instance behind `c` if `function` is legal in its state; a panic becomes
+/// fmi2Error, the instance moves to the Error state and the panic is logged.
+unsafe fn with_instance<M: FmuModel>(
+    c: fmi2Component,
+    function: &str,
+    legal: u32,
+    f: impl FnOnce(&mut Instance<M>) -> fmi2Status,
+) -> fmi2Status {
+    if c.is_null() {
+        return fmi2Error;
+    }
+    let inst = c as *mut Instance<M>;
+    // SAFETY: `c` was returned by `instantiate::<M>` and not freed (importer contract).
+    if let Err(status) = (*inst).check_state(function, legal) {
+        return status;
+    }
+    match catch_unwind(AssertUnwindSafe(|| f(&mut *inst))) {
+        Ok(status) => status,
+        Err(p) => {
+            let inst = &mut *inst;
+            inst.core.state = LifeState::Error;
+            inst.log(
+                fmi2Error,
+                CAT_ERROR,
+                &format!(
+                    "{function}: internal error (panic: {}); the instance is in the Error state \
+                     (fmi2Reset, fmi2SetFMUstate or fmi2FreeInstance)",
+                    panic_message(p.as_ref())
+                ),
+            );
+            fmi2Error
+        }
+    }
+}
+
+pub fn types_platform() -> *const c_char {
+    c"default".as_ptr()
+}
+
+pub fn version() -> *const c_char {
+    c"2.0".as_ptr()
+}
+
+/// `fmi2Instantiate`: NULL (with a log line where possible) on a missing/wrong GUID, a missing
+/// instance name, a non-co-simulation type or missing callbacks.
+///
+/// # Safety
+/// Arguments as the FMI 2.0 standard defines them.
+pub unsafe fn instantiate<M: FmuModel>(
+    name: fmi2String,
+    kind: fmi2Type,
+    guid: fmi2String,
+    _resources: fmi2String,
+    functions: *const fmi2CallbackFunctions,
+    _visible: fmi2Boolean,
+    logging_on: fmi2Boolean,
+) -> fmi2Component {
+    let result = catch_unwind(AssertUnwindSafe(|| {
+        if functions.is_null() {
+            return std::ptr::null_mut();
+        }
+        let functions = *functions;
+        let (logger, env) = (functions.logger, functions.componentEnvironment);
+        let name_c = if name.is_null() {
+            CString::default()
+        } else {
+            CStr::from_ptr(name).to_owned()
+        };
+        let fail = |msg: &str| {
+            log_raw(
+                logger,
+                env,
+                &name_c,
+                fmi2Error,
+                LOG_CATEGORIES[CAT_ERROR].0,
+                msg,
+            );
+            std::ptr::null_mut()
+        };
+        if name_c.as_bytes().is_empty() {
+            return fail(&format!(
+                "fmi2Instantiate ({}): missing instance name",
+                M::MODEL_IDENTIFIER
+            ));
+        }
+        if kind != fmi2CoSimulation {
+            return fail(&format!(
+                "fmi2Instantiate: {} supports only fmi2CoSimulation (fmuType = {kind})",
+                M::MODEL_IDENTIFIER
+            ));
+        }
+        let expected = crate::xml::guid::<M>();
+        if guid.is_null() {
+            return fail("fmi2Instantiate: missing GUID");
+        }
+        let given = CStr::from_ptr(guid).to_string_lossy();
+        if given != expected {
+            return fail(&format!(
+                "fmi2Instantiate: wrong GUID {given}; {} expects {expected} (modelDescription.xml \
+                 and binary do not belong together)",
+                M::MODEL_IDENTIFIER
+            ));
+        }
+        let inst = Instance::<M>::new(
+            name_c.clone(),
+            logger,
+            env,
+            logging_on != fmi2False,
+            fnv1a(expected.as_bytes()),
+        );
+        inst.log(
+            fmi2OK,
+            CAT_EVENTS,
+            &format!("instantiated {} {expected}", M::MODEL_IDENTIFIER),
+        );
+        Box::into_raw(Box::new(inst)) as fmi2Component
+    }));
+    result.unwrap_or(std::ptr::null_mut())
+}
+
+/// # Safety
+/// `c` must come from `instantiate::<M>` and not be used afterwards.
+pub unsafe fn free_instance<M: FmuModel>(c: fmi2Component) {
+    if c.is_null() {
+        return;
+    }
+    let _ = catch_unwind(AssertUnwindSafe(|| {
+        drop(Box::from_raw(c as *mut Instance<M>));
+    }));
+}
+
+/// # Safety
+/// FMI 2.0 arguments.
+pub unsafe fn set_debug_logging<M: FmuModel>(
+    c: fmi2Component,
+    on: fmi2Boolean,
+    n: usize,
+    categories: *const fmi2String,
+) -> fmi2Status {
+    with_instance::<M>(c, "fmi2SetDebugLogging", mask::SET_DEBUG_LOGGING, |inst| {
+        let on = on != fmi2False;
+        if n == 0 {
+            inst.enabled = [on; LOG_CATEGORIES.len()];
+            return fmi2OK;
+        }
+        if categories.is_null() {
+            return inst.error("fmi2SetDebugLogging: categories is NULL but nCategories > 0");
+        }
+        for i in 0..n {
+            let p = *categories.add(i);
+            let name = lossy_str(p);
+            match LOG_CATEGORIES.iter().position(|(c, _)| *c == name) {
+                Some(k) => inst.enabled[k] = on,
+                None => {
+                    return inst.error(&format!(
+                        "fmi2SetDebugLogging: unknown log category {name:?}; known: {}",
+                        LOG_CATEGORIES.map(|(c, _)| c).join(", ")
+                    ))
+                }
+            }
+        }
+        fmi2OK
+    })
+}
+
+/// # Safety
+/// FMI 2.0 arguments.
+pub unsafe fn setup_experiment<M: FmuModel>(
+    c: fmi2Component,
+    _tol_defined: fmi2Boolean,
+    _tol: fmi2Real,
+    start: fmi2Real,
+    stop_defined: fmi2Boolean,
+    stop: fmi2Real,
+) -> fmi2Status {
+    with_instance::<M>(c, "fmi2SetupExperiment", mask::SETUP_EXPERIMENT, |inst| {
+        if !start.is_finite() {
+            return inst.error(&format!(
+                "fmi2SetupExperiment: startTime = {start} is not finite"
+            ));
+        }
+        let stop = if stop_defined != fmi2False {
+            if !(stop.is_finite() && stop >= start) {
+                return inst.error(&format!(
+                    "fmi2SetupExperiment: stopTime = {stop} must be finite and >= startTime = {start}"
+                ));
+            }
+            Some(stop)
+        } else {
+            None
+        };
+        inst.core.start_time = start;
+        inst.core.time = start;
+        inst.core.stop_time = stop;
+        fmi2OK
+    })
+}
+
+/// # Safety
+/// FMI 2.0 arguments.
+pub unsafe fn enter_initialization_mode<M: FmuModel>(c: fmi2Component) -> fmi2Status {
+    with_instance::<M>(
+        c,
+        "fmi2EnterInitializationMode",
+        mask::ENTER_INITIALIZATION_MODE,
+        |inst| {
+            inst.core.state = LifeState::InitializationMode;
+            fmi2OK
+        },
+    )
+}
+
+/// # Safety
+/// FMI 2.0 arguments.
+pub unsafe fn exit_initialization_mode<M: FmuModel>(c: fmi2Component) -> fmi2Status {
+    with_instance::<M>(
+        c,
+        "fmi2ExitInitializationMode",
+        mask::EXIT_INITIALIZATION_MODE,
+        |inst| match inst.model.initialize(inst.core.start_time) {
+            Ok(()) => {
+                inst.dirty = false;
+                inst.core.state = LifeState::StepComplete;
+                inst.log(
+                    fmi2OK,
+                    CAT_EVENTS,
+                    &format!("initialized at t = {}", inst.core.start_time),
+                );
+                fmi2OK
+            }
+            Err(msg) => {
+                inst.core.state = LifeState::Error;
+                inst.error(&format!("fmi2ExitInitializationMode: {msg}"))
+            }
+        },
+    )
+}
+
+/// # Safety
+/// FMI 2.0 arguments.
+pub unsafe fn terminate<M: FmuModel>(c: fmi2Component) -> fmi2Status {
+    with_instance::<M>(c, "fmi2Terminate", mask::TERMINATE, |inst| {
+        inst.core.state = LifeState::Terminated;
+        inst.log(
+            fmi2OK,
+            CAT_EVENTS,
+            &format!("terminated at t = {}", inst.core.time),
+        );
+        fmi2OK
+    })
+}
+
+/// # Safety
+/// FMI 2.0 arguments.
+pub unsafe fn reset<M: FmuModel>(c: fmi2Component) -> fmi2Status {
+    with_instance::<M>(c, "fmi2Reset", mask::RESET, |inst| {
+        inst.model = M::default();
+        inst.core = Core {
+            state: LifeState::Instantiated,
+            time: 0.0,
+            start_time: 0.0,
+            stop_time: None,
+        };
+        inst.dirty = true;
+        inst.log(fmi2OK, CAT_EVENTS, "reset to the start values");
+        fmi2OK
+    })
+}
+
+/// Looks up `vr` and checks the base type; the error names the function and the reference.
+fn lookup<'a, M: FmuModel>(
+    inst: &Instance<M>,
+    function: &str,
+    vr: fmi2ValueReference,
+    expected: crate::BaseType,
+) -> Result<&'a Variable<M>, fmi2Status> {
+    let vars = M::variables();
+    match vars.get(vr as usize) {
+        Some(v) if v.base_type() == expected => Ok(v),
+        Some(v) => Err(inst.error(&format!(
+            "{function}: value reference {vr} is {} {:?}, not a {expected} variable",
+            v.base_type(),
+            v.name
+        ))),
+        None => Err(inst.error(&format!(
+            "{function}: no variable with value reference {vr} in {} (valid: 0..{})",
+            M::MODEL_IDENTIFIER,
+            vars.len().saturating_sub(1)
+        ))),
+    }
+}
+
+/// Checks that `v` may be set in the current state (FMI 2.0 section 4.2.4 and the variability
+/// rules: fixed parameters only before initialization is left; tunable parameters and inputs also
+/// in StepComplete; nothing else ever).
+fn check_settable<M: FmuModel>(inst: &Instance<M>, function: &str, v: &Variable<M>) -> fmi2Status {
+    if !v.settable() {
+        return inst.error(&format!(
+            "{function}: variable {:?} has causality {:?} and cannot be set",
+            v.name, v.causality
+        ));
+    }
+    if inst.core.state == LifeState::StepComplete
+        && v.causality == Causality::Parameter
+        && v.variability == Variability::Fixed
+    {
+        return inst.error(&format!(
+            "{function}: fixed parameter {:?} cannot be changed after initialization",
+            v.name
+        ));
+    }
+    fmi2OK
+}
+
+/// Shared body of the typed getters.
+unsafe fn get_values<M: FmuModel, T>(
+    c: fmi2Component,
+    function: &str,
+    base: crate::BaseType,
+    vr: *const fmi2ValueReference,
+    n: usize,
+    out: *mut T,
+    read: impl Fn(&Variable<M>, &M) -> T,
+) -> fmi2Status {
+    with_instance::<M>(c, function, mask::GET, |inst| {
+        if n == 0 {
+            return fmi2OK;
+        }
+        if vr.is_null() || out.is_null() {
+            return inst.error(&format!("{function}: NULL array with nvr = {n}"));
+        }
+        inst.refresh_outputs();
+        let vrs = std::slice::from_raw_parts(vr, n);
+        for (i, &r) in vrs.iter().enumerate() {
+            match lookup(inst, function, r, base) {
+                Ok(v) => *out.add(i) = read(v, &inst.model),
+                Err(s) => return s,
+            }
+        }
+        fmi2OK
+    })
+}
+
+/// # Safety
+/// FMI 2.0 arguments.
+pub unsafe fn get_real<M: FmuModel>(
+    c: fmi2Component,
+    vr: *const fmi2ValueReference,
+    n: usize,
+    out: *mut fmi2Real,
+) -> fmi2Status {
+    get_values::<M, f64>(
+        c,
+        "fmi2GetReal",
+        crate::BaseType::Real,
+        vr,
+        n,
+        out,
+        |v, m| match v.access {
+            Access::Real { get, .. } => get(m),
+            _ => unreachable!("type checked by lookup"),
+        },
+    )
+}
+
+/// # Safety
+/// FMI 2.0 arguments.
+pub unsafe fn get_integer<M: FmuModel>(
+    c: fmi2Component,
+    vr: *const fmi2ValueReference,
+    n: usize,
+    out: *mut fmi2Integer,
+) -> fmi2Status {
+    get_values::<M, i32>(
+        c,
+        "fmi2GetInteger",
+        crate::BaseType::Integer,
+        vr,
+        n,
+        out,
+        |v, m| match v.access {
+            Access::Integer { get, .. } => get(m),
+            _ => unreachable!("type checked by lookup"),
+        },
+    )
+}
+
+/// # Safety
+/// FMI 2.0 arguments.
+pub unsafe fn get_boolean<M: FmuModel>(
+    c: fmi2Component,
+    vr: *const fmi2ValueReference,
+    n: usize,
+    out: *mut fmi2Boolean,
+) -> fmi2Status {
+    get_values::<M, fmi2Boolean>(
+        c,
+        "fmi2GetBoolean",
+        crate::BaseType::Boolean,
+        vr,
+        n,
+        out,
+        |v, m| match v.access {
+            Access::Boolean { get, .. } => get(m) as fmi2Boolean,
+            _ => unreachable!("type checked by lookup"),
+        },
+    )
+}
+
+/// No String variables exist: any value reference is an error.
+///
+/// # Safety
+/// FMI 2.0 arguments.
+pub unsafe fn get_string<M: FmuModel>(
+    c: fmi2Component,
+    vr: *const fmi2ValueReference,
+    n: usize,
+    _out: *mut fmi2String,
+) -> fmi2Status {
+    with_instance::<M>(c, "fmi2GetString", mask::GET, |inst| {
+        if n == 0 {
+            return fmi2OK;
+        }
+        let first = if vr.is_null() { 0 } else { *vr };
+        inst.error(&format!(
+            "fmi2GetString: {} has no String variables (value reference {first})",
+            M::MODEL_IDENTIFIER
+        ))
+    })
+}
+
+/// Shared body of the typed setters. `apply` validates the value and writes it; it returns an
+/// error message naming the variable on refusal. A tunable parameter changed in StepComplete is
+/// checked by `parameters_changed` and restored on refusal.
+unsafe fn set_values<M: FmuModel, T: Copy>(
+    c: fmi2Component,
+    function: &'static str,
+    base: crate::BaseType,
+    legal: u32,
+    vr: *const fmi2ValueReference,
+    n: usize,
+    values: *const T,
+    apply: impl Fn(&Variable<M>, &mut M, T) -> Result<Option<T>, String>,
+) -> fmi2Status {
+    with_instance::<M>(c, function, legal, |inst| {
+        if n == 0 {
+            return fmi2OK;
+        }
+        if vr.is_null() || values.is_null() {
+            return inst.error(&format!("{function}: NULL array with nvr = {n}"));
+        }
+        let vrs = std::slice::from_raw_parts(vr, n);
+        let vals = std::slice::from_raw_parts(values, n);
+        for (&r, &x) in vrs.iter().zip(vals) {
+            let v = match lookup(inst, function, r, base) {
+                Ok(v) => v,
+                Err(s) => return s,
+            };
+            let s = check_settable(inst, function, v);
+            if s != fmi2OK {
+                return s;
+            }
+            let old = match apply(v, &mut inst.model, x) {
+                Ok(old) => old,
+                Err(msg) => {
+                    return inst.error(&format!(
+                        "{function}: instance {:?}: {msg}",
+                        inst.name.to_string_lossy()
+                    ))
+                }
+            };
+            inst.dirty = true;
+            if inst.core.state == LifeState::StepComplete && v.causality == Causality::Parameter {
+                if let Err(msg) = inst.model.parameters_changed() {
+                    if let Some(old) = old {
+                        let _ = apply(v, &mut inst.model, old);
+                    }
+                    return inst.error(&format!(
+                        "{function}: instance {:?}: refused {:?}: {msg}",
+                        inst.name.to_string_lossy(),
+                        v.name
+                    ));
+                }
+            }
+        }
+        fmi2OK
+    })
+}
+
+/// # Safety
+/// FMI 2.0 arguments.
+pub unsafe fn set_real<M: FmuModel>(
+    c: fmi2Component,
+    vr: *const fmi2ValueReference,
+    n: usize,
+    values: *const fmi2Real,
+) -> fmi2Status {
+    set_values::<M, f64>(
+        c,
+        "fmi2SetReal",
+        crate::BaseType::Real,
+        mask::SET_REAL,
+        vr,
+        n,
+        values,
+        |v, m, x| match v.access {
+            Access::Real {
+                get, set, min, max, ..
+            } => {
+                if !x.is_finite() {
+                    return Err(format!("{:?} = {x} refused: not a finite number", v.name));
+                }
+                if min.is_some_and(|lo| x < lo) || max.is_some_and(|hi| x > hi) {
+                    return Err(format!(
+                        "{:?} = {x} refused: outside [{}, {}]",
+                        v.name,
+                        min.unwrap_or(f64::NEG_INFINITY),
+                        max.unwrap_or(f64::INFINITY)
+                    ));
+                }
+                let old = get(m);
+                (set.expect("settable variables have setters (check_table)"))(m, x);
+                Ok(Some(old))
+            }
+            _ => unreachable!("type checked by lookup"),
+        },
+    )
+}
+
+/// # Safety
+/// FMI 2.0 arguments.
+pub unsafe fn set_integer<M: FmuModel>(
+    c: fmi2Component,
+    vr: *const fmi2ValueReference,
+    n: usize,
+    values: *const fmi2Integer,
+) -> fmi2Status {
+    set_values::<M, i32>(
+        c,
+        "fmi2SetInteger",
+        crate::BaseType::Integer,
+        mask::SET_OTHER,
+        vr,
+        n,
+        values,
+        |v, m, x| match v.access {
+            Access::Integer { get, set, min, max } => {
+                if min.is_some_and(|lo| x < lo) || max.is_some_and(|hi| x > hi) {
+                    return Err(format!(
+                        "{:?} = {x} refused: outside [{}, {}]",
+                        v.name,
+                        min.unwrap_or(i32::MIN),
+                        max.unwrap_or(i32::MAX)
+                    ));
+                }
+                let old = get(m);
+                (set.expect("settable variables have setters (check_table)"))(m, x);
+                Ok(Some(old))
+            }
+            _ => unreachable!("type checked by lookup"),
+        },
+    )
+}
+
+/// # Safety
+/// FMI 2.0 arguments.
+pub unsafe fn set_boolean<M: FmuModel>(
+    c: fmi2Component,
+    vr: *const fmi2ValueReference,
+    n: usize,
+    values: *const fmi2Boolean,
+) -> fmi2Status {
+    set_values::<M, fmi2Boolean>(
+        c,
+        "fmi2SetBoolean",
+        crate::BaseType::Boolean,
+        mask::SET_OTHER,
+        vr,
+        n,
+        values,
+        |v, m, x| match v.access {
+            Access::Boolean { get, set } => {
+                let old = get(m) as fmi2Boolean;
+                (set.expect("settable variables have setters (check_table)"))(m, x != fmi2False);
+                Ok(Some(old))
+            }
+            _ => unreachable!("type checked by lookup"),
+        },
+    )
+}
+
+/// # Safety
+/// FMI 2.0 arguments.
+pub unsafe fn set_string<M: FmuModel>(
+    c: fmi2Component,
+    vr: *const fmi2ValueReference,
+    n: usize,
+    _values: *const fmi2String,
+) -> fmi2Status {
+    with_instance::<M>(c, "fmi2SetString", mask::SET_OTHER, |inst| {
+        if n == 0 {
+            return fmi2OK;
+        }
+        let first = if vr.is_null() { 0 } else { *vr };
+        inst.error(&format!(
+            "fmi2SetString: {} has no String variables (value reference {first})",
+            M::MODEL_IDENTIFIER
+        ))
+    })
+}
+
+/// Checks that an FMU-state pointer was made by this model type.
+unsafe fn state_ref<'a, M: FmuModel>(
+    inst: &Instance<M>,
+    function: &str,
+    s: fmi2FMUstate,
+) -> Result<&'a mut StateBox<M>, fmi2Status> {
+    if s.is_null() {
+        return Err(inst.error(&format!("{function}: FMU state is NULL")));
+    }
+    let b = &mut *(s as *mut StateBox<M>);
+    if b.magic != inst.magic {
+        return Err(inst.error(&format!(
+            "{function}: the FMU state was not created by {} (or was freed)",
+            M::MODEL_IDENTIFIER
+        )));
+    }
+    Ok(b)
+}
+
+/// `fmi2GetFMUstate`: a new snapshot, or overwrites the one `*s` points to.
+///
+/// # Safety
+/// FMI 2.0 arguments.
+pub unsafe fn get_fmu_state<M: FmuModel>(c: fmi2Component, s: *mut fmi2FMUstate) -> fmi2Status {
+    with_instance::<M>(c, "fmi2GetFMUstate", mask::FMU_STATE, |inst| {
+        if s.is_null() {
+            return inst.error("fmi2GetFMUstate: FMUstate pointer is NULL");
+        }
+        inst.refresh_outputs();
+        let snapshot = Snapshot {
+            model: inst.model.clone(),
+            core: inst.core.clone(),
+        };
+        if (*s).is_null() {
+            *s = Box::into_raw(Box::new(StateBox {
+                magic: inst.magic,
+                snapshot,
+            })) as fmi2FMUstate;
+        } else {
+            match state_ref::<M>(inst, "fmi2GetFMUstate", *s) {
+                Ok(b) => b.snapshot = snapshot,
+                Err(st) => return st,
+            }
+        }
+        fmi2OK
+    })
+}
+
+/// `fmi2SetFMUstate`: restores model, time and lifecycle state.
+///
+/// # Safety
+/// FMI 2.0 arguments.
+pub unsafe fn set_fmu_state<M: FmuModel>(c: fmi2Component, s: fmi2FMUstate) -> fmi2Status {
+    with_instance::<M>(
+        c,
+        "fmi2SetFMUstate",
+        mask::FMU_STATE,
+        |inst| match state_ref::<M>(inst, "fmi2SetFMUstate", s) {
+            Ok(b) => {
+                inst.model = b.snapshot.model.clone();
+                inst.core = b.snapshot.core.clone();
+                inst.dirty = false;
+                inst.log(
+                    fmi2OK,
+                    CAT_EVENTS,
+                    &format!("state restored to t = {}", inst.core.time),
+                );
+                fmi2OK
+            }
+            Err(st) => st,
+        },
+    )
+}
+
+/// # Safety
+/// FMI 2.0 arguments.
+pub unsafe fn free_fmu_state<M: FmuModel>(c: fmi2Component, s: *mut fmi2FMUstate) -> fmi2Status {
+    with_instance::<M>(c, "fmi2FreeFMUstate", mask::FMU_STATE, |inst| {
+        if s.is_null() || (*s).is_null() {
+            return fmi2OK;
+        }
+        match state_ref::<M>(inst, "fmi2FreeFMUstate", *s) {
+            Ok(b) => {
+                b.magic = 0;
+                drop(Box::from_raw(b as *mut StateBox<M>));
+                *s = std::ptr::null_mut();
+                fmi2OK
+            }
+            Err(st) => st,
+        }
+    })
+}
+
+fn serialize_snapshot<M: FmuModel>(magic: u64, snap: &Snapshot<M>) -> Result<Vec<u8>, String> {
+    let mut bytes = Vec::with_capacity(64);
+    bytes.extend_from_slice(&magic.to_le_bytes());
+    bytes.extend_from_slice(&SERIAL_VERSION.to_le_bytes());
+    bincode::serialize_into(&mut bytes, snap).map_err(|e| e.to_string())?;
+    Ok(bytes)
+}
+
+/// # Safety
+/// FMI 2.0 arguments.
+pub unsafe fn serialized_fmu_state_size<M: FmuModel>(
+    c: fmi2Component,
+    s: fmi2FMUstate,
+    size: *mut usize,
+) -> fmi2Status {
+    with_instance::<M>(c, "fmi2SerializedFMUstateSize", mask::FMU_STATE, |inst| {
+        if size.is_null() {
+            return inst.error("fmi2SerializedFMUstateSize: size pointer is NULL");
+        }
+        match state_ref::<M>(inst, "fmi2SerializedFMUstateSize", s) {
+            Ok(b) => match bincode::serialized_size(&b.snapshot) {
+                Ok(n) => {
+                    *size = n as usize + 12;
+                    fmi2OK
+                }
+                Err(e) => inst.error(&format!("fmi2SerializedFMUstateSize: {e}")),
+            },
+            Err(st) => st,
+        }
+    })
+}
+
+/// # Safety
+/// FMI 2.0 arguments.
+pub unsafe fn serialize_fmu_state<M: FmuModel>(
+    c: fmi2Component,
+    s: fmi2FMUstate,
+    out: *mut fmi2Byte,
+    size: usize,
+) -> fmi2Status {
+    with_instance::<M>(c, "fmi2SerializeFMUstate", mask::FMU_STATE, |inst| {
+        let b = match state_ref::<M>(inst, "fmi2SerializeFMUstate", s) {
+            Ok(b) => b,
+            Err(st) => return st,
+        };
+        let bytes = match serialize_snapshot(inst.magic, &b.snapshot) {
+            Ok(v) => v,
+            Err(e) => return inst.error(&format!("fmi2SerializeFMUstate: {e}")),
+        };
+        if out.is_null() || size != bytes.len() {
+            return inst.error(&format!(
+                "fmi2SerializeFMUstate: buffer of {size} bytes given, {} needed \
+                 (fmi2SerializedFMUstateSize)",
+                bytes.len()
+            ));
+        }
+        std::ptr::copy_nonoverlapping(bytes.as_ptr(), out as *mut u8, size);
+        fmi2OK
+    })
+}
+
+/// # Safety
+/// FMI 2.0 arguments.
+pub unsafe fn deserialize_fmu_state<M: FmuModel>(
+    c: fmi2Component,
+    bytes: *const fmi2Byte,
+    size: usize,
+    s: *mut fmi2FMUstate,
+) -> fmi2Status {
+    with_instance::<M>(c, "fmi2DeSerializeFMUstate", mask::FMU_STATE, |inst| {
+        if bytes.is_null() || s.is_null() {
+            return inst.error("fmi2DeSerializeFMUstate: NULL argument");
+        }
+        let data = std::slice::from_raw_parts(bytes as *const u8, size);
+        if size < 12 || data[..8] != inst.magic.to_le_bytes() {
+            return inst.error(&format!(
+                "fmi2DeSerializeFMUstate: the {size} bytes are not a serialized state of this \
+                 {} (GUID mismatch)",
+                M::MODEL_IDENTIFIER
+            ));
+        }
+        let version = u32::from_le_bytes([data[8], data[9], data[10], data[11]]);
+        if version != SERIAL_VERSION {
+            return inst.error(&format!(
+                "fmi2DeSerializeFMUstate: serialized state layout {version}, expected \
+                 {SERIAL_VERSION}"
+            ));
+        }
+        let snapshot: Snapshot<M> = match bincode::deserialize(&data[12..]) {
+            Ok(v) => v,
+            Err(e) => return inst.error(&format!("fmi2DeSerializeFMUstate: corrupt state: {e}")),
+        };
+        if (*s).is_null() {
+            *s = Box::into_raw(Box::new(StateBox {
+                magic: inst.magic,
+                snapshot,
+            })) as fmi2FMUstate;
+        } else {
+            match state_ref::<M>(inst, "fmi2DeSerializeFMUstate", *s) {
+                Ok(b) => b.snapshot = snapshot,
+                Err(st) => return st,
+            }
+        }
+        fmi2OK
+    })
+}
+
+/// A function for a capability the FMU declares absent: fmi2Error and a log line.
+///
+/// # Safety
+/// FMI 2.0 arguments.
+pub unsafe fn unsupported<M: FmuModel>(c: fmi2Component, function: &str, why: &str) -> fmi2Status {
+    with_instance::<M>(c, function, mask::ANY, |inst| {
+        inst.error(&format!("{function} is not supported: {why}"))
+    })
+}
+
+/// `fmi2DoStep`: checks the communication point and step size, then advances the model.
+///
+/// # Safety
+/// FMI 2.0 arguments.
+pub unsafe fn do_step<M: FmuModel>(
+    c: fmi2Component,
+    t: fmi2Real,
+    h: fmi2Real,
+    _no_set_prior: fmi2Boolean,
+) -> fmi2Status {
+    with_instance::<M>(c, "fmi2DoStep", mask::DO_STEP, |inst| {
+        let now = inst.core.time;
+        if !(h.is_finite() && h > 0.0) {
+            return inst.error(&format!(
+                "fmi2DoStep: communicationStepSize = {h} must be > 0"
+            ));
+        }
+        let tol = 1e-10 * now.abs().max(1.0);
+        if !t.is_finite() || (t - now).abs() > tol {
+            return inst.error(&format!(
+                "fmi2DoStep: currentCommunicationPoint = {t} does not match the FMU's time {now}"
+            ));
+        }
+        if let Some(stop) = inst.core.stop_time {
+            if t + h > stop + 1e-10 * stop.abs().max(1.0) {
+                return inst.error(&format!(
+                    "fmi2DoStep: step to {} passes stopTime = {stop}",
+                    t + h
+                ));
+            }
+        }
+        match inst.model.do_step(t, h) {
+            Ok(()) => {
+                inst.core.time = t + h;
+                inst.dirty = false;
+                fmi2OK
+            }
+            Err(msg) => {
+                inst.core.state = LifeState::Error;
+                inst.error(&format!(
+                    "fmi2DoStep at t = {t}, h = {h}: instance {:?}: {msg}",
+                    inst.name.to_string_lossy()
+                ))
+            }
+        }
+    })
+}
+
+/// # Safety
+/// FMI 2.0 arguments.
+pub unsafe fn get_status<M: FmuModel>(
+    c: fmi2Component,
+    kind: fmi2StatusKind,
+    _v: *mut fmi2Status,
+) -> fmi2Status {
+    with_instance::<M>(c, "fmi2GetStatus", mask::GET_STATUS, |inst| {
+        inst.error(&format!(
+            "fmi2GetStatus(kind {kind}): only meaningful after fmi2DoStep returned fmi2Pending, \
+             which this FMU never does"
+        ))
+    })
+}
+
+/// `fmi2LastSuccessfulTime` is the time reached by the last completed step.
+///
+/// # Safety
+/// FMI 2.0 arguments.
+pub unsafe fn get_real_status<M: FmuModel>(
+    c: fmi2Component,
+    kind: fmi2StatusKind,
+    v: *mut fmi2Real,
+) -> fmi2Status {
+    with_instance::<M>(c, "fmi2GetRealStatus", mask::GET_STATUS, |inst| {
+        if kind != fmi2LastSuccessfulTime {
+            return inst.error(&format!(
+                "fmi2GetRealStatus: status kind {kind} is not fmi2LastSuccessfulTime"
+            ));
+        }
+        if v.is_null() {
+            return inst.error("fmi2GetRealStatus: value pointer is NULL");
+        }
+        *v = inst.core.time;
+        fmi2OK
+    })
+}
+
+/// # Safety
+/// FMI 2.0 arguments.
+pub unsafe fn get_integer_status<M: FmuModel>(
+    c: fmi2Component,
+    kind: fmi2StatusKind,
+    _v: *mut fmi2Integer,
+) -> fmi2Status {
+    with_instance::<M>(c, "fmi2GetIntegerStatus", mask::GET_STATUS, |inst| {
+        inst.error(&format!(
+            "fmi2GetIntegerStatus: no integer status (kind {kind}) is defined"
+        ))
+    })
+}
+
+/// `fmi2Terminated`: whether the FMU asks to stop (never, here: fmi2False).
+///
+/// # Safety
+/// FMI 2.0 arguments.
+pub unsafe fn get_boolean_status<M: FmuModel>(
+    c: fmi2Component,
+    kind: fmi2StatusKind,
+    v: *mut fmi2Boolean,
+) -> fmi2Status {
+    with_instance::<M>(c, "fmi2GetBooleanStatus", mask::GET_STATUS, |inst| {
+        if kind != fmi2Terminated {
+            return inst.error(&format!(
+                "fmi2GetBooleanStatus: status kind {kind} is not fmi2Terminated"
+            ));
+        }
+        if v.is_null() {
+            return inst.error("fmi2GetBooleanStatus: value pointer is NULL");
+        }
+        *v = fmi2False;
+        fmi2OK
+    })
+}
+
+/// # Safety
+/// FMI 2.0 arguments.
+pub unsafe fn get_string_status<M: FmuModel>(
+    c: fmi2Component,
+    kind: fmi2StatusKind,
+    _v: *mut fmi2String,
+) -> fmi2Status {
+    with_instance::<M>(c, "fmi2GetStringStatus", mask::GET_STATUS, |inst| {
+        inst.error(&format!(
+            "fmi2GetStringStatus(kind {kind}): only meaningful after fmi2DoStep returned \
+             fmi2Pending, which this FMU never does"
+        ))
+    })
+}
+
+/// Hands generated text to the caller of a generator entry point.
+pub fn emit_text(
+    out: *mut c_void,
+    write: unsafe extern "C" fn(*mut c_void, *const u8, usize),
+    text: &str,
+) {
+    // SAFETY: the generator passes a valid callback and context.
+    let _ = catch_unwind(AssertUnwindSafe(|| unsafe {
+        write(out, text.as_ptr(), text.len())
+    }));
+}

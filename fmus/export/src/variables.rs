@@ -1,0 +1,464 @@
+//! The variable table: the single source of truth from which the C API dispatches get/set and
+//! from which `modelDescription.xml` and the HTML documentation are generated.
+//!
+//! A variable's value reference is its index in the table, so value references cannot drift
+//! between the XML and the code. The `initial` attribute and the start values are derived:
+//! parameters are `initial="exact"` with the start taken from `M::default()` through the getter,
+//! inputs carry a start value and no `initial`, outputs and locals are `initial="calculated"`
+//! without a start (FMI 2.0 standard, section 2.2.7, table of legal combinations).
+
+use std::fmt;
+
+/// `causality` (FMI 2.0 section 2.2.7).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Causality {
+    Parameter,
+    CalculatedParameter,
+    Input,
+    Output,
+    Local,
+}
+
+/// `variability` (FMI 2.0 section 2.2.7).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Variability {
+    Fixed,
+    Tunable,
+    Discrete,
+    Continuous,
+}
+
+/// `initial` (FMI 2.0 section 2.2.7).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Initial {
+    Exact,
+    Calculated,
+}
+
+/// Typed accessors of a variable into the model `M`.
+pub enum Access<M> {
+    Real {
+        get: fn(&M) -> f64,
+        set: Option<fn(&mut M, f64)>,
+        unit: Option<&'static str>,
+        min: Option<f64>,
+        max: Option<f64>,
+    },
+    Integer {
+        get: fn(&M) -> i32,
+        set: Option<fn(&mut M, i32)>,
+        min: Option<i32>,
+        max: Option<i32>,
+    },
+    Boolean {
+        get: fn(&M) -> bool,
+        set: Option<fn(&mut M, bool)>,
+    },
+}
+
+/// The FMI base type of a variable.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BaseType {
+    Real,
+    Integer,
+    Boolean,
+}
+
+impl fmt::Display for BaseType {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            BaseType::Real => "Real",
+            BaseType::Integer => "Integer",
+            BaseType::Boolean => "Boolean",
+        })
+    }
+}
+
+/// One scalar variable.
+pub struct Variable<M> {
+    pub name: &'static str,
+    pub causality: Causality,
+    pub variability: Variability,
+    pub description: &'static str,
+    pub access: Access<M>,
+}
+
+impl<M> Variable<M> {
+    /// A Real parameter (tunable when `tunable`), `initial="exact"`.
+    pub const fn real_parameter(
+        name: &'static str,
+        unit: Option<&'static str>,
+        tunable: bool,
+        description: &'static str,
+        get: fn(&M) -> f64,
+        set: fn(&mut M, f64),
+    ) -> Self {
+        Variable {
+            name,
+            causality: Causality::Parameter,
+            variability: if tunable {
+                Variability::Tunable
+            } else {
+                Variability::Fixed
+            },
+            description,
+            access: Access::Real {
+                get,
+                set: Some(set),
+                unit,
+                min: None,
+                max: None,
+            },
+        }
+    }
+
+    /// A continuous Real input.
+    pub const fn real_input(
+        name: &'static str,
+        unit: Option<&'static str>,
+        description: &'static str,
+        get: fn(&M) -> f64,
+        set: fn(&mut M, f64),
+    ) -> Self {
+        Variable {
+            name,
+            causality: Causality::Input,
+            variability: Variability::Continuous,
+            description,
+            access: Access::Real {
+                get,
+                set: Some(set),
+                unit,
+                min: None,
+                max: None,
+            },
+        }
+    }
+
+    /// A continuous Real output.
+    pub const fn real_output(
+        name: &'static str,
+        unit: Option<&'static str>,
+        description: &'static str,
+        get: fn(&M) -> f64,
+    ) -> Self {
+        Variable {
+            name,
+            causality: Causality::Output,
+            variability: Variability::Continuous,
+            description,
+            access: Access::Real {
+                get,
+                set: None,
+                unit,
+                min: None,
+                max: None,
+            },
+        }
+    }
+
+    /// A discrete Boolean output.
+    pub const fn boolean_output(
+        name: &'static str,
+        description: &'static str,
+        get: fn(&M) -> bool,
+    ) -> Self {
+        Variable {
+            name,
+            causality: Causality::Output,
+            variability: Variability::Discrete,
+            description,
+            access: Access::Boolean { get, set: None },
+        }
+    }
+
+    /// A Boolean parameter.
+    pub const fn boolean_parameter(
+        name: &'static str,
+        tunable: bool,
+        description: &'static str,
+        get: fn(&M) -> bool,
+        set: fn(&mut M, bool),
+    ) -> Self {
+        Variable {
+            name,
+            causality: Causality::Parameter,
+            variability: if tunable {
+                Variability::Tunable
+            } else {
+                Variability::Fixed
+            },
+            description,
+            access: Access::Boolean {
+                get,
+                set: Some(set),
+            },
+        }
+    }
+
+    /// An Integer parameter with an inclusive range.
+    pub const fn integer_parameter(
+        name: &'static str,
+        tunable: bool,
+        description: &'static str,
+        min: i32,
+        max: i32,
+        get: fn(&M) -> i32,
+        set: fn(&mut M, i32),
+    ) -> Self {
+        Variable {
+            name,
+            causality: Causality::Parameter,
+            variability: if tunable {
+                Variability::Tunable
+            } else {
+                Variability::Fixed
+            },
+            description,
+            access: Access::Integer {
+                get,
+                set: Some(set),
+                min: Some(min),
+                max: Some(max),
+            },
+        }
+    }
+
+    /// Adds an inclusive range to a Real variable (declared in the XML and enforced on set).
+    pub const fn with_range(mut self, lo: Option<f64>, hi: Option<f64>) -> Self {
+        if let Access::Real {
+            ref mut min,
+            ref mut max,
+            ..
+        } = self.access
+        {
+            *min = lo;
+            *max = hi;
+        }
+        self
+    }
+
+    pub fn base_type(&self) -> BaseType {
+        match self.access {
+            Access::Real { .. } => BaseType::Real,
+            Access::Integer { .. } => BaseType::Integer,
+            Access::Boolean { .. } => BaseType::Boolean,
+        }
+    }
+
+    /// The derived `initial` attribute (None: not written).
+    pub fn initial(&self) -> Option<Initial> {
+        match self.causality {
+            Causality::Parameter => Some(Initial::Exact),
+            Causality::Input => None,
+            Causality::Output | Causality::Local | Causality::CalculatedParameter => {
+                Some(Initial::Calculated)
+            }
+        }
+    }
+
+    /// Whether the variable carries a start value in the XML.
+    pub fn has_start(&self) -> bool {
+        matches!(self.causality, Causality::Parameter | Causality::Input)
+    }
+
+    /// Whether fmi2SetXXX may write it at all.
+    pub fn settable(&self) -> bool {
+        matches!(self.causality, Causality::Parameter | Causality::Input)
+    }
+
+    pub fn unit(&self) -> Option<&'static str> {
+        match self.access {
+            Access::Real { unit, .. } => unit,
+            _ => None,
+        }
+    }
+}
+
+/// A unit of the registry: its SI base-unit exponents (kg, m, s, A, K, mol, cd, rad), factor and
+/// display units (name, factor) for `<UnitDefinitions>`.
+pub struct UnitDef {
+    pub name: &'static str,
+    pub exponents: [i8; 8],
+    pub factor: f64,
+    pub display: &'static [(&'static str, f64)],
+}
+
+const BASE_NAMES: [&str; 8] = ["kg", "m", "s", "A", "K", "mol", "cd", "rad"];
+const DEG_PER_RAD: f64 = 180.0 / std::f64::consts::PI;
+
+/// Units the FMUs may use. SI on every interface; degrees and knots only as display units.
+pub const UNITS: &[UnitDef] = &[
+    UnitDef {
+        name: "rad",
+        exponents: [0, 0, 0, 0, 0, 0, 0, 1],
+        factor: 1.0,
+        display: &[("deg", DEG_PER_RAD)],
+    },
+    UnitDef {
+        name: "rad/s",
+        exponents: [0, 0, -1, 0, 0, 0, 0, 1],
+        factor: 1.0,
+        display: &[("deg/s", DEG_PER_RAD)],
+    },
+    UnitDef {
+        name: "rad/s2",
+        exponents: [0, 0, -2, 0, 0, 0, 0, 1],
+        factor: 1.0,
+        display: &[("deg/s2", DEG_PER_RAD)],
+    },
+    UnitDef {
+        name: "s",
+        exponents: [0, 0, 1, 0, 0, 0, 0, 0],
+        factor: 1.0,
+        display: &[],
+    },
+    UnitDef {
+        name: "1/s",
+        exponents: [0, 0, -1, 0, 0, 0, 0, 0],
+        factor: 1.0,
+        display: &[],
+    },
+    UnitDef {
+        name: "m",
+        exponents: [0, 1, 0, 0, 0, 0, 0, 0],
+        factor: 1.0,
+        display: &[],
+    },
+    UnitDef {
+        name: "m/s",
+        exponents: [0, 1, -1, 0, 0, 0, 0, 0],
+        factor: 1.0,
+        display: &[("kn", 3600.0 / 1852.0)],
+    },
+    UnitDef {
+        name: "m/s2",
+        exponents: [0, 1, -2, 0, 0, 0, 0, 0],
+        factor: 1.0,
+        display: &[],
+    },
+    UnitDef {
+        name: "m2",
+        exponents: [0, 2, 0, 0, 0, 0, 0, 0],
+        factor: 1.0,
+        display: &[],
+    },
+    UnitDef {
+        name: "kg",
+        exponents: [1, 0, 0, 0, 0, 0, 0, 0],
+        factor: 1.0,
+        display: &[],
+    },
+    UnitDef {
+        name: "N",
+        exponents: [1, 1, -2, 0, 0, 0, 0, 0],
+        factor: 1.0,
+        display: &[("kN", 1e-3)],
+    },
+    UnitDef {
+        name: "N.m",
+        exponents: [1, 2, -2, 0, 0, 0, 0, 0],
+        factor: 1.0,
+        display: &[("kN.m", 1e-3)],
+    },
+    UnitDef {
+        name: "rpm",
+        exponents: [0, 0, -1, 0, 0, 0, 0, 0],
+        factor: 1.0 / 60.0,
+        display: &[],
+    },
+];
+
+/// Looks a unit up in [`UNITS`].
+pub fn unit_def(name: &str) -> Option<&'static UnitDef> {
+    UNITS.iter().find(|u| u.name == name)
+}
+
+/// Names of the SI base units in the order of [`UnitDef::exponents`].
+pub fn base_unit_names() -> &'static [&'static str; 8] {
+    &BASE_NAMES
+}
+
+/// Checks a variable table for the rules the XML and the C API rely on: unique legal names,
+/// settable causalities have setters, units are in the registry, legal
+/// causality/variability combinations. Returns every problem found.
+pub fn check_table<M: Default>(vars: &[Variable<M>]) -> Result<(), Vec<String>> {
+    let mut problems = Vec::new();
+    let default = M::default();
+    for (i, v) in vars.iter().enumerate() {
+        let legal_name = !v.name.is_empty()
+            && v.name
+                .chars()
+                .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '.')
+            && !v.name.starts_with(|c: char| c.is_ascii_digit());
+        if !legal_name {
+            problems.push(format!("variable {i}: illegal name {:?}", v.name));
+        }
+        if vars[..i].iter().any(|w| w.name == v.name) {
+            problems.push(format!("variable {}: duplicate name", v.name));
+        }
+        let has_setter = match &v.access {
+            Access::Real { set, .. } => set.is_some(),
+            Access::Integer { set, .. } => set.is_some(),
+            Access::Boolean { set, .. } => set.is_some(),
+        };
+        if v.settable() != has_setter {
+            problems.push(format!(
+                "variable {}: causality {:?} {} a setter",
+                v.name,
+                v.causality,
+                if has_setter { "must not have" } else { "needs" }
+            ));
+        }
+        if let Some(u) = v.unit() {
+            if unit_def(u).is_none() {
+                problems.push(format!("variable {}: unit {u:?} is not in UNITS", v.name));
+            }
+        }
+        let legal = match v.causality {
+            Causality::Parameter | Causality::CalculatedParameter => {
+                matches!(v.variability, Variability::Fixed | Variability::Tunable)
+            }
+            Causality::Input | Causality::Output | Causality::Local => {
+                matches!(
+                    v.variability,
+                    Variability::Discrete | Variability::Continuous
+                )
+            }
+        };
+        if !legal {
+            problems.push(format!(
+                "variable {}: causality {:?} with variability {:?} is illegal",
+                v.name, v.causality, v.variability
+            ));
+        }
+        if v.variability == Variability::Continuous && v.base_type() != BaseType::Real {
+            problems.push(format!(
+                "variable {}: only Real variables may be continuous",
+                v.name
+            ));
+        }
+        if v.has_start() {
+            if let Access::Real { get, min, max, .. } = &v.access {
+                let s = get(&default);
+                if !s.is_finite() {
+                    problems.push(format!(
+                        "variable {}: start value {s} is not finite",
+                        v.name
+                    ));
+                }
+                if min.is_some_and(|m| s < m) || max.is_some_and(|m| s > m) {
+                    problems.push(format!(
+                        "variable {}: start value {s} outside range",
+                        v.name
+                    ));
+                }
+            }
+        }
+    }
+    if problems.is_empty() {
+        Ok(())
+    } else {
+        Err(problems)
+    }
+}

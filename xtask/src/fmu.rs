@@ -1,0 +1,221 @@
+//! Building and packaging the FMUs.
+//!
+//! Every workspace package with `[package.metadata.fmu] model-identifier = "X"` is an FMU crate
+//! (a `cdylib` that invokes `fmi2_export::export_fmu!`). All of them are built in one
+//! `cargo build --release` so they share one build of the workspace. For each, the shared library
+//! is loaded once to obtain the generated `modelDescription.xml` and `documentation/index.html`
+//! (this also proves the library loads), its exported symbols and dynamic dependencies are
+//! checked, and `target/fmu/X.fmu` is written with fixed timestamps (reproducible archives).
+
+use crate::{cargo, run};
+use anyhow::{bail, Context, Result};
+use object::read::elf::{Dyn, ElfFile64, FileHeader};
+use object::{Object, ObjectSymbol};
+use serde::Deserialize;
+use std::ffi::c_void;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+#[derive(Deserialize)]
+struct Metadata {
+    packages: Vec<Package>,
+    workspace_members: Vec<String>,
+}
+
+#[derive(Deserialize)]
+struct Package {
+    id: String,
+    name: String,
+    targets: Vec<Target>,
+    metadata: Option<serde_json::Value>,
+}
+
+#[derive(Deserialize)]
+struct Target {
+    name: String,
+    crate_types: Vec<String>,
+}
+
+/// An FMU crate of the workspace.
+pub struct FmuCrate {
+    pub package: String,
+    pub lib_name: String,
+    pub model_identifier: String,
+}
+
+/// Lists the FMU crates from `cargo metadata`.
+pub fn fmu_crates(root: &Path) -> Result<Vec<FmuCrate>> {
+    let out = cargo()
+        .current_dir(root)
+        .args(["metadata", "--format-version", "1", "--no-deps"])
+        .output()
+        .context("running cargo metadata")?;
+    if !out.status.success() {
+        bail!(
+            "cargo metadata failed: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+    let meta: Metadata = serde_json::from_slice(&out.stdout).context("parsing cargo metadata")?;
+    let mut crates = Vec::new();
+    for p in meta
+        .packages
+        .iter()
+        .filter(|p| meta.workspace_members.contains(&p.id))
+    {
+        let Some(id) = p
+            .metadata
+            .as_ref()
+            .and_then(|m| m.get("fmu"))
+            .and_then(|f| f.get("model-identifier"))
+            .and_then(|v| v.as_str())
+        else {
+            continue;
+        };
+        let lib = p
+            .targets
+            .iter()
+            .find(|t| t.crate_types.iter().any(|c| c == "cdylib"))
+            .with_context(|| format!("FMU package {} has no cdylib target", p.name))?;
+        crates.push(FmuCrate {
+            package: p.name.clone(),
+            lib_name: lib.name.clone(),
+            model_identifier: id.to_string(),
+        });
+    }
+    crates.sort_by(|a, b| a.model_identifier.cmp(&b.model_identifier));
+    Ok(crates)
+}
+
+unsafe extern "C" fn append(out: *mut c_void, data: *const u8, len: usize) {
+    let v = &mut *(out as *mut Vec<u8>);
+    v.extend_from_slice(std::slice::from_raw_parts(data, len));
+}
+
+type Generator =
+    unsafe extern "C" fn(*mut c_void, unsafe extern "C" fn(*mut c_void, *const u8, usize));
+
+/// Calls a generator entry point of the FMU library.
+fn generated_text(lib: &libloading::Library, symbol: &[u8]) -> Result<String> {
+    let mut buf: Vec<u8> = Vec::new();
+    // SAFETY: the symbol is emitted by `export_fmu!` with exactly this signature.
+    unsafe {
+        let f: libloading::Symbol<Generator> = lib
+            .get(symbol)
+            .with_context(|| format!("symbol {}", String::from_utf8_lossy(symbol)))?;
+        f(&mut buf as *mut Vec<u8> as *mut c_void, append);
+    }
+    String::from_utf8(buf).context("generated text is not UTF-8")
+}
+
+/// Shared libraries an FMU binary may depend on (glibc, libm, libgcc_s, the loader).
+const ALLOWED_NEEDED: [&str; 6] = [
+    "libc.so.6",
+    "libm.so.6",
+    "libgcc_s.so.1",
+    "ld-linux-x86-64.so.2",
+    "libpthread.so.0",
+    "libdl.so.2",
+];
+
+/// Checks the exported FMI symbols and the dynamic dependencies of a built FMU binary.
+fn check_binary(path: &Path) -> Result<()> {
+    let data = std::fs::read(path).with_context(|| format!("reading {}", path.display()))?;
+    let elf = ElfFile64::<object::Endianness>::parse(&*data)
+        .with_context(|| format!("{} is not a 64-bit ELF file", path.display()))?;
+    let exported: std::collections::HashSet<&str> = elf
+        .dynamic_symbols()
+        .filter(|s| s.is_definition())
+        .filter_map(|s| s.name().ok())
+        .collect();
+    let missing: Vec<&str> = fmi2::CS_FUNCTION_NAMES
+        .iter()
+        .copied()
+        .filter(|n| !exported.contains(n))
+        .collect();
+    if !missing.is_empty() {
+        bail!("{} does not export {}", path.display(), missing.join(", "));
+    }
+    let endian = elf.endian();
+    let header = elf.elf_header();
+    let mut needed = Vec::new();
+    if let Some((dynamic, link)) = header
+        .sections(endian, &*data)
+        .ok()
+        .and_then(|s| s.dynamic(endian, &*data).ok().flatten())
+    {
+        let sections = header.sections(endian, &*data)?;
+        let strings = sections.strings(endian, &*data, link)?;
+        for d in dynamic {
+            if d.d_tag(endian) as u32 == object::elf::DT_NEEDED {
+                let name = strings
+                    .get(d.d_val(endian) as u32)
+                    .map_err(|_| anyhow::anyhow!("bad DT_NEEDED entry"))?;
+                needed.push(String::from_utf8_lossy(name).into_owned());
+            }
+        }
+    }
+    let extra: Vec<&String> = needed
+        .iter()
+        .filter(|n| !ALLOWED_NEEDED.contains(&n.as_str()))
+        .collect();
+    if !extra.is_empty() {
+        bail!(
+            "{} depends on {:?}; an FMU may only need {:?}",
+            path.display(),
+            extra,
+            ALLOWED_NEEDED
+        );
+    }
+    Ok(())
+}
+
+/// Writes one `.fmu` archive.
+fn write_fmu(out: &Path, id: &str, xml: &str, so: &Path, html: &str) -> Result<()> {
+    use zip::write::SimpleFileOptions;
+    let file = std::fs::File::create(out).with_context(|| format!("creating {}", out.display()))?;
+    let mut zip = zip::ZipWriter::new(file);
+    let opts = SimpleFileOptions::default()
+        .compression_method(zip::CompressionMethod::Deflated)
+        .last_modified_time(zip::DateTime::default());
+    zip.start_file("modelDescription.xml", opts)?;
+    zip.write_all(xml.as_bytes())?;
+    zip.start_file(
+        format!("binaries/linux64/{id}.so"),
+        opts.unix_permissions(0o755),
+    )?;
+    zip.write_all(&std::fs::read(so)?)?;
+    zip.start_file("documentation/index.html", opts)?;
+    zip.write_all(html.as_bytes())?;
+    zip.finish()?;
+    Ok(())
+}
+
+/// Builds and packages every FMU; returns the output folder `target/fmu`.
+pub fn build_fmus(root: &Path) -> Result<PathBuf> {
+    let crates = fmu_crates(root)?;
+    if crates.is_empty() {
+        bail!("no FMU crates found (packages with [package.metadata.fmu])");
+    }
+    let mut cmd = cargo();
+    cmd.current_dir(root).args(["build", "--release", "--lib"]);
+    for c in &crates {
+        cmd.args(["-p", &c.package]);
+    }
+    run(&mut cmd)?;
+    let out_dir = root.join("target/fmu");
+    std::fs::create_dir_all(&out_dir)?;
+    for c in &crates {
+        let so = root.join(format!("target/release/lib{}.so", c.lib_name));
+        check_binary(&so)?;
+        // SAFETY: our own FMU library; loading runs no initialisers beyond Rust's std.
+        let lib = unsafe { libloading::Library::new(&so) }
+            .with_context(|| format!("loading {}", so.display()))?;
+        let xml = generated_text(&lib, b"shipfmu_model_description")?;
+        let html = generated_text(&lib, b"shipfmu_documentation_html")?;
+        let fmu = out_dir.join(format!("{}.fmu", c.model_identifier));
+        write_fmu(&fmu, &c.model_identifier, &xml, &so, &html)?;
+        eprintln!("xtask: wrote {}", fmu.display());
+    }
+    Ok(out_dir)
+}
