@@ -519,6 +519,31 @@ print(sys.version.split()[0])\n";
         std::env::set_var("PYTHONPATH", pp);
         let lib = unsafe { Library::open(Some(libpath), RTLD_NOW | RTLD_GLOBAL) }
             .map_err(|e| format!("cannot load {}: {e}", libpath.display()))?;
+        // Initialize the interpreter here, once, and release the GIL. PythonFMU binaries then
+        // find it initialized: they take the GIL per call and never finalize it, so several
+        // Python FMUs can share the process and exit does not run Py_Finalize twice.
+        unsafe {
+            let is_init = lib
+                .get::<unsafe extern "C" fn() -> std::ffi::c_int>(b"Py_IsInitialized\0")
+                .map_err(|e| format!("{}: {e}", libpath.display()))?;
+            if is_init() == 0 {
+                let init = lib
+                    .get::<unsafe extern "C" fn(std::ffi::c_int)>(b"Py_InitializeEx\0")
+                    .map_err(|e| format!("{}: {e}", libpath.display()))?;
+                let save = lib
+                    .get::<unsafe extern "C" fn() -> *mut c_void>(b"PyEval_SaveThread\0")
+                    .map_err(|e| format!("{}: {e}", libpath.display()))?;
+                // 0: do not install Python's signal handlers (Ctrl-C stays ours).
+                init(0);
+                if is_init() == 0 {
+                    return Err(format!(
+                        "Python {version} from {} failed to initialize (PYTHONHOME={base_prefix})",
+                        libpath.display()
+                    ));
+                }
+                save();
+            }
+        }
         std::mem::forget(lib);
         Ok(libpath.display().to_string())
     }

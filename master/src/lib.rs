@@ -9,7 +9,10 @@ pub mod error;
 pub mod fmu;
 pub mod inspect;
 pub mod instance;
+pub mod master;
 pub mod model_description;
+pub mod osp;
+pub mod system;
 
 pub use error::{Error, Result};
 pub use fmu::Fmu;

@@ -1,7 +1,14 @@
-//! The `shipsim` command line.
+//! The `shipsim` command line: `run`, `check`, `inspect`, `export-osp`.
 use clap::{Parser, Subcommand};
+use shipsim::error::Error;
+use shipsim::fmu::UnpackedFmu;
+use shipsim::master::{run_system, Output, RunOptions};
+use shipsim::system::System;
+use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::process::ExitCode;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 
 #[derive(Parser)]
 #[command(
@@ -16,23 +23,178 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
+    /// Run a system (native .toml or OSP OspSystemStructure.xml).
+    Run {
+        /// The system file.
+        system: PathBuf,
+        /// Override the stop time [s].
+        #[arg(long)]
+        stop_time: Option<f64>,
+        /// CSV output file (overrides the system's output.file).
+        #[arg(long, short)]
+        output: Option<PathBuf>,
+        /// Set a parameter or start value: --set instance.variable=value (repeatable).
+        #[arg(long = "set", value_name = "INST.VAR=VALUE")]
+        set: Vec<String>,
+        /// Override the algorithm: jacobi or gauss-seidel.
+        #[arg(long)]
+        algorithm: Option<String>,
+        /// Show all FMU log messages and switch FMU debug logging on.
+        #[arg(long, short)]
+        verbose: bool,
+        /// No progress bar and no summary.
+        #[arg(long, short)]
+        quiet: bool,
+    },
+    /// Validate a system without running it.
+    Check {
+        system: PathBuf,
+        #[arg(long = "set", value_name = "INST.VAR=VALUE")]
+        set: Vec<String>,
+    },
     /// Show an FMU's variables, units and capabilities.
     Inspect {
         /// The .fmu file.
         fmu: PathBuf,
     },
+    /// Write an OSP OspSystemStructure.xml for a native system file (runs in libcosim).
+    ExportOsp {
+        system: PathBuf,
+        /// Output file (default: OspSystemStructure.xml beside the system file).
+        #[arg(long, short)]
+        output: Option<PathBuf>,
+    },
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
-    let result: shipsim::Result<()> = match cli.command {
-        Command::Inspect { fmu } => shipsim::inspect::inspect(&fmu).map(|s| print!("{s}")),
-    };
-    match result {
+    match dispatch(cli.command) {
         Ok(()) => ExitCode::SUCCESS,
+        Err(Error::Interrupted { time }) => {
+            eprintln!(
+                "interrupted at t = {time} s; instances terminated and freed, output flushed"
+            );
+            ExitCode::from(130)
+        }
         Err(e) => {
             eprintln!("error: {e}");
             ExitCode::FAILURE
+        }
+    }
+}
+
+fn dispatch(cmd: Command) -> shipsim::Result<()> {
+    match cmd {
+        Command::Inspect { fmu } => {
+            print!("{}", shipsim::inspect::inspect(&fmu)?);
+            Ok(())
+        }
+        Command::Check { system, set } => {
+            let mut sys = System::load(&system)?;
+            sys.apply_overrides(&set)?;
+            let mut unpacked = Vec::new();
+            for inst in &sys.instances {
+                if !inst.fmu.exists() {
+                    return Err(Error::system(
+                        &sys.source,
+                        inst.line,
+                        format!(
+                            "instance '{}': FMU file '{}' not found",
+                            inst.name,
+                            inst.fmu.display()
+                        ),
+                    ));
+                }
+                let u = UnpackedFmu::open(&inst.fmu)?;
+                u.binary_path()?;
+                unpacked.push(u);
+            }
+            let mds: Vec<_> = unpacked.iter().map(|u| &u.model_description).collect();
+            let plan = sys.validate(&mds)?;
+            for w in &plan.warnings {
+                eprintln!("warning: {w}");
+            }
+            println!(
+                "{}: OK ({} instances, {} connections, {} events, {} recorded variables, {} steps of {} s, {:?})",
+                system.display(),
+                plan.instances.len(),
+                plan.connections.len(),
+                plan.events.len(),
+                plan.outputs.len(),
+                plan.n_steps,
+                plan.step_size,
+                plan.algorithm
+            );
+            Ok(())
+        }
+        Command::Run {
+            system,
+            stop_time,
+            output,
+            set,
+            algorithm,
+            verbose,
+            quiet,
+        } => {
+            let mut sys = System::load(&system)?;
+            sys.apply_overrides(&set)?;
+            if let Some(t) = stop_time {
+                sys.stop_time = Some(t);
+            }
+            if let Some(a) = algorithm {
+                sys.algorithm = match a.to_lowercase().as_str() {
+                    "jacobi" => shipsim::system::Algorithm::Jacobi,
+                    "gauss-seidel" | "gauss_seidel" | "gaussseidel" => {
+                        shipsim::system::Algorithm::GaussSeidel
+                    }
+                    _ => {
+                        return Err(Error::Other(format!(
+                            "--algorithm {a}: use jacobi or gauss-seidel"
+                        )))
+                    }
+                };
+            }
+            let out_file = output.or_else(|| sys.output.file.clone());
+            let out = match &out_file {
+                Some(p) => Output::File(p.clone()),
+                None => Output::None,
+            };
+            let flag = Arc::new(AtomicBool::new(false));
+            {
+                let f = flag.clone();
+                // A second Ctrl-C while shutting down falls back to the default behaviour.
+                let _ = ctrlc::set_handler(move || {
+                    if f.swap(true, Ordering::SeqCst) {
+                        std::process::exit(130);
+                    }
+                });
+            }
+            let opts = RunOptions {
+                verbose,
+                progress: !quiet && std::io::stderr().is_terminal(),
+                interrupt: Some(flag),
+                log_sink: None,
+            };
+            let (_plan, summary) = run_system(&sys, out, &opts)?;
+            if !quiet {
+                eprintln!("{summary}");
+            }
+            Ok(())
+        }
+        Command::ExportOsp { system, output } => {
+            let sys = System::load(&system)?;
+            let out = output.unwrap_or_else(|| {
+                system
+                    .parent()
+                    .unwrap_or(std::path::Path::new("."))
+                    .join("OspSystemStructure.xml")
+            });
+            let warnings = shipsim::osp::write(&sys, &out)?;
+            for w in warnings {
+                eprintln!("warning: {w}");
+            }
+            eprintln!("wrote {}", out.display());
+            Ok(())
         }
     }
 }
