@@ -133,6 +133,8 @@ pub struct ConnectionSpec {
     pub gain: f64,
     pub offset: f64,
     pub line: Option<usize>,
+    /// OSP VariableConnection: the direction follows the variables' causalities.
+    pub either_direction: bool,
 }
 
 #[derive(Debug, Clone)]
@@ -375,6 +377,7 @@ impl System {
                 gain: gain.unwrap_or(1.0),
                 offset: offset.unwrap_or(0.0),
                 line,
+                either_direction: false,
             });
         }
         let mut events = Vec::new();
@@ -482,35 +485,6 @@ impl System {
             });
         }
         Ok(())
-    }
-
-    /// The order in which Gauss-Seidel steps the instances: by first appearance in the
-    /// connection list (a source before its target), then the unconnected ones in file order.
-    pub fn gauss_seidel_order(&self) -> Vec<usize> {
-        let idx: HashMap<&str, usize> = self
-            .instances
-            .iter()
-            .enumerate()
-            .map(|(i, s)| (s.name.as_str(), i))
-            .collect();
-        let mut order = Vec::new();
-        let mut seen = vec![false; self.instances.len()];
-        for c in &self.connections {
-            for name in [&c.from.instance, &c.to.instance] {
-                if let Some(&i) = idx.get(name.as_str()) {
-                    if !seen[i] {
-                        seen[i] = true;
-                        order.push(i);
-                    }
-                }
-            }
-        }
-        for (i, s) in seen.iter().enumerate() {
-            if !s {
-                order.push(i);
-            }
-        }
-        order
     }
 }
 
@@ -816,7 +790,6 @@ impl System {
         let mut connections = Vec::new();
         let mut driven: HashMap<(usize, usize), (String, Option<usize>)> = HashMap::new();
         for c in &self.connections {
-            let name = format!("{} -> {}", c.from, c.to);
             let (fi, fv) = match resolve(&c.from, c.line, "connection source") {
                 Ok(x) => x,
                 Err(e) => {
@@ -831,6 +804,21 @@ impl System {
                     continue;
                 }
             };
+            let swapped;
+            let (c, fi, fv, ti, tv) = if c.either_direction
+                && mds[fi].model_variables.variables[fv].causality == Causality::Input
+                && mds[ti].model_variables.variables[tv].causality == Causality::Output
+            {
+                swapped = ConnectionSpec {
+                    from: c.to.clone(),
+                    to: c.from.clone(),
+                    ..c.clone()
+                };
+                (&swapped, ti, tv, fi, fv)
+            } else {
+                (c, fi, fv, ti, tv)
+            };
+            let name = format!("{} -> {}", c.from, c.to);
             let fsv = &mds[fi].model_variables.variables[fv];
             let tsv = &mds[ti].model_variables.variables[tv];
             let mut ok = true;
@@ -1072,7 +1060,20 @@ impl System {
         // Stepping order and algebraic loops.
         let order: Vec<usize> = match self.algorithm {
             Algorithm::Jacobi => (0..self.instances.len()).collect(),
-            Algorithm::GaussSeidel => self.gauss_seidel_order(),
+            Algorithm::GaussSeidel => {
+                let mut order = Vec::new();
+                let mut seen = vec![false; self.instances.len()];
+                for c in &connections {
+                    for i in [c.from_instance, c.to_instance] {
+                        if !seen[i] {
+                            seen[i] = true;
+                            order.push(i);
+                        }
+                    }
+                }
+                order.extend((0..self.instances.len()).filter(|&i| !seen[i]));
+                order
+            }
         };
         if self.algorithm == Algorithm::GaussSeidel {
             if let Some(cycle) = find_algebraic_loop(&connections, mds, &self.instances) {
