@@ -1,1 +1,3 @@
-//! Shared helpers for the system tests in `tests/tests/`.
+//! Shared code of the system tests: the Rust-model reference cases (see [`reference`]).
+
+pub mod reference;
