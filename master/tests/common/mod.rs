@@ -1,0 +1,181 @@
+//! Test helpers: build the C test FMU (tests/c/testfmu.c) with gcc and package it, in variants
+//! that misbehave on purpose.
+#![allow(dead_code)]
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+pub const GUID: &str = "{shipsim-test-fmu}";
+
+pub fn model_description(guid: &str, fmi_version: &str) -> String {
+    format!(
+        r#"<?xml version="1.0" encoding="UTF-8"?>
+<fmiModelDescription fmiVersion="{fmi_version}" modelName="testfmu" guid="{guid}" generationTool="shipsim tests">
+  <CoSimulation modelIdentifier="testfmu" canHandleVariableCommunicationStepSize="true"/>
+  <UnitDefinitions>
+    <Unit name="m"><BaseUnit m="1"/></Unit>
+    <Unit name="km"><BaseUnit m="1" factor="1000"/></Unit>
+    <Unit name="s"><BaseUnit s="1"/></Unit>
+  </UnitDefinitions>
+  <LogCategories><Category name="logAll"/></LogCategories>
+  <DefaultExperiment startTime="0" stopTime="1" stepSize="0.01"/>
+  <ModelVariables>
+    <ScalarVariable name="u" valueReference="0" causality="input"><Real start="0" unit="m"/></ScalarVariable>
+    <ScalarVariable name="y" valueReference="1" causality="output" initial="calculated"><Real unit="m"/></ScalarVariable>
+    <ScalarVariable name="k" valueReference="2" causality="parameter" variability="fixed"><Real start="1"/></ScalarVariable>
+    <ScalarVariable name="t_last" valueReference="3" causality="output" initial="calculated"><Real unit="s"/></ScalarVariable>
+    <ScalarVariable name="grid_error" valueReference="4" causality="output" initial="calculated"><Real unit="s"/></ScalarVariable>
+    <ScalarVariable name="base_step" valueReference="5" causality="parameter" variability="fixed"><Real start="0" unit="s"/></ScalarVariable>
+    <ScalarVariable name="y2" valueReference="6" causality="output" initial="calculated"><Real unit="km"/></ScalarVariable>
+    <ScalarVariable name="steps" valueReference="0" causality="output" variability="discrete" initial="calculated"><Integer/></ScalarVariable>
+    <ScalarVariable name="fail_at_step" valueReference="1" causality="parameter" variability="fixed"><Integer start="-1"/></ScalarVariable>
+    <ScalarVariable name="n_in" valueReference="2" causality="input" variability="discrete"><Integer start="0"/></ScalarVariable>
+    <ScalarVariable name="n_out" valueReference="3" causality="output" variability="discrete" initial="calculated"><Integer/></ScalarVariable>
+    <ScalarVariable name="enabled" valueReference="0" causality="input" variability="discrete"><Boolean start="true"/></ScalarVariable>
+    <ScalarVariable name="enabled_out" valueReference="1" causality="output" variability="discrete" initial="calculated"><Boolean/></ScalarVariable>
+  </ModelVariables>
+  <ModelStructure>
+    <Outputs>
+      <Unknown index="2" dependencies=""/>
+      <Unknown index="4" dependencies=""/>
+      <Unknown index="5" dependencies=""/>
+      <Unknown index="7" dependencies="1"/>
+      <Unknown index="8" dependencies=""/>
+      <Unknown index="11" dependencies="10"/>
+      <Unknown index="13" dependencies="12"/>
+    </Outputs>
+  </ModelStructure>
+</fmiModelDescription>
+"#
+    )
+}
+
+/// Compiles testfmu.c into `dir/<tag>.so` with extra defines.
+pub fn compile(dir: &Path, tag: &str, defines: &[&str]) -> PathBuf {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/c/testfmu.c");
+    let out = dir.join(format!("{tag}.so"));
+    let mut cmd = Command::new("gcc");
+    cmd.args(["-shared", "-fPIC", "-O2", "-fvisibility=hidden", "-o"])
+        .arg(&out)
+        .arg(&src);
+    for d in defines {
+        cmd.arg(format!("-D{d}"));
+    }
+    cmd.arg("-lm");
+    let st = cmd
+        .status()
+        .expect("gcc must be installed to build the test FMU");
+    assert!(st.success(), "gcc failed for {tag}");
+    out
+}
+
+/// Writes a zip with the given (name, bytes) entries.
+pub fn zip_files(path: &Path, entries: &[(&str, Vec<u8>)]) {
+    let f = std::fs::File::create(path).unwrap();
+    let mut z = zip::ZipWriter::new(f);
+    let opts = zip::write::SimpleFileOptions::default();
+    for (name, data) in entries {
+        z.start_file(*name, opts).unwrap();
+        z.write_all(data).unwrap();
+    }
+    z.finish().unwrap();
+}
+
+pub struct Variant<'a> {
+    pub defines: &'a [&'a str],
+    pub md_guid: &'a str,
+    pub fmi_version: &'a str,
+    pub with_binary: bool,
+    pub with_md: bool,
+    pub md_override: Option<&'a str>,
+}
+
+impl Default for Variant<'_> {
+    fn default() -> Self {
+        Variant {
+            defines: &[],
+            md_guid: GUID,
+            fmi_version: "2.0",
+            with_binary: true,
+            with_md: true,
+            md_override: None,
+        }
+    }
+}
+
+/// Builds `dir/<name>.fmu`.
+pub fn build_fmu(dir: &Path, name: &str, v: Variant) -> PathBuf {
+    let mut entries: Vec<(&str, Vec<u8>)> = Vec::new();
+    let md = match v.md_override {
+        Some(s) => s.to_string(),
+        None => model_description(v.md_guid, v.fmi_version),
+    };
+    if v.with_md {
+        entries.push(("modelDescription.xml", md.into_bytes()));
+    }
+    if v.with_binary {
+        let so = compile(dir, name, v.defines);
+        entries.push(("binaries/linux64/testfmu.so", std::fs::read(so).unwrap()));
+    }
+    entries.push(("resources/readme.txt", b"test".to_vec()));
+    let p = dir.join(format!("{name}.fmu"));
+    zip_files(&p, &entries);
+    p
+}
+
+/// The standard test FMU.
+pub fn test_fmu(dir: &Path) -> PathBuf {
+    build_fmu(dir, "testfmu", Variant::default())
+}
+
+/// Writes a system file into `dir` and returns its path.
+pub fn write_system(dir: &Path, name: &str, text: &str) -> PathBuf {
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+/// Reads a CSV into (header, rows of f64).
+pub fn read_csv(path: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines = text.lines();
+    let header = lines.next().unwrap().split(',').map(String::from).collect();
+    let rows = lines
+        .map(|l| {
+            l.split(',')
+                .map(|x| match x {
+                    "true" => 1.0,
+                    "false" => 0.0,
+                    _ => x.parse::<f64>().unwrap(),
+                })
+                .collect()
+        })
+        .collect();
+    (header, rows)
+}
+
+pub fn col(header: &[String], name: &str) -> usize {
+    header
+        .iter()
+        .position(|h| h == name)
+        .unwrap_or_else(|| panic!("no column {name} in {header:?}"))
+}
+
+/// Directory of our built FMUs: $SHIPSIM_FMU_DIR or <workspace>/target/fmu.
+pub fn fmu_dir() -> PathBuf {
+    std::env::var_os("SHIPSIM_FMU_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../target/fmu"))
+}
+
+/// Path of one of our FMUs; fails (never skips) when it has not been built.
+pub fn our_fmu(model_identifier: &str) -> PathBuf {
+    let p = fmu_dir().join(format!("{model_identifier}.fmu"));
+    assert!(
+        p.is_file(),
+        "{} is missing: run `cargo xtask build-fmus` first",
+        p.display()
+    );
+    p
+}
