@@ -8,47 +8,11 @@ use std::process::Command;
 
 pub const GUID: &str = "{shipsim-test-fmu}";
 
+/// tests/c/testfmu.xml with the GUID and fmiVersion filled in.
 pub fn model_description(guid: &str, fmi_version: &str) -> String {
-    format!(
-        r#"<?xml version="1.0" encoding="UTF-8"?>
-<fmiModelDescription fmiVersion="{fmi_version}" modelName="testfmu" guid="{guid}" generationTool="shipsim tests">
-  <CoSimulation modelIdentifier="testfmu" canHandleVariableCommunicationStepSize="true"/>
-  <UnitDefinitions>
-    <Unit name="m"><BaseUnit m="1"/></Unit>
-    <Unit name="km"><BaseUnit m="1" factor="1000"/></Unit>
-    <Unit name="s"><BaseUnit s="1"/></Unit>
-  </UnitDefinitions>
-  <LogCategories><Category name="logAll"/></LogCategories>
-  <DefaultExperiment startTime="0" stopTime="1" stepSize="0.01"/>
-  <ModelVariables>
-    <ScalarVariable name="u" valueReference="0" causality="input"><Real start="0" unit="m"/></ScalarVariable>
-    <ScalarVariable name="y" valueReference="1" causality="output" initial="calculated"><Real unit="m"/></ScalarVariable>
-    <ScalarVariable name="k" valueReference="2" causality="parameter" variability="fixed"><Real start="1"/></ScalarVariable>
-    <ScalarVariable name="t_last" valueReference="3" causality="output" initial="calculated"><Real unit="s"/></ScalarVariable>
-    <ScalarVariable name="grid_error" valueReference="4" causality="output" initial="calculated"><Real unit="s"/></ScalarVariable>
-    <ScalarVariable name="base_step" valueReference="5" causality="parameter" variability="fixed"><Real start="0" unit="s"/></ScalarVariable>
-    <ScalarVariable name="y2" valueReference="6" causality="output" initial="calculated"><Real unit="km"/></ScalarVariable>
-    <ScalarVariable name="steps" valueReference="0" causality="output" variability="discrete" initial="calculated"><Integer/></ScalarVariable>
-    <ScalarVariable name="fail_at_step" valueReference="1" causality="parameter" variability="fixed"><Integer start="-1"/></ScalarVariable>
-    <ScalarVariable name="n_in" valueReference="2" causality="input" variability="discrete"><Integer start="0"/></ScalarVariable>
-    <ScalarVariable name="n_out" valueReference="3" causality="output" variability="discrete" initial="calculated"><Integer/></ScalarVariable>
-    <ScalarVariable name="enabled" valueReference="0" causality="input" variability="discrete"><Boolean start="true"/></ScalarVariable>
-    <ScalarVariable name="enabled_out" valueReference="1" causality="output" variability="discrete" initial="calculated"><Boolean/></ScalarVariable>
-  </ModelVariables>
-  <ModelStructure>
-    <Outputs>
-      <Unknown index="2" dependencies=""/>
-      <Unknown index="4" dependencies=""/>
-      <Unknown index="5" dependencies=""/>
-      <Unknown index="7" dependencies="1"/>
-      <Unknown index="8" dependencies=""/>
-      <Unknown index="11" dependencies="10"/>
-      <Unknown index="13" dependencies="12"/>
-    </Outputs>
-  </ModelStructure>
-</fmiModelDescription>
-"#
-    )
+    include_str!("../c/testfmu.xml")
+        .replace("FMI_VERSION", fmi_version)
+        .replace("GUID", guid)
 }
 
 /// Compiles testfmu.c into `dir/<tag>.so` with extra defines.
