@@ -14,6 +14,7 @@
 //! | [`container_ship::ContainerShip`], [`container_ship::LinearContainerShip`] | spec `container_ship.md` §2, §4 (Son & Nomoto 1982 via MSS) |
 //! | [`mariner::Mariner`] | spec `container_ship.md` §3 (Chislett & Strøm-Tejsen 1965 via MSS) |
 //! | [`nomoto::NomotoShip`] | seed 000, spec `ddg51_ekf_autopilot.md` §2.8-2.14, §3.2 |
+//! | [`supply_vessel::SupplyVessel`] | seed 001, spec `passive_observer_dp.md` §2.1-2.3, §3.1 |
 //! | [`tokyo_maru::TokyoMaru`] | seed 004, spec `adaptive_path_control.md` §2.1-2.3, Tables 1-2 |
 //! | [`rrs_ship::RrsShip`] | seed 003, spec `rrs_models_filters.md` §2.3-2.4, Tables 2.1-2.5 |
 
@@ -21,6 +22,7 @@ pub mod container_ship;
 pub mod mariner;
 pub mod nomoto;
 pub mod rrs_ship;
+pub mod supply_vessel;
 pub mod tokyo_maru;
 
 /// One degree in radians.
