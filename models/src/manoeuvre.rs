@@ -36,8 +36,9 @@
 //! * **First overshoot angle**: max s·Δψ after the second execute, minus b; its time.
 //! * **Second overshoot angle**: |min s·Δψ after the third execute (s·Δψ reaching −b)| − b.
 //! * **Period**: time between the first two upward crossings of +b.
-//! The "overshoot times" (time from the execute to the peak, "time to check yaw") are reported as
-//! well.
+//!
+//! The times from each reversal (second, third execute) to the following overshoot peak
+//! ("time to check yaw") are reported as well.
 
 use serde::{Deserialize, Serialize};
 

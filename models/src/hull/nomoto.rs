@@ -32,6 +32,7 @@
 //!   A_R = 1289.67 ft², ∂C_L/∂α = 2.217 /rad (AR 1.538), inflow speed U, at x′_R = −0.5:
 //!   Y′_δ = −(A_R/L²)·2.217, N′_δ = x′_R·Y′_δ (positive δ → starboard turn, §2.1);
 //! * U = 10 kn (any speed gives the same nondimensional results).
+//!
 //! With Table 2.3 the linear Esso Osaka is **course unstable**: det N = (−Y_v)(m x_G − N_r) −
 //! (m − Y_r)(−N_v) = −3.71e-7 < 0 (the real ship is known to be directionally unstable). Its
 //! "steady turning rate" r′ = K′δ with K′ = (n11 b2 − n21 b1)/det N is therefore an unstable
