@@ -1,7 +1,10 @@
 //! Ship-control physics in pure Rust: every model the FMUs expose lives here and is tested here.
 //! No FFI: the FMU crates under `fmus/` map these types onto FMI variables.
 
+pub mod control;
+pub mod disturbances;
 pub mod hull;
 pub mod integrate;
 pub mod manoeuvre;
+pub mod random;
 pub mod steering_gear;
