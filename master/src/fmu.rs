@@ -128,13 +128,21 @@ pub(crate) struct Api {
 impl Api {
     /// Resolves all 34 functions; the first missing one is reported by name.
     unsafe fn resolve(lib: &Library) -> std::result::Result<Api, String> {
+        /// Looks a function up; a missing or NULL export is reported by name.
+        unsafe fn get<T: Copy>(lib: &Library, name: &str) -> std::result::Result<T, String> {
+            let c = format!("{name}\0");
+            match lib.get::<*const c_void>(c.as_bytes()) {
+                Ok(p) if !p.is_null() => {}
+                _ => return Err(format!("the shared library does not export '{name}'")),
+            }
+            lib.get::<T>(c.as_bytes())
+                .map(|s| *s)
+                .map_err(|e| format!("cannot resolve '{name}': {e}"))
+        }
         macro_rules! sym {
-            ($name:literal) => {{
-                match lib.get::<*const c_void>(concat!($name, "\0").as_bytes()) {
-                    Ok(s) if !s.is_null() => std::mem::transmute::<*const c_void, _>(*s),
-                    _ => return Err(format!("the shared library does not export '{}'", $name)),
-                }
-            }};
+            ($name:literal) => {
+                get(lib, $name)?
+            };
         }
         let api = Api {
             GetTypesPlatform: sym!("fmi2GetTypesPlatform"),

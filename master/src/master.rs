@@ -37,7 +37,7 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 /// How to run.
-#[derive(Clone)]
+#[derive(Clone, Default)]
 pub struct RunOptions {
     /// FMU log messages below fmi2Warning are shown too, and loggingOn is passed to the FMUs.
     pub verbose: bool,
@@ -46,17 +46,6 @@ pub struct RunOptions {
     /// Set to true (e.g. by Ctrl-C) to stop the run cleanly.
     pub interrupt: Option<Arc<AtomicBool>>,
     pub log_sink: Option<LogSink>,
-}
-
-impl Default for RunOptions {
-    fn default() -> Self {
-        RunOptions {
-            verbose: false,
-            progress: false,
-            interrupt: None,
-            log_sink: None,
-        }
-    }
 }
 
 /// What a run did.
