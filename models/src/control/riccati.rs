@@ -224,6 +224,34 @@ pub fn kalman_bucy(a: &M, c: &M, g: &M, qw: &M, rv: &M) -> Result<(M, M), Riccat
     Ok((&p * c.transpose() * rinv, p))
 }
 
+/// Steady-state Kalman–Bucy gain with correlated process and measurement noise (van der Klugt
+/// 1987 eqs. 4.16–4.17 and 4.78–4.79): process noise intensity `DQDᵀ` = `qd`, measurement noise
+/// intensity `rv`, cross intensity `n` = E[D w vᵀ] (n × p). `K = (PCᵀ + N) Rv⁻¹` with P the
+/// stabilising solution of `AP + PAᵀ + DQDᵀ − (PCᵀ + N) Rv⁻¹ (PCᵀ + N)ᵀ = 0`, solved as the
+/// standard problem with `Ā = A − N Rv⁻¹ C` and `Q̄ = DQDᵀ − N Rv⁻¹ Nᵀ`. Returns (K, P).
+pub fn kalman_bucy_correlated(a: &M, c: &M, qd: &M, rv: &M, n: &M) -> Result<(M, M), RiccatiError> {
+    let nx = a.nrows();
+    check_square("A", a, nx)?;
+    check_square("DQDᵀ", qd, nx)?;
+    if c.ncols() != nx || n.nrows() != nx || n.ncols() != c.nrows() {
+        return Err(RiccatiError::Dimension(format!(
+            "C is {}x{}, N is {}x{} for {nx} states",
+            c.nrows(),
+            c.ncols(),
+            n.nrows(),
+            n.ncols()
+        )));
+    }
+    let rinv = rv
+        .clone()
+        .try_inverse()
+        .ok_or(RiccatiError::Singular("Rv"))?;
+    let a_bar = a - n * &rinv * c;
+    let q_bar = symmetrize(&(qd - n * &rinv * n.transpose()));
+    let p = care(&a_bar.transpose(), &c.transpose(), &q_bar, rv)?;
+    Ok(((&p * c.transpose() + n) * rinv, p))
+}
+
 /// Stabilising solution of the DARE `P = AᵀPA − AᵀPB(R + BᵀPB)⁻¹BᵀPA + Q` by the
 /// structure-preserving doubling algorithm.
 pub fn dare(a: &M, b: &M, q: &M, r: &M) -> Result<M, RiccatiError> {
@@ -487,6 +515,38 @@ mod tests {
         let (phi, gam) = zoh(&dmatrix![-1.0 / tau], &dmatrix![1.0 / tau], 0.5).unwrap();
         let e = (-0.25f64).exp();
         assert!((phi[(0, 0)] - e).abs() < 1e-15 && (gam[(0, 0)] - (1.0 - e)).abs() < 1e-15);
+    }
+
+    /// Speed filter with high-pass coloured measurement noise (van der Klugt 1987 §4.5.2,
+    /// eqs. 4.91–4.101): x = (speed, x_v), A = [[0,0],[0,−1/τ]], D = [[1,0],[0,1/τ]],
+    /// C = (1 −1), w = (w, v), R = E[v²], S = (0, E[v²])ᵀ. Closed form k1 = √(E[w²]/E[v²]),
+    /// k2 = (k1τ + 1 − √(k1²τ² + 2k1τ))/τ; spec rrs_models_filters.md §6.2 lists
+    /// (1e−4, 1, 20) ⇒ (0.01, 0.026834), (1e−2, 1, 5) ⇒ (0.1, 0.076393), (1, 0.5, 3) ⇒
+    /// (1.41421, 0.032085).
+    #[test]
+    fn correlated_noise_speed_filter_gains() {
+        for (ew, ev, tau, k1_ref, k2_ref) in [
+            (1e-4, 1.0, 20.0, 0.01, 0.026834),
+            (1e-2, 1.0, 5.0, 0.1, 0.076393),
+            (1.0, 0.5, 3.0, 1.41421, 0.032085),
+        ] {
+            let a = dmatrix![0.0, 0.0; 0.0, -1.0 / tau];
+            let d = dmatrix![1.0, 0.0; 0.0, 1.0 / tau];
+            let c = dmatrix![1.0, -1.0];
+            let q = dmatrix![ew, 0.0; 0.0, ev];
+            let s = dmatrix![0.0; ev];
+            let (k, _) =
+                kalman_bucy_correlated(&a, &c, &(&d * q * d.transpose()), &dmatrix![ev], &(&d * s))
+                    .unwrap();
+            let k1 = (ew / ev).sqrt();
+            let k2 = (k1 * tau + 1.0 - (k1 * k1 * tau * tau + 2.0 * k1 * tau).sqrt()) / tau;
+            assert!(
+                (k[(0, 0)] - k1).abs() < 1e-10 && (k[(1, 0)] - k2).abs() < 1e-10,
+                "{k}"
+            );
+            // the spec's printed values, to their last digit
+            assert!((k[(0, 0)] - k1_ref).abs() < 6e-6 && (k[(1, 0)] - k2_ref).abs() < 6e-7);
+        }
     }
 
     #[test]
