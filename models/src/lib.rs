@@ -2,7 +2,9 @@
 //! No FFI: the FMU crates under `fmus/` map these types onto FMI variables.
 
 pub mod control;
+pub mod disturbances;
 pub mod hull;
 pub mod integrate;
 pub mod manoeuvre;
+pub mod random;
 pub mod steering_gear;

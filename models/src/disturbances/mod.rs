@@ -1,0 +1,7 @@
+//! Environmental disturbances: waves, wind, currents and bias processes, with the noise-process
+//! and spectral machinery they share. Every random source is seeded per instance
+//! ([`crate::random`]).
+
+pub mod shaping;
+pub mod spectral;
+pub mod waves;
