@@ -311,3 +311,27 @@ fn ctrl_c_terminates_cleanly() {
     assert_eq!(h, vec!["time", "a.y"]);
     assert!(rows.len() > 1);
 }
+
+/// fmi2Discard with fmi2Terminated = true ends the run early at that communication point
+/// (FMI 2.0 section 4.2.3); the summary says which instance and when; rows stop there.
+#[test]
+fn fmu_that_terminates_early_ends_the_run_cleanly() {
+    let d = tempfile::tempdir().unwrap();
+    test_fmu(d.path());
+    let p = write_system(
+        d.path(),
+        "term.toml",
+        "[simulation]\nstop_time = 1.0\nstep_size = 0.1\n[[instances]]\nname = \"a\"\nfmu = \"testfmu.fmu\"\n[[instances]]\nname = \"quitter\"\nfmu = \"testfmu.fmu\"\nparameters = { terminate_at_step = 4 }\n",
+    );
+    let out = d.path().join("term.csv");
+    let s = run_file(&p, &out);
+    assert_eq!(s.macro_steps, 5);
+    let msg = s.terminated_by.unwrap();
+    assert!(
+        msg.contains("instance 'quitter' ended the simulation at t = 0.4"),
+        "{msg}"
+    );
+    let (_, rows) = read_csv(&out);
+    assert_eq!(rows.len(), 6);
+    assert_eq!(rows.last().unwrap()[0], 0.5);
+}

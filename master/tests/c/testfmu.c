@@ -7,6 +7,8 @@
  *          5 base_step (parameter, 0 = no grid check)  6 y2 (output, y2 = k*u, feed-through)
  * Integer: 0 steps (output)  1 fail_at_step (parameter: fmi2DoStep returns fmi2Error at that
  *          step, -1 = never)  2 n_in (input)  3 n_out (output, n_out = n_in)
+ *          4 terminate_at_step (parameter: fmi2DoStep returns fmi2Discard with fmi2Terminated
+ *            = true at that step, ending the simulation early; -1 = never)
  * Boolean: 0 enabled (input: integrate only when true)  1 enabled_out (output)
  *
  * Defines: MODEL_GUID (checked in fmi2Instantiate), OMIT_CANCEL_STEP (leave out fmi2CancelStep
@@ -48,7 +50,9 @@ typedef struct {
     fmi2CallbackFunctions cb;
     char name[128];
     double r[7];
-    int i[4];
+    int i[5];
+    int terminated;
+    double last_ok;
     int b[2];
     double t0, x;
     long n;
@@ -84,6 +88,7 @@ EXPORT fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2String 
     snprintf(c->name, sizeof c->name, "%s", name ? name : "");
     c->r[2] = 1.0;
     c->i[1] = -1;
+    c->i[4] = -1;
     c->b[0] = 1;
     outputs(c);
     return c;
@@ -125,7 +130,7 @@ EXPORT fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], si
     return fmi2OK;
 }
 EXPORT fmi2Status fmi2GetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t n, fmi2Integer v[]) {
-    Inst *p = c; CHECK_VR(p->i, n, 4);
+    Inst *p = c; CHECK_VR(p->i, n, 5);
     if (p->state == 1) outputs(p);
     for (size_t j = 0; j < n; j++) v[j] = p->i[vr[j]];
     return fmi2OK;
@@ -146,7 +151,7 @@ EXPORT fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], si
     return fmi2OK;
 }
 EXPORT fmi2Status fmi2SetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t n, const fmi2Integer v[]) {
-    Inst *p = c; CHECK_VR(p->i, n, 4);
+    Inst *p = c; CHECK_VR(p->i, n, 5);
     for (size_t j = 0; j < n; j++) p->i[vr[j]] = v[j];
     outputs(p);
     return fmi2OK;
@@ -184,6 +189,12 @@ EXPORT fmi2Status fmi2DoStep(fmi2Component c, fmi2Real t, fmi2Real h, fmi2Boolea
         p->state = 4;
         return fmi2Error;
     }
+    if (p->n == p->i[4]) {
+        LOG(p, fmi2Discard, "fmi2DoStep: the model ends the simulation at t = %g", t);
+        p->terminated = 1;
+        p->last_ok = t;
+        return fmi2Discard;
+    }
     if (p->r[5] > 0) {
         long m = lround(h / p->r[5]);
         double expected = p->t0 + (double)(p->n * m) * p->r[5];
@@ -203,7 +214,17 @@ EXPORT fmi2Status fmi2DoStep(fmi2Component c, fmi2Real t, fmi2Real h, fmi2Boolea
 EXPORT fmi2Status fmi2CancelStep(fmi2Component c) { (void)c; return fmi2Error; }
 #endif
 EXPORT fmi2Status fmi2GetStatus(fmi2Component c, const fmi2StatusKind s, fmi2Status *v) { (void)c; (void)s; (void)v; return fmi2Error; }
-EXPORT fmi2Status fmi2GetRealStatus(fmi2Component c, const fmi2StatusKind s, fmi2Real *v) { (void)c; (void)s; (void)v; return fmi2Error; }
+EXPORT fmi2Status fmi2GetRealStatus(fmi2Component c, const fmi2StatusKind s, fmi2Real *v) {
+    Inst *p = c;
+    if (s != fmi2LastSuccessfulTime) return fmi2Error;
+    *v = p->last_ok;
+    return fmi2OK;
+}
 EXPORT fmi2Status fmi2GetIntegerStatus(fmi2Component c, const fmi2StatusKind s, fmi2Integer *v) { (void)c; (void)s; (void)v; return fmi2Error; }
-EXPORT fmi2Status fmi2GetBooleanStatus(fmi2Component c, const fmi2StatusKind s, fmi2Boolean *v) { (void)c; (void)s; (void)v; return fmi2Error; }
+EXPORT fmi2Status fmi2GetBooleanStatus(fmi2Component c, const fmi2StatusKind s, fmi2Boolean *v) {
+    Inst *p = c;
+    if (s != fmi2Terminated) return fmi2Error;
+    *v = p->terminated;
+    return fmi2OK;
+}
 EXPORT fmi2Status fmi2GetStringStatus(fmi2Component c, const fmi2StatusKind s, fmi2String *v) { (void)c; (void)s; (void)v; return fmi2Error; }
