@@ -658,6 +658,7 @@ fn at_time(e: Error, t: f64, name: &str) -> Error {
 
 /// Validates a system, loads its FMUs and runs it.
 pub fn run_system(system: &System, output: Output, opts: &RunOptions) -> Result<(Plan, Summary)> {
+    let begin = Instant::now();
     let fmus = load_fmus(system)?;
     let mds: Vec<&crate::model_description::ModelDescription> =
         fmus.iter().map(|f| &f.model_description).collect();
@@ -665,6 +666,7 @@ pub fn run_system(system: &System, output: Output, opts: &RunOptions) -> Result<
     for w in &plan.warnings {
         eprintln!("warning: {w}");
     }
-    let summary = run(&plan, &fmus, output, opts)?;
+    let mut summary = run(&plan, &fmus, output, opts)?;
+    summary.total_wall_time = begin.elapsed();
     Ok((plan, summary))
 }
