@@ -196,10 +196,16 @@ def test_pythonfmu_chain_equals_libcosim(python_fmus, tmp_path):
 
 
 def test_crane_fmu_forced_oscillator_equals_libcosim(tmp_path):
+    """crane-fmu's oscillator and driving force; a gain/offset connection becomes an OSP
+    LinearTransformation function in the exported file."""
     for name in ["HarmonicOscillator6D", "DrivingForce"]:
         shutil.copy(crane_fmu(name), tmp_path / f"{name}.fmu")
     (tmp_path / "osc.toml").write_text(textwrap.dedent("""
-        connections = ["drv.f[2] -> osc.f[2]", "osc.v[2] -> drv.v_osc[2]", "drv.f[0] -> osc.f[0]"]
+        connections = [
+            { from = "drv.f[2]", to = "osc.f[2]", gain = 2.0, offset = 0.1 },
+            "osc.v[2] -> drv.v_osc[2]",
+            "drv.f[0] -> osc.f[0]",
+        ]
         [simulation]
         stop_time = 1.0
         step_size = 0.01
@@ -217,6 +223,7 @@ def test_crane_fmu_forced_oscillator_equals_libcosim(tmp_path):
     out = tmp_path / "osc.csv"
     shipsim("run", tmp_path / "osc.toml", "-o", out)
     shipsim("export-osp", tmp_path / "osc.toml", "-o", tmp_path / "OspSystemStructure.xml")
+    assert '<LinearTransformation name="lt0" factor="2.0" offset="0.1"/>' in (tmp_path / "OspSystemStructure.xml").read_text()
     header, rows = read_csv(out)
     assert abs(rows[-1][header.index("osc.x[2]")]) > 1e-3
     assert_same_as_libcosim(tmp_path / "OspSystemStructure.xml", out)
