@@ -375,6 +375,11 @@ pub fn run(plan: &Plan, fmus: &[Arc<Fmu>], output: Output, opts: &RunOptions) ->
     let (out, out_path): (Option<Box<dyn Write>>, Option<PathBuf>) = match output {
         Output::None => (None, None),
         Output::File(p) => {
+            if let Some(dir) = p.parent().filter(|d| !d.as_os_str().is_empty()) {
+                std::fs::create_dir_all(dir).map_err(|e| {
+                    Error::io(format!("cannot create output folder {}", dir.display()), e)
+                })?;
+            }
             let f = std::fs::File::create(&p)
                 .map_err(|e| Error::io(format!("cannot create output file {}", p.display()), e))?;
             (
