@@ -6,5 +6,6 @@ pub mod disturbances;
 pub mod hull;
 pub mod integrate;
 pub mod manoeuvre;
+pub mod observers;
 pub mod random;
 pub mod steering_gear;

@@ -1,0 +1,13 @@
+//! State observers of the sources: Kalman filters, the state-augmented EKF and the passive
+//! nonlinear observer. Each takes the measured signals and the command actually applied as
+//! inputs and produces estimates plus innovation statistics.
+//!
+//! | module | source |
+//! | --- | --- |
+//! | [`path_model`] | seed 004, spec `adaptive_path_control.md` §2.7-2.9: Tokyo Maru 7-state design model (shared with the path controller) |
+//!
+//! Gains are computed at initialization (DMatrix Riccati solvers of [`crate::control::riccati`]);
+//! the per-step updates use fixed-size nalgebra types and allocate nothing. Every filter is
+//! `Clone + Serialize + Deserialize` so an FMU state snapshot is a clone.
+
+pub mod path_model;
