@@ -4,7 +4,7 @@
 
 use fmi2_export::{export_fmu, DefaultExperiment, FmuModel, Variable};
 use models::disturbances::waves::{
-    encounter_angle, Realisation, ShapingForm, SpectrumKind, WaveParams, Waves,
+    encounter_angle, wf_sigma_for_std, Realisation, ShapingForm, SpectrumKind, WaveParams, Waves,
 };
 use serde::{Deserialize, Serialize};
 
@@ -18,11 +18,6 @@ pub struct WavesFmu {
     speed: f64,
     heading: f64,
     waves: Waves,
-}
-
-/// σ of 001 eq. 10 giving the standard deviation `std`: var = σ²/(4 ζ ω0).
-pub fn wf_sigma(std: f64, zeta: f64, omega0: f64) -> f64 {
-    std * (4.0 * zeta * omega0).sqrt()
 }
 
 impl Default for WavesFmu {
@@ -51,7 +46,7 @@ impl WavesFmu {
     pub fn model_params(&self) -> WaveParams {
         let mut p = self.params.clone();
         for i in 0..3 {
-            p.wf_sigma[i] = wf_sigma(self.wf_std[i], p.wf_zeta, p.wf_omega0);
+            p.wf_sigma[i] = wf_sigma_for_std(self.wf_std[i], p.wf_zeta, p.wf_omega0);
         }
         p
     }

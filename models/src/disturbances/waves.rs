@@ -294,6 +294,11 @@ pub fn encounter_angle(wave_direction: f64, heading: f64) -> f64 {
     g
 }
 
+/// σ of 001 eq. 10 that gives the standard deviation `std`: var = σ²/(4 ζ ω0).
+pub fn wf_sigma_for_std(std: f64, zeta: f64, omega0: f64) -> f64 {
+    std * (4.0 * zeta * omega0).sqrt()
+}
+
 /// Realisation of the elevation.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub enum Realisation {
@@ -339,7 +344,6 @@ pub struct WaveParams {
 
 impl Default for WaveParams {
     fn default() -> Self {
-        let k = 1.0 / (1.0 / (4.0f64 * 0.1 * 0.8976)).sqrt(); // σ per unit std: 1/1.669
         WaveParams {
             sea: SeaState::sea_state_4(),
             realisation: Realisation::SumOfSinusoids,
@@ -352,7 +356,11 @@ impl Default for WaveParams {
             yaw_gain: 0.0,
             wf_omega0: 0.8976,
             wf_zeta: 0.1,
-            wf_sigma: [5.0 * k, 5.0 * k, 0.5f64.to_radians() * k],
+            wf_sigma: [
+                wf_sigma_for_std(5.0, 0.1, 0.8976),
+                wf_sigma_for_std(5.0, 0.1, 0.8976),
+                wf_sigma_for_std(0.5f64.to_radians(), 0.1, 0.8976),
+            ],
             gravity: GRAVITY,
             seed: 1,
         }

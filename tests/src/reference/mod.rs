@@ -13,6 +13,7 @@
 use std::io::Write;
 
 pub mod steering_gear;
+pub mod waves;
 
 /// A reference case: name, description, generator.
 pub type Case = (
@@ -21,9 +22,23 @@ pub type Case = (
     fn(&mut dyn Write) -> std::io::Result<()>,
 );
 
-pub const CASES: &[Case] = &[(
-    "steering_gear_sine",
-    "SteeringGear with default (003 RRS) parameters, rudder_command = 0.5 sin(0.8 t) rad, \
-     h = 0.01 s, 30 s: both the angle limit (22 deg) and the rate limit (15 deg/s) engage",
-    steering_gear::sine,
-)];
+pub const CASES: &[Case] = &[
+    (
+        "steering_gear_sine",
+        "SteeringGear with default (003 RRS) parameters, rudder_command = 0.5 sin(0.8 t) rad, \
+         h = 0.01 s, 30 s: both the angle limit (22 deg) and the rate limit (15 deg/s) engage",
+        steering_gear::sine,
+    ),
+    (
+        "waves_sum_of_sinusoids",
+        "Waves, default sea (SS4 PM, 400 sinusoids), seed 5, roll_gain 1e6, yaw_gain 3e5, \
+         wave_direction 0.4 rad; ship_speed = 6 + 0.01 t, heading = 0.3 sin(0.05 t); h = 0.1 s, 300 s",
+        waves::sum_of_sinusoids,
+    ),
+    (
+        "waves_shaping_filter",
+        "Waves as waves_sum_of_sinusoids with realisation 2 (shaping filter), shaping_form 1 \
+         (003 low-pass)",
+        waves::shaping_filter,
+    ),
+];
