@@ -18,13 +18,15 @@ fn main() {
         Some("build-fmus") => fmu::build_fmus(&workspace_root()).map(|_| ()),
         Some("test") => test(&args[1..]),
         Some("demo") => demo(),
+        Some("bench") => bench(&args[1..]),
         _ => {
             eprintln!(
                 "usage: cargo xtask <task>\n\n\
                  tasks:\n  \
                  build-fmus   build every FMU into target/fmu/<ModelIdentifier>.fmu\n  \
                  test         run every test: Rust, FMU packaging, FMPy and libcosim checks\n  \
-                 demo         run the default coupled system"
+                 demo         run the default coupled system\n  \
+                 bench        master overhead per FMU-step: shipsim vs libcosim vs FMPy (master/bench)"
             );
             std::process::exit(2);
         }
@@ -121,6 +123,20 @@ fn test(extra: &[String]) -> Result<()> {
         started.elapsed().as_secs_f64()
     );
     Ok(())
+}
+
+/// Runs master/bench/bench_master.py in the project venv (extra arguments are passed on).
+fn bench(extra: &[String]) -> Result<()> {
+    let root = workspace_root();
+    run(cargo()
+        .current_dir(&root)
+        .args(["build", "--release", "-p", "shipsim", "--bins"]))?;
+    let python = ensure_venv(&root)?;
+    run(Command::new(python)
+        .current_dir(&root)
+        .arg("master/bench/bench_master.py")
+        .args(extra)
+        .env("SHIPSIM_BIN", root.join("target/release/shipsim")))
 }
 
 /// The built-in default system: currently the steering-gear classification manoeuvre
