@@ -2,6 +2,7 @@
 //! No FFI: the FMU crates under `fmus/` map these types onto FMI variables.
 
 pub mod control;
+pub mod controllers;
 pub mod disturbances;
 pub mod hull;
 pub mod integrate;

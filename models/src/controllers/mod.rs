@@ -1,0 +1,52 @@
+//! Controllers: LQ designs and the autopilots the controller FMUs expose.
+//!
+//! * [`lq`]: continuous LQ state feedback in the sources' sign convention (u = C x), shared by
+//!   every LQ design here; the Riccati numerics themselves are [`crate::control::riccati`].
+//! * [`path`]: Parsons & Cuong (1980, source 004) optimal steady-state path controller of the
+//!   *Tokyo Maru* in restricted water, with gain scheduling over depth, the partial adaptation
+//!   of f23/f25 from a parameter estimator (Table 10 validity logic) and the open-loop dither.
+//!
+//! Design computations (Riccati equations) run at initialization, on a parameter change or on
+//! an adaptation clock and may allocate; the per-step control laws use fixed-size nalgebra types
+//! and allocate nothing. Every controller state is `Clone + Serialize + Deserialize` so an FMU
+//! state is a clone and a serialized state its bincode bytes.
+
+use std::fmt;
+
+pub mod lq;
+pub mod path;
+
+/// Why a controller could not be designed or configured: names the parameter or the design step.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ControlError(pub String);
+
+impl fmt::Display for ControlError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for ControlError {}
+
+impl From<crate::control::riccati::RiccatiError> for ControlError {
+    fn from(e: crate::control::riccati::RiccatiError) -> Self {
+        ControlError(format!("Riccati equation: {e}"))
+    }
+}
+
+impl From<crate::steering_gear::ParamError> for ControlError {
+    fn from(e: crate::steering_gear::ParamError) -> Self {
+        ControlError(e.to_string())
+    }
+}
+
+/// Checks `value` > 0 and finite.
+pub(crate) fn positive(name: &str, value: f64) -> Result<(), ControlError> {
+    if value > 0.0 && value.is_finite() {
+        Ok(())
+    } else {
+        Err(ControlError(format!(
+            "parameter {name} = {value} must be > 0 and finite"
+        )))
+    }
+}
