@@ -9,4 +9,5 @@ pub mod integrate;
 pub mod manoeuvre;
 pub mod observers;
 pub mod random;
+pub mod sensors;
 pub mod steering_gear;
