@@ -12,6 +12,9 @@
 
 use std::io::Write;
 
+pub mod container_ship;
+pub mod path_kalman_filter;
+pub mod sensors;
 pub mod steering_gear;
 pub mod waves;
 
@@ -40,5 +43,30 @@ pub const CASES: &[Case] = &[
         "Waves as waves_sum_of_sinusoids with realisation 2 (shaping filter), shaping_form 1 \
          (003 low-pass)",
         waves::shaping_filter,
+    ),
+    (
+        "sensors_default",
+        "Sensors with default noise levels (004 Table 3, 002 DGPS), seed 8, roll_sigma 0.3; \
+         true channel i = (i+1) sin(0.1 t + 0.05 i); h = 0.1 s, 60 s",
+        sensors::default_noise,
+    ),
+    (
+        "container_ship_nonlinear",
+        "ContainerShip with default parameters (80 rpm equilibrium), rudder_command = 0.3 \
+         sin(0.05 t) rad, shaft_speed_command = 80 - 10 sin(0.01 t) rpm, sway_force = 1e5 \
+         sin(0.1 t) N, roll_moment = 2e6 sin(0.5 t) N.m, yaw_moment = -1e6 cos(0.02 t) N.m; h \
+         = 0.1 s, 300 s: rudder limits engage",
+        container_ship::nonlinear,
+    ),
+    (
+        "container_ship_linear",
+        "ContainerShip variant 2 (linearised, U0 = 7 m/s), rudder_command = 0.2 sin(0.03 t) \
+         rad; h = 0.25 s, 300 s",
+        container_ship::linear,
+    ),
+    (
+        "path_kalman_filter",
+        "PathKalmanFilter with default parameters (random walk, H/T 1.89, Table 5 gains); heading = 0.02 sin(0.03 t), yaw_rate = 6e-4 cos(0.03 t), cross_track = 5 + 0.02 t, rudder_command = +-0.05 square wave of period 120 s; h = 0.25 s, 300 s",
+        path_kalman_filter::case,
     ),
 ];
