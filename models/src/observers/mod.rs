@@ -4,10 +4,12 @@
 //!
 //! | module | source |
 //! | --- | --- |
+//! | [`path_kalman::PathKalmanFilter`] | seed 004, spec `adaptive_path_control.md` §2.8-2.9, §5.5: steady-state Kalman-Bucy filter, Euler at Δt′ = 0.005 |
 //! | [`path_model`] | seed 004, spec `adaptive_path_control.md` §2.7-2.9: Tokyo Maru 7-state design model (shared with the path controller) |
 //!
 //! Gains are computed at initialization (DMatrix Riccati solvers of [`crate::control::riccati`]);
 //! the per-step updates use fixed-size nalgebra types and allocate nothing. Every filter is
 //! `Clone + Serialize + Deserialize` so an FMU state snapshot is a clone.
 
+pub mod path_kalman;
 pub mod path_model;

@@ -1,0 +1,126 @@
+//! Calls the `fmi2*` symbols emitted for PathKalmanFilter (linked from this crate's rlib), as a C
+//! importer would, and checks them against the model.
+
+use fmi2::*;
+use models::hull::tokyo_maru::{L, U};
+use models::observers::path_kalman::{PathKalmanConfig, PathKalmanFilter};
+use std::ffi::{c_char, CString};
+use std::ptr::null;
+
+extern "C" {
+    fn fmi2GetVersion() -> *const c_char;
+    fn fmi2Instantiate(
+        name: fmi2String,
+        kind: fmi2Type,
+        guid: fmi2String,
+        res: fmi2String,
+        f: *const fmi2CallbackFunctions,
+        visible: fmi2Boolean,
+        logging: fmi2Boolean,
+    ) -> fmi2Component;
+    fn fmi2FreeInstance(c: fmi2Component);
+    fn fmi2SetupExperiment(
+        c: fmi2Component,
+        a: fmi2Boolean,
+        b: f64,
+        s: f64,
+        d: fmi2Boolean,
+        e: f64,
+    ) -> fmi2Status;
+    fn fmi2EnterInitializationMode(c: fmi2Component) -> fmi2Status;
+    fn fmi2ExitInitializationMode(c: fmi2Component) -> fmi2Status;
+    fn fmi2SetReal(c: fmi2Component, vr: *const u32, n: usize, v: *const f64) -> fmi2Status;
+    fn fmi2GetReal(c: fmi2Component, vr: *const u32, n: usize, v: *mut f64) -> fmi2Status;
+    fn fmi2DoStep(c: fmi2Component, t: f64, h: f64, p: fmi2Boolean) -> fmi2Status;
+    fn fmi2Terminate(c: fmi2Component) -> fmi2Status;
+}
+
+fn callbacks() -> fmi2CallbackFunctions {
+    fmi2CallbackFunctions {
+        logger: None,
+        allocateMemory: None,
+        freeMemory: None,
+        stepFinished: None,
+        componentEnvironment: std::ptr::null_mut(),
+    }
+}
+
+fn vr(name: &str) -> u32 {
+    use fmi2_export::FmuModel;
+    path_kalman_filter_fmu::PathKalmanFilterFmu::variables()
+        .iter()
+        .position(|v| v.name == name)
+        .unwrap_or_else(|| panic!("{name}")) as u32
+}
+
+#[test]
+fn exported_api_reproduces_the_model() {
+    let guid = CString::new(fmi2_export::xml::guid::<
+        path_kalman_filter_fmu::PathKalmanFilterFmu,
+    >())
+    .unwrap();
+    let name = CString::new("pkf").unwrap();
+    let cb = callbacks();
+    unsafe {
+        assert_eq!(lossy_str(fmi2GetVersion()), "2.0");
+        let c = fmi2Instantiate(
+            name.as_ptr(),
+            fmi2CoSimulation,
+            guid.as_ptr(),
+            null(),
+            &cb,
+            0,
+            0,
+        );
+        assert!(!c.is_null());
+        assert_eq!(fmi2SetupExperiment(c, 0, 0.0, 0.0, 0, 0.0), fmi2OK);
+        assert_eq!(fmi2EnterInitializationMode(c), fmi2OK);
+        assert_eq!(fmi2ExitInitializationMode(c), fmi2OK);
+        let design = PathKalmanConfig::default().design().unwrap();
+        let mut model = PathKalmanFilter::new(design, [0.0; 7]).unwrap();
+        let ins = [
+            vr("heading_measured"),
+            vr("yaw_rate_measured"),
+            vr("cross_track_measured"),
+            vr("rudder_command"),
+        ];
+        let outs = [
+            vr("heading_estimate"),
+            vr("cross_track_estimate"),
+            vr("yaw_moment_prime_estimate"),
+            vr("sway_force_prime_estimate"),
+        ];
+        let h = 0.005 * L / U;
+        for k in 0..400 {
+            let t = k as f64 * h;
+            let u = [0.02 * (0.05 * t).sin(), 0.001, 3.0 + 0.01 * t, 0.05];
+            assert_eq!(fmi2SetReal(c, ins.as_ptr(), 4, u.as_ptr()), fmi2OK);
+            assert_eq!(fmi2DoStep(c, t, h, 1), fmi2OK);
+            model.step(u[0], u[1], u[2], u[3], h);
+            let mut v = [0.0; 4];
+            assert_eq!(fmi2GetReal(c, outs.as_ptr(), 4, v.as_mut_ptr()), fmi2OK);
+            let x = model.estimate();
+            assert_eq!(v, [x[0], x[3] * L, x[5], x[6]]);
+        }
+        // gain-update event: the Table 5 K(eta', eta') = 4.0000 -> Table 6 (deep water) 4.6587
+        let mut g = 0.0;
+        let vg = vr("gain_cross_track_cross_track");
+        assert_eq!(fmi2GetReal(c, &vg, 1, &mut g), fmi2OK);
+        assert!((g - 4.0000).abs() < 1e-4);
+        let deep = 1e12;
+        assert_eq!(fmi2SetReal(c, &vr("design_depth_ratio"), 1, &deep), fmi2OK);
+        assert_eq!(fmi2GetReal(c, &vg, 1, &mut g), fmi2OK);
+        assert!((g - 4.6587).abs() < 1e-4, "{g}");
+        assert_eq!(fmi2Terminate(c), fmi2OK);
+        fmi2FreeInstance(c);
+    }
+}
+
+#[test]
+fn variable_table_passes_the_layer_checks() {
+    use fmi2_export::FmuModel;
+    fmi2_export::variables::check_table(path_kalman_filter_fmu::PathKalmanFilterFmu::variables())
+        .unwrap();
+    let xml = fmi2_export::xml::model_description::<path_kalman_filter_fmu::PathKalmanFilterFmu>();
+    assert!(xml.contains(r#"name="heading_measured""#));
+}
