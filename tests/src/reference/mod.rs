@@ -13,6 +13,7 @@
 use std::io::Write;
 
 pub mod container_ship;
+pub mod path_controller;
 pub mod path_kalman_filter;
 pub mod sensors;
 pub mod steering_gear;
@@ -26,6 +27,12 @@ pub type Case = (
 );
 
 pub const CASES: &[Case] = &[
+    (
+        "path_controller_adaptive",
+        "PathController, adaptation 2 (estimates), dither windows of 1 L every 3 L from t' = 1; \
+         sinusoidal state-estimate inputs, f23/f25 estimates at deep-water values; h = 0.5 s, 300 s",
+        path_controller::adaptive,
+    ),
     (
         "steering_gear_sine",
         "SteeringGear with default (003 RRS) parameters, rudder_command = 0.5 sin(0.8 t) rad, \
