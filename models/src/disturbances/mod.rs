@@ -2,6 +2,7 @@
 //! and spectral machinery they share. Every random source is seeded per instance
 //! ([`crate::random`]).
 
+pub mod current;
 pub mod shaping;
 pub mod spectral;
 pub mod waves;
