@@ -16,6 +16,9 @@ from cosim import run_libcosim, variables_by_name
 CASES = {
     "container_ship_nonlinear": ("ContainerShip", {}),
     "container_ship_linear": ("ContainerShip", {"variant": 2}),
+    "mariner_trimmed": ("Mariner", {}),
+    "rrs_ship_simulation": ("RrsShip", {"model": 1}),
+    "rrs_ship_control": ("RrsShip", {"model": 2}),
 }
 
 

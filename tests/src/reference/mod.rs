@@ -13,8 +13,10 @@
 use std::io::Write;
 
 pub mod container_ship;
+pub mod mariner;
 pub mod path_controller;
 pub mod path_kalman_filter;
+pub mod rrs_ship;
 pub mod sensors;
 pub mod steering_gear;
 pub mod waves;
@@ -75,5 +77,25 @@ pub const CASES: &[Case] = &[
         "path_kalman_filter",
         "PathKalmanFilter with default parameters (random walk, H/T 1.89, Table 5 gains); heading = 0.02 sin(0.03 t), yaw_rate = 6e-4 cos(0.03 t), cross_track = 5 + 0.02 t, rudder_command = +-0.05 square wave of period 120 s; h = 0.25 s, 300 s",
         path_kalman_filter::case,
+    ),
+    (
+        "mariner_trimmed",
+        "Mariner from the trimmed straight course at 15 kn, rudder_command = trim + 0.3 \
+         sin(0.04 t) rad; h = 0.1 s, 300 s: rudder rate limit engages",
+        mariner::trimmed,
+    ),
+    (
+        "rrs_ship_simulation",
+        "RrsShip model 1 (22 kn simulation model, Tables 2.1/2.2), rudder_angle = 0.1 sin(0.3 \
+         t) rad, speed 11.32 m/s, wave_elevation = 0.5 sin(0.64 t) + 0.3 sin(0.9 t) m, \
+         roll/yaw disturbances 0.01 sin(0.2 t), 0.005 cos(0.1 t); h = 0.05 s, 200 s",
+        rrs_ship::simulation,
+    ),
+    (
+        "rrs_ship_control",
+        "RrsShip model 2 (control model, Table 2.4 speed laws), rudder_angle = 0.1 sin(0.3 t) \
+         rad, speed = 8 + 0.02 t m/s, roll/yaw disturbances as rrs_ship_simulation; h = 0.05 \
+         s, 200 s",
+        rrs_ship::control,
     ),
 ];
