@@ -312,6 +312,27 @@ impl Current {
         &self.params
     }
 
+    /// Changes the current-velocity profile (tunable; the random processes are untouched).
+    pub fn set_current_profile(
+        &mut self,
+        speed_initial: f64,
+        speed_final: f64,
+        direction: f64,
+        t_start: f64,
+        ramp_duration: f64,
+    ) -> Result<(), String> {
+        if !(ramp_duration >= 0.0) {
+            return Err(format!("ramp_duration = {ramp_duration} must be >= 0"));
+        }
+        let p = &mut self.params;
+        p.speed_initial = speed_initial;
+        p.speed_final = speed_final;
+        p.direction = direction;
+        p.t_start = t_start;
+        p.ramp_duration = ramp_duration;
+        Ok(())
+    }
+
     pub fn set_heading(&mut self, heading: f64) {
         self.heading = heading;
     }

@@ -13,6 +13,7 @@
 use std::io::Write;
 
 pub mod container_ship;
+pub mod current;
 pub mod mariner;
 pub mod path_controller;
 pub mod path_kalman_filter;
@@ -97,5 +98,12 @@ pub const CASES: &[Case] = &[
          rad, speed = 8 + 0.02 t m/s, roll/yaw disturbances as rrs_ship_simulation; h = 0.05 \
          s, 200 s",
         rrs_ship::control,
+    ),
+    (
+        "current_004",
+        "Current: 5-kn beam current stepped in at 30 s, 004 design current, 4x passing ship at \
+         t' = 20, white N', shaping Y', random-walk Y', 001 bias; seed 6; heading 0.2 sin(0.01 t); \
+         h = 0.5 s, 1200 s",
+        current::disturbances_004,
     ),
 ];
