@@ -5,6 +5,7 @@
 //! | module | source |
 //! | --- | --- |
 //! | [`path_kalman::PathKalmanFilter`] | seed 004, spec `adaptive_path_control.md` §2.8-2.9, §5.5: steady-state Kalman-Bucy filter, Euler at Δt′ = 0.005 |
+//! | [`rrs_filter::RrsFilter`] | seed 003, spec `rrs_models_filters.md` §4.4-4.7, `rrs_controller_results.md` §2.7-2.8: roll (App. E), yaw (App. F, adaptive E[w3²]) and adaptive speed filters, Euler Eqs. 6.2-6.4 |
 //! | [`path_model`] | seed 004, spec `adaptive_path_control.md` §2.7-2.9: Tokyo Maru 7-state design model (shared with the path controller) |
 //!
 //! Gains are computed at initialization (DMatrix Riccati solvers of [`crate::control::riccati`]);
@@ -13,3 +14,4 @@
 
 pub mod path_kalman;
 pub mod path_model;
+pub mod rrs_filter;
