@@ -6,3 +6,4 @@ pub mod current;
 pub mod shaping;
 pub mod spectral;
 pub mod waves;
+pub mod wind;
