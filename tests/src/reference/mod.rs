@@ -17,6 +17,7 @@ pub mod current;
 pub mod mariner;
 pub mod path_controller;
 pub mod path_kalman_filter;
+pub mod rrs_filter;
 pub mod rrs_ship;
 pub mod sensors;
 pub mod steering_gear;
@@ -105,5 +106,10 @@ pub const CASES: &[Case] = &[
          t' = 20, white N', shaping Y', random-walk Y', 001 bias; seed 6; heading 0.2 sin(0.01 t); \
          h = 0.5 s, 1200 s",
         current::disturbances_004,
+    ),
+    (
+        "rrs_filter",
+        "RrsFilter with default parameters (T 0.1 s, Table 2.4 at 11 m/s, roll q (10, 0.001), adaptive yaw filter, L speed filter); roll = 0.1 sin(0.63 t) + 0.02, heading = 0.05 sin(0.02 t) + 0.01 sin(0.9 t), speed = 11 + 4 sin(0.01 t) + 0.5 sin(1.7 t), roll_rudder = 0.01 cos(0.63 t), course_rudder = 0.02 cos(0.01 t); h = 0.25 s, 300 s",
+        rrs_filter::case,
     ),
 ];
