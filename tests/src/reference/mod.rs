@@ -22,6 +22,7 @@ pub mod rrs_ship;
 pub mod sensors;
 pub mod steering_gear;
 pub mod waves;
+pub mod wind;
 
 /// A reference case: name, description, generator.
 pub type Case = (
@@ -111,5 +112,12 @@ pub const CASES: &[Case] = &[
         "rrs_filter",
         "RrsFilter with default parameters (T 0.1 s, Table 2.4 at 11 m/s, roll q (10, 0.001), adaptive yaw filter, L speed filter); roll = 0.1 sin(0.63 t) + 0.02, heading = 0.05 sin(0.02 t) + 0.01 sin(0.9 t), speed = 11 + 4 sin(0.01 t) + 0.5 sin(1.7 t), roll_rudder = 0.01 cos(0.63 t), course_rudder = 0.02 cos(0.01 t); h = 0.25 s, 300 s",
         rrs_filter::case,
+    ),
+    (
+        "wind_gusts",
+        "Wind with default gusts (10 m/s, 1.5 m/s, 20 s; 5 deg, 60 s), seed 4, roll_coefficient \
+         2e3, yaw_coefficient 5e3, wind_direction 1.0 rad; ship_speed = 5 + 0.01 t, heading = \
+         0.5 sin(0.02 t); h = 0.1 s, 300 s",
+        wind::gusts,
     ),
 ];
