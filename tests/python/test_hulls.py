@@ -19,6 +19,15 @@ CASES = {
     "mariner_trimmed": ("Mariner", {}),
     "rrs_ship_simulation": ("RrsShip", {"model": 1}),
     "rrs_ship_control": ("RrsShip", {"model": 2}),
+    "tokyo_maru_design_depth": ("TokyoMaru", {"depth_ratio": 1.89}),
+    "tokyo_maru_gear_deep": ("TokyoMaru", {"deep_water": True, "internal_steering_gear": True}),
+    "nomoto_ship_ddg51": ("NomotoShip", {"model": 1}),
+    "nomoto_ship_esso_osaka": ("NomotoShip", {"model": 2}),
+    "supply_vessel_thrust": ("SupplyVessel", {}),
+    "manoeuvre_zigzag": ("Manoeuvre", {"kind": 2, "rudder_angle": 0.17453292519943295,
+                                       "check_angle": 0.17453292519943295, "execute_time": 10.0}),
+    "manoeuvre_pull_out": ("Manoeuvre", {"kind": 3, "rudder_angle": 0.3490658503988659,
+                                         "hold_time": 60.0, "execute_time": 10.0}),
 }
 
 

@@ -14,13 +14,17 @@ use std::io::Write;
 
 pub mod container_ship;
 pub mod current;
+pub mod manoeuvre;
 pub mod mariner;
+pub mod nomoto_ship;
 pub mod path_controller;
 pub mod path_kalman_filter;
 pub mod rrs_filter;
 pub mod rrs_ship;
 pub mod sensors;
 pub mod steering_gear;
+pub mod supply_vessel;
+pub mod tokyo_maru;
 pub mod waves;
 pub mod wind;
 
@@ -119,5 +123,49 @@ pub const CASES: &[Case] = &[
          2e3, yaw_coefficient 5e3, wind_direction 1.0 rad; ship_speed = 5 + 0.01 t, heading = \
          0.5 sin(0.02 t); h = 0.1 s, 300 s",
         wind::gusts,
+    ),
+    (
+        "tokyo_maru_design_depth",
+        "TokyoMaru at H/T = 1.89, rudder_angle = 0.1 sin(0.02 t) rad, yaw_moment_prime = 1e-4 \
+         sin(0.01 t), sway_force_prime = 2e-3 cos(0.015 t), current_lateral = 0.3 m/s; h = 1 \
+         s, 600 s",
+        tokyo_maru::design_depth,
+    ),
+    (
+        "tokyo_maru_gear_deep",
+        "TokyoMaru deep water (deep_water = true) with the internal steering gear, \
+         rudder_command = 0.1 sign(sin(0.02 t)); h = 0.5 s, 600 s",
+        tokyo_maru::gear_deep,
+    ),
+    (
+        "nomoto_ship_ddg51",
+        "NomotoShip model 1 (DDG-51 Nomoto, 22 kn), rudder_angle = 0.1 sin(0.05 t) rad, \
+         current 0.5 m/s toward 1 rad; h = 0.1 s, 300 s",
+        nomoto_ship::ddg51,
+    ),
+    (
+        "nomoto_ship_esso_osaka",
+        "NomotoShip model 2 (Esso Osaka sway-yaw), rudder_angle = 0.1 sin(0.02 t) rad; h = \
+         0.5 s, 600 s",
+        nomoto_ship::esso_osaka,
+    ),
+    (
+        "supply_vessel_thrust",
+        "SupplyVessel (Northern Clipper), thrust 1e5 sin(0.01 t) N / 5e4 cos(0.02 t) N / 1e6 \
+         sin(0.015 t) N.m, bias 2e4, -1e4 N, 5e5 N.m, wave motion 0.5 sin(0.8 t) m, 0.3 \
+         cos(0.7 t) m, 0.02 sin(0.9 t) rad; h = 0.2 s, 600 s",
+        supply_vessel::thrust,
+    ),
+    (
+        "manoeuvre_zigzag",
+        "Manoeuvre kind 2 (zig-zag 10/10, execute at 10 s) driven by heading = 0.3 sin(0.05 \
+         (t - 10)) for t > 10, yaw_rate = its derivative; h = 0.1 s, 300 s",
+        manoeuvre::zigzag,
+    ),
+    (
+        "manoeuvre_pull_out",
+        "Manoeuvre kind 3 (pull-out, 20 deg for 60 s from 10 s) with heading = 0.01 t; h = \
+         0.5 s, 200 s",
+        manoeuvre::pull_out,
     ),
 ];
