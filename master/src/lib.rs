@@ -6,6 +6,7 @@
 //! - [`inspect`]: human-readable FMU summary (`shipsim inspect`).
 //! - [`system`]: the TOML system description, validation into a [`system::Plan`].
 //! - [`osp`]: OSP `OspSystemStructure.xml` read and write (libcosim's format).
+//! - [`plot`]: PNG time-series plots of recorded CSVs (`shipsim plot`).
 //! - [`master`]: Jacobi / Gauss-Seidel fixed-step multi-rate master, events, CSV recorder.
 //!
 //! Tests: `master/tests/*.rs` (C test FMU compiled at test time, our FMUs from
@@ -22,6 +23,7 @@ pub mod instance;
 pub mod master;
 pub mod model_description;
 pub mod osp;
+pub mod plot;
 pub mod system;
 
 pub use error::{Error, Result};

@@ -1,4 +1,4 @@
-//! The `shipsim` command line: `run`, `check`, `inspect`, `export-osp`.
+//! The `shipsim` command line: `run`, `check`, `inspect`, `export-osp`, `plot`.
 use clap::{Parser, Subcommand};
 use shipsim::error::Error;
 use shipsim::fmu::UnpackedFmu;
@@ -57,6 +57,23 @@ enum Command {
         /// The .fmu file.
         fmu: PathBuf,
     },
+    /// Plot recorded columns of a CSV against time into a PNG.
+    Plot {
+        /// The CSV written by `shipsim run`.
+        csv: PathBuf,
+        /// A panel: "Y LABEL=column,column,..." (repeatable; panels stack vertically).
+        #[arg(long = "panel", value_name = "LABEL=COL[,COL...]", required = true)]
+        panels: Vec<String>,
+        /// Factor applied to every plotted value (e.g. 57.29578 for rad -> deg).
+        #[arg(long, default_value_t = 1.0)]
+        scale: f64,
+        /// Figure title (default: the CSV file name).
+        #[arg(long)]
+        title: Option<String>,
+        /// PNG output file.
+        #[arg(long, short)]
+        output: PathBuf,
+    },
     /// Write an OSP OspSystemStructure.xml for a native system file (runs in libcosim).
     ExportOsp {
         system: PathBuf,
@@ -85,6 +102,37 @@ fn main() -> ExitCode {
 
 fn dispatch(cmd: Command) -> shipsim::Result<()> {
     match cmd {
+        Command::Plot {
+            csv,
+            panels,
+            scale,
+            title,
+            output,
+        } => {
+            let table = shipsim::plot::Table::read(&csv)?;
+            let mut out = Vec::new();
+            for spec in &panels {
+                let (label, cols) = spec.split_once('=').ok_or_else(|| {
+                    Error::Other(format!("--panel {spec:?}: expected LABEL=COL[,COL...]"))
+                })?;
+                let mut series = Vec::new();
+                for col in cols.split(',').map(str::trim).filter(|c| !c.is_empty()) {
+                    series.push(shipsim::plot::Series {
+                        label: col.to_string(),
+                        t: table.time().to_vec(),
+                        y: table.column(col)?.iter().map(|v| v * scale).collect(),
+                    });
+                }
+                out.push(shipsim::plot::Panel {
+                    y_label: label.to_string(),
+                    series,
+                });
+            }
+            let title = title.unwrap_or_else(|| csv.display().to_string());
+            shipsim::plot::plot_panels(&output, &title, &out)?;
+            println!("wrote {}", output.display());
+            Ok(())
+        }
         Command::Inspect { fmu } => {
             print!("{}", shipsim::inspect::inspect(&fmu)?);
             Ok(())

@@ -199,6 +199,22 @@ fn demo() -> Result<()> {
         );
     }
     println!("(classification rule: 70 deg within 30 s, i.e. 2.5 deg/s suffices)");
-    println!("results: {}", csv.display());
+    let png = out_dir.join("steering_gear_classification.png");
+    run(Command::new(root.join("target/release/shipsim"))
+        .arg("plot")
+        .arg(&csv)
+        .args([
+            "--panel",
+            "rudder angle [deg]=slow.rudder_angle,rrs.rudder_angle",
+            "--panel",
+            "rudder rate [deg/s]=slow.rudder_rate,rrs.rudder_rate",
+            "--scale",
+            "57.29577951308232",
+            "--title",
+            "Hard over 35 deg port to 35 deg starboard: 2.5 deg/s vs 15 deg/s gear",
+            "-o",
+        ])
+        .arg(&png))?;
+    println!("results: {} and {}", csv.display(), png.display());
     Ok(())
 }
