@@ -15,6 +15,7 @@ use std::fmt;
 
 pub mod lq;
 pub mod path;
+pub mod rrs;
 
 /// Why a controller could not be designed or configured: names the parameter or the design step.
 #[derive(Clone, Debug, PartialEq)]
