@@ -17,6 +17,7 @@ pub mod current;
 pub mod manoeuvre;
 pub mod mariner;
 pub mod nomoto_ship;
+pub mod passive_observer;
 pub mod path_controller;
 pub mod path_kalman_filter;
 pub mod rrs_filter;
@@ -167,5 +168,10 @@ pub const CASES: &[Case] = &[
         "Manoeuvre kind 3 (pull-out, 20 deg for 60 s from 10 s) with heading = 0.01 t; h = \
          0.5 s, 200 s",
         manoeuvre::pull_out,
+    ),
+    (
+        "passive_observer",
+        "PassiveObserver with default parameters (Northern Clipper, eq. 59 gains, mass-normalised injection); north = 0.02 t + 3 sin(0.9 t), east = 5 sin(0.01 t) - 2 cos(0.85 t), heading = 0.1 + 0.01 sin(0.9 t), tau = 1e5 (sin 0.05 t, sin 0.1 t, sin 0.07 t); h = 1 s, 600 s",
+        passive_observer::case,
     ),
 ];
