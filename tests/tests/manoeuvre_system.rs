@@ -10,8 +10,8 @@
 use models::hull::container_ship::{ContainerShip, L};
 use models::hull::DEG;
 use models::manoeuvre::{
-    run, turning_circle, ContainerShipRun, ManoeuvreGenerator, ManoeuvreKind, Sample,
-    TurningCircleMetrics,
+    run, turning_circle, zigzag, ContainerShipRun, ManoeuvreGenerator, ManoeuvreKind,
+    ManoeuvreShip, Sample, TurningCircleMetrics,
 };
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -52,13 +52,15 @@ fn fmu_dir() -> PathBuf {
 
 /// Runs a system file from systems/ with its FMU paths pointed at [`fmu_dir`], with the given
 /// algorithm; returns the CSV columns by name.
-fn run_system(file: &str, algorithm: &str) -> HashMap<String, Vec<f64>> {
+fn run_system(file: &str, algorithm: &str, extra: &[&str]) -> HashMap<String, Vec<f64>> {
     let text = std::fs::read_to_string(root().join("systems").join(file))
         .unwrap_or_else(|e| panic!("reading systems/{file}: {e}"));
     let fmus = fmu_dir();
     let text = text.replace("../target/fmu/", &format!("{}/", fmus.display()));
+    static RUNS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let n = RUNS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
     let dir = std::env::temp_dir().join(format!(
-        "shipsim-manoeuvre-{}-{algorithm}",
+        "shipsim-manoeuvre-{}-{n}-{algorithm}",
         std::process::id()
     ));
     std::fs::create_dir_all(&dir).unwrap();
@@ -73,6 +75,7 @@ fn run_system(file: &str, algorithm: &str) -> HashMap<String, Vec<f64>> {
         .arg("--algorithm")
         .arg(algorithm)
         .arg("--quiet")
+        .args(extra)
         .output()
         .expect("starting shipsim");
     assert!(
@@ -148,7 +151,7 @@ const ABS_ANGLE: f64 = 1e-9;
 fn container_ship_turning_circle_through_the_master_matches_the_rust_run() {
     let (rust, m) = rust_only();
     for algorithm in ["jacobi", "gauss-seidel"] {
-        let c = run_system("container_ship_turning_circle.toml", algorithm);
+        let c = run_system("container_ship_turning_circle.toml", algorithm, &[]);
         let s = samples(&c);
         assert_eq!(s.len(), rust.len(), "{algorithm}: one row per 0.1 s step");
         // The command sequence is the Rust loop's, sample for sample (the master records the
@@ -221,4 +224,113 @@ fn container_ship_turning_circle_through_the_master_matches_the_rust_run() {
         assert!(f.steady_heel < 0.0, "outward heel in a starboard turn");
         assert!(f.initial_inward_heel > 0.0, "inverse initial roll");
     }
+}
+
+/// The 10/10 zig-zag through the master (the same system file with kind = 2, Jacobi). The
+/// generator decides a rudder reversal from the heading it was given, which under Jacobi is the
+/// heading of the previous communication point: each reversal comes one step (0.1 s) later than in
+/// `models::manoeuvre::run`, which decides from the heading at the current point. The master run
+/// must equal the Rust loop with exactly that exchange (written out below) to 1e-9, and the
+/// effect of the delay on the metrics is printed (measured: first overshoot +0.057 deg, second
+/// +0.105 deg, period +0.6 s at h = 0.1 s).
+#[test]
+fn container_ship_zigzag_through_the_master_is_the_rust_run_with_a_one_step_decision_delay() {
+    let a = 10.0 * DEG;
+    let h = 0.1;
+    let n = 6000;
+    let make = || ContainerShipRun {
+        ship: ContainerShip::at_equilibrium(80.0).unwrap(),
+        shaft_command_rpm: 80.0,
+    };
+    let gen = ManoeuvreGenerator::new(
+        ManoeuvreKind::ZigZag {
+            rudder: a,
+            check: a,
+        },
+        10.0,
+        0.0,
+    );
+    let undelayed = run(&mut make(), &mut gen.clone(), h, n as f64 * h);
+    let m0 = zigzag(&undelayed, 10.0, 1.0, a).unwrap();
+    // The Jacobi exchange: the command at t_k comes from the generator as committed at t_(k-1)
+    // with the heading of t_(k-1); the commit at t_k sees the heading of t_k.
+    let mut ship = make();
+    let mut g = gen;
+    let mut held = ship.sample();
+    let mut jacobi = Vec::with_capacity(n + 1);
+    for k in 0..=n {
+        let t = k as f64 * h;
+        let mut smp = ship.sample();
+        let cmd = g.clone().command(t, held.psi, held.r);
+        smp.rudder_command = cmd;
+        jacobi.push(smp);
+        if k == n {
+            break;
+        }
+        g.command(t, smp.psi, smp.r);
+        held = smp;
+        ship.advance(cmd, h);
+    }
+    let m = zigzag(&jacobi, 10.0, 1.0, a).unwrap();
+
+    let set = [
+        "--stop-time",
+        "600",
+        "--set",
+        "manoeuvre.kind=2",
+        "--set",
+        "manoeuvre.rudder_angle=0.17453292519943295",
+        "--set",
+        "manoeuvre.check_angle=0.17453292519943295",
+    ];
+    let c = run_system("container_ship_turning_circle.toml", "jacobi", &set);
+    let s = samples(&c);
+    assert_eq!(s.len(), jacobi.len());
+    for (p, q) in s.iter().zip(&jacobi) {
+        assert_eq!(p.rudder_command, q.rudder_command, "t = {}", p.t);
+        assert!((p.psi - q.psi).abs() < 1e-9 && (p.x - q.x).abs() < 1e-9 * (1.0 + q.x.abs()));
+    }
+    let f = zigzag(&s, 10.0, 1.0, a).unwrap();
+    println!(
+        "10/10 zig-zag through shipsim (Jacobi): initial turning time {:.3} s, first overshoot \
+         {:.4} deg, second overshoot {:.4} deg, period {:.2} s; the undelayed Rust loop: {:.3} s, \
+         {:.4} deg, {:.4} deg, {:.2} s",
+        f.initial_turning_time,
+        f.first_overshoot / DEG,
+        f.second_overshoot / DEG,
+        f.period,
+        m0.initial_turning_time,
+        m0.first_overshoot / DEG,
+        m0.second_overshoot / DEG,
+        m0.period
+    );
+    for (name, x, y) in [
+        (
+            "initial_turning_time",
+            f.initial_turning_time,
+            m.initial_turning_time,
+        ),
+        ("first_overshoot", f.first_overshoot, m.first_overshoot),
+        ("second_overshoot", f.second_overshoot, m.second_overshoot),
+        (
+            "first_overshoot_time",
+            f.first_overshoot_time,
+            m.first_overshoot_time,
+        ),
+        (
+            "second_overshoot_time",
+            f.second_overshoot_time,
+            m.second_overshoot_time,
+        ),
+        ("period", f.period, m.period),
+    ] {
+        assert!(
+            (x - y).abs() <= 1e-9 * (1.0 + y.abs()),
+            "{name}: {x} vs {y}"
+        );
+    }
+    // Before the first reversal the runs are the same; the reversal is exactly one step late.
+    assert!((f.initial_turning_time - m0.initial_turning_time).abs() < 1e-9);
+    let first_switch = |v: &[Sample]| v.iter().position(|p| p.rudder_command < 0.0).unwrap();
+    assert_eq!(first_switch(&s), first_switch(&undelayed) + 1);
 }
