@@ -10,9 +10,8 @@ from cosim import run_libcosim
 
 OUTPUTS = ["wave_elevation", "roll_moment", "yaw_moment", "wf_motion_surge", "wf_motion_yaw"]
 # Outputs are compared to 1e-12 of their scale (the moments are gain x elevation). The outputs are
-# functions of absolute time; libcosim's integer-nanosecond clock hands the FMU communication
-# points up to an ulp off FMPy's k*h (5.7e-14 s at t = 300 s), which moves a 5 m, 0.9 rad/s signal
-# by ~1e-12: libcosim is held to 1e-11 of scale, FMPy (same clock as the reference) to 1e-12.
+# functions of absolute time; the models round every time to a whole nanosecond, so libcosim's
+# integer-nanosecond clock and FMPy's k*h give the same instants.
 SCALE = {"roll_moment": 1.0e6, "yaw_moment": 3.0e5}
 PARAMS = {"seed": 5, "roll_gain": 1.0e6, "yaw_gain": 3.0e5, "wave_direction": 0.4}
 CASES = {
@@ -54,7 +53,7 @@ def test_libcosim_matches_rust_model(fmu_path, reference, case):
                           initial={**PARAMS, **CASES[case]})
     for name in OUTPUTS:
         expected = np.array([r[name] for r in ref[1:]])
-        np.testing.assert_allclose(result[name], expected, rtol=0, atol=1e-11 * SCALE.get(name, 1.0),
+        np.testing.assert_allclose(result[name], expected, rtol=0, atol=1e-12 * SCALE.get(name, 1.0),
                                    err_msg=name)
 
 
@@ -85,3 +84,57 @@ def test_output_independent_of_communication_step(fmu_path):
                               output=["wave_elevation", "wf_motion_sway"], start_values=extra)
         for name in ("wave_elevation", "wf_motion_sway"):
             np.testing.assert_allclose(fine[name], coarse[name], rtol=0, atol=1e-9, err_msg=name)
+
+
+def test_disturbance_fmus_in_shipsim_equal_fmpy_and_libcosim(fmu_path, tmp_path):
+    """Waves, Wind, Current and Sensors in our master: each seeded instance gives bit-identical
+    output to the same FMU alone in FMPy, and the coupled system equals libcosim on the exported
+    OspSystemStructure.xml (Jacobi) to 1e-12."""
+    import shutil
+    import textwrap
+    from test_master_interop import assert_same_as_libcosim, read_csv, shipsim
+
+    for name in ("Waves", "Wind", "Current", "Sensors"):
+        shutil.copy(fmu_path(name), tmp_path / f"{name}.fmu")
+    (tmp_path / "env.toml").write_text(textwrap.dedent("""
+        connections = ["waves.wave_elevation -> sensors.cross_track", "wind.relative_wind_speed -> sensors.speed"]
+        [simulation]
+        stop_time = 60.0
+        step_size = 0.1
+        [[instances]]
+        name = "waves"
+        fmu = "Waves.fmu"
+        parameters = { seed = 5, realisation = 2 }
+        [[instances]]
+        name = "wind"
+        fmu = "Wind.fmu"
+        parameters = { seed = 4 }
+        [[instances]]
+        name = "current"
+        fmu = "Current.fmu"
+        parameters = { seed = 6, white_sigma_n = 2e-5, passing_ship_factor = 4.0, passing_ship_time = 0.5 }
+        [[instances]]
+        name = "sensors"
+        fmu = "Sensors.fmu"
+        parameters = { seed = 8, speed_sigma = 0.1 }
+        [output]
+        variables = ["waves.wave_elevation", "wind.true_wind_speed", "current.n_prime",
+                     "sensors.cross_track_measured", "sensors.speed_measured", "sensors.north_measured"]
+    """))
+    out = tmp_path / "env.csv"
+    shipsim("run", tmp_path / "env.toml", "-o", out)
+    header, rows = read_csv(out)
+    col = lambda name: np.array([r[header.index(name)] for r in rows])
+    for fmu, var, start in (("Waves", "wave_elevation", {"seed": 5, "realisation": 2}),
+                            ("Wind", "true_wind_speed", {"seed": 4}),
+                            ("Current", "n_prime", {"seed": 6, "white_sigma_n": 2e-5,
+                                                    "passing_ship_factor": 4.0, "passing_ship_time": 0.5}),
+                            ("Sensors", "north_measured", {"seed": 8})):
+        alone = simulate_fmu(str(fmu_path(fmu)), stop_time=60.0, step_size=0.1, output_interval=0.1,
+                             output=[var], start_values=start)
+        ours = col(f"{fmu.lower()}.{var}")
+        assert len(ours) == len(alone)
+        diff = np.max(np.abs(ours - alone[var]))
+        assert diff == 0.0, (fmu, diff, np.argmax(np.abs(ours - alone[var])))
+    shipsim("export-osp", tmp_path / "env.toml", "-o", tmp_path / "OspSystemStructure.xml")
+    assert_same_as_libcosim(tmp_path / "OspSystemStructure.xml", out)

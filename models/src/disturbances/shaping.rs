@@ -18,6 +18,20 @@
 //! frequency): the new Φ and Q_d apply from the next grid interval that is drawn.
 
 use crate::random::NoiseStream;
+
+/// Time quantum of the disturbance models [s]: every time handed to `advance_to` is rounded to
+/// a whole nanosecond first. Importers compute communication points differently (FMPy
+/// `t0 + k h`, libcosim integer nanoseconds, an FMU's own `t + h`), which puts "the same" instant
+/// a few ulps apart; after rounding they coincide, so outputs that are functions of time (the
+/// sums of sinusoids, the interpolated processes, the 004 histories) are bit-identical across
+/// importers whenever the communication points lie on a nanosecond grid. Exact for |t| < 9e6 s.
+pub const TIME_QUANTUM: f64 = 1e-9;
+
+/// `t` rounded to a whole [`TIME_QUANTUM`].
+#[inline]
+pub fn quantise_time(t: f64) -> f64 {
+    (t * 1e9).round() / 1e9
+}
 use nalgebra::Matrix2;
 use serde::{Deserialize, Serialize};
 

@@ -25,7 +25,7 @@
 //! 10 m/s, σ_g = 1.5 m/s (15 % turbulence intensity), T_g = 20 s, σ_β = 5°, T_β = 60 s.
 //! V is clipped at 0.
 
-use super::shaping::{FirstOrderProcess, Start};
+use super::shaping::{quantise_time, FirstOrderProcess, Start};
 use crate::random::{channel, NoiseStream};
 use serde::{Deserialize, Serialize};
 
@@ -115,6 +115,7 @@ pub struct Wind {
 
 impl Wind {
     pub fn new(params: WindParams, t0: f64) -> Result<Self, String> {
+        let t0 = quantise_time(t0);
         params.validate()?;
         let gain = |std: f64, t: f64| std * (2.0 / t).sqrt();
         let gust = FirstOrderProcess::new(
@@ -166,7 +167,9 @@ impl Wind {
         self.heading = heading;
     }
 
+    /// `t` is rounded to a whole nanosecond ([`quantise_time`]).
     pub fn advance_to(&mut self, t: f64) {
+        let t = quantise_time(t);
         self.time = t;
         self.gust.advance_to(t);
         self.turn.advance_to(t);
