@@ -138,3 +138,19 @@ def test_disturbance_fmus_in_shipsim_equal_fmpy_and_libcosim(fmu_path, tmp_path)
         assert diff == 0.0, (fmu, diff, np.argmax(np.abs(ours - alone[var])))
     shipsim("export-osp", tmp_path / "env.toml", "-o", tmp_path / "OspSystemStructure.xml")
     assert_same_as_libcosim(tmp_path / "OspSystemStructure.xml", out)
+
+
+def test_encounter_frequency_outputs_eq_2_22(fmu_path):
+    """peak_encounter_frequency = wp - wp^2 U cos(gamma)/g at head, beam and following seas,
+    including the sign change in following seas at high speed (default sea: Tp = 8.84 s)."""
+    wp, g = 2 * np.pi / 8.84, 9.81
+    for heading, speed, gamma in ((np.pi, 10.0, np.pi), (np.pi / 2, 10.0, -np.pi / 2),
+                                  (0.0, 5.0, 0.0), (0.0, 25.0, 0.0)):
+        r = simulate_fmu(str(fmu_path("Waves")), stop_time=1.0, step_size=0.5, output_interval=0.5,
+                         output=["peak_encounter_frequency", "encounter_angle"],
+                         start_values={"heading": heading, "ship_speed": speed})
+        assert abs(abs(r["encounter_angle"][-1]) - abs(gamma)) < 1e-12
+        expected = wp - wp ** 2 * speed * np.cos(gamma) / g
+        assert abs(r["peak_encounter_frequency"][-1] - expected) < 1e-12
+    # following seas: positive at 5 m/s, negative at 25 m/s (> g/wp = 13.8 m/s)
+    assert wp - wp ** 2 * 5.0 / g > 0 > wp - wp ** 2 * 25.0 / g
