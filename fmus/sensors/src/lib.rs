@@ -135,10 +135,9 @@ impl FmuModel for SensorsFmu {
         self.sensors.set_inputs(self.input);
     }
 
-    fn do_step(&mut self, _t: f64, h: f64) -> Result<(), String> {
+    fn do_step(&mut self, t: f64, h: f64) -> Result<(), String> {
         self.sensors.set_inputs(self.input);
-        let t = _t + h;
-        self.sensors.advance_to(t);
+        self.sensors.advance_to(t + h);
         Ok(())
     }
 }
