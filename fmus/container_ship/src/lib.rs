@@ -395,6 +395,8 @@ impl ContainerShipFmu {
 
 impl FmuModel for ContainerShipFmu {
     const MODEL_IDENTIFIER: &'static str = "ContainerShip";
+    /// Every output is a function of the state: no direct feedthrough from the inputs.
+    const DIRECT_FEEDTHROUGH: bool = false;
     const DESCRIPTION: &'static str = "Son & Nomoto (1982) high-speed container ship: nonlinear \
         roll-coupled surge-sway-yaw-roll manoeuvring model with rudder and shaft servos (MSS \
         container.m), or its linearisation (Lcontainer.m)";

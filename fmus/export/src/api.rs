@@ -983,13 +983,13 @@ pub unsafe fn get_string_status<M: FmuModel>(
 }
 
 /// Hands generated text to the caller of a generator entry point.
-pub fn emit_text(
+///
+/// # Safety
+/// `write` must be callable with `out` and a byte slice.
+pub unsafe fn emit_text(
     out: *mut c_void,
     write: unsafe extern "C" fn(*mut c_void, *const u8, usize),
     text: &str,
 ) {
-    // SAFETY: the generator passes a valid callback and context.
-    let _ = catch_unwind(AssertUnwindSafe(|| unsafe {
-        write(out, text.as_ptr(), text.len())
-    }));
+    let _ = catch_unwind(AssertUnwindSafe(|| write(out, text.as_ptr(), text.len())));
 }

@@ -62,6 +62,11 @@ pub trait FmuModel: Clone + Default + Serialize + DeserializeOwned + 'static {
     const DESCRIPTION: &'static str;
     const DEFAULT_EXPERIMENT: DefaultExperiment;
 
+    /// Whether outputs that declare no dependencies may depend directly on inputs. `false`: they
+    /// depend on the state only, written as `dependencies=""` in ModelStructure, so importers
+    /// (e.g. a Gauss-Seidel master) know there is no algebraic loop through this FMU.
+    const DIRECT_FEEDTHROUGH: bool = true;
+
     /// The variable table; value reference = index.
     fn variables() -> &'static [Variable<Self>];
 
@@ -380,7 +385,7 @@ macro_rules! export_fmu {
 
             /// Generator entry (not FMI): the model description, for `cargo xtask build-fmus`.
             #[no_mangle]
-            pub extern "C" fn shipfmu_model_description(
+            pub unsafe extern "C" fn shipfmu_model_description(
                 out: *mut c_void,
                 write: unsafe extern "C" fn(*mut c_void, *const u8, usize),
             ) {
@@ -388,7 +393,7 @@ macro_rules! export_fmu {
             }
             /// Generator entry (not FMI): documentation/index.html.
             #[no_mangle]
-            pub extern "C" fn shipfmu_documentation_html(
+            pub unsafe extern "C" fn shipfmu_documentation_html(
                 out: *mut c_void,
                 write: unsafe extern "C" fn(*mut c_void, *const u8, usize),
             ) {

@@ -81,6 +81,9 @@ pub struct Variable<M> {
     pub variability: Variability,
     pub description: &'static str,
     pub access: Access<M>,
+    /// For outputs: the inputs this output depends on directly (ModelStructure `dependencies`).
+    /// `None`: not declared (all inputs, unless the model says `DIRECT_FEEDTHROUGH = false`).
+    pub dependencies: Option<&'static [&'static str]>,
 }
 
 impl<M> Variable<M> {
@@ -109,6 +112,7 @@ impl<M> Variable<M> {
                 min: None,
                 max: None,
             },
+            dependencies: None,
         }
     }
 
@@ -132,6 +136,7 @@ impl<M> Variable<M> {
                 min: None,
                 max: None,
             },
+            dependencies: None,
         }
     }
 
@@ -154,6 +159,30 @@ impl<M> Variable<M> {
                 min: None,
                 max: None,
             },
+            dependencies: None,
+        }
+    }
+
+    /// A Real calculated parameter (computed from the parameters at initialization).
+    pub const fn real_calculated_parameter(
+        name: &'static str,
+        unit: Option<&'static str>,
+        description: &'static str,
+        get: fn(&M) -> f64,
+    ) -> Self {
+        Variable {
+            name,
+            causality: Causality::CalculatedParameter,
+            variability: Variability::Fixed,
+            description,
+            access: Access::Real {
+                get,
+                set: None,
+                unit,
+                min: None,
+                max: None,
+            },
+            dependencies: None,
         }
     }
 
@@ -169,6 +198,7 @@ impl<M> Variable<M> {
             variability: Variability::Discrete,
             description,
             access: Access::Boolean { get, set: None },
+            dependencies: None,
         }
     }
 
@@ -193,6 +223,7 @@ impl<M> Variable<M> {
                 get,
                 set: Some(set),
             },
+            dependencies: None,
         }
     }
 
@@ -221,7 +252,14 @@ impl<M> Variable<M> {
                 min: Some(min),
                 max: Some(max),
             },
+            dependencies: None,
         }
+    }
+
+    /// Declares the inputs an output depends on directly (`&[]`: the state only).
+    pub const fn depends_on(mut self, inputs: &'static [&'static str]) -> Self {
+        self.dependencies = Some(inputs);
+        self
     }
 
     /// Adds an inclusive range to a Real variable (declared in the XML and enforced on set).
@@ -350,6 +388,19 @@ pub const UNITS: &[UnitDef] = &[
         display: &[],
     },
     UnitDef {
+        name: "kg/m3",
+        exponents: [1, -3, 0, 0, 0, 0, 0, 0],
+        factor: 1.0,
+        display: &[],
+    },
+    UnitDef {
+        // wind moment coefficient: moment per dynamic pressure-like term (003 eqs. 2.19-2.20)
+        name: "N.m.s2/m2",
+        exponents: [1, 0, 0, 0, 0, 0, 0, 0],
+        factor: 1.0,
+        display: &[],
+    },
+    UnitDef {
         name: "N",
         exponents: [1, 1, -2, 0, 0, 0, 0, 0],
         factor: 1.0,
@@ -431,6 +482,25 @@ pub fn check_table<M: Default>(vars: &[Variable<M>]) -> Result<(), Vec<String>> 
                 "variable {}: causality {:?} with variability {:?} is illegal",
                 v.name, v.causality, v.variability
             ));
+        }
+        if let Some(deps) = v.dependencies {
+            if v.causality != Causality::Output {
+                problems.push(format!(
+                    "variable {}: only outputs declare dependencies",
+                    v.name
+                ));
+            }
+            for d in deps {
+                if !vars
+                    .iter()
+                    .any(|w| w.name == *d && w.causality == Causality::Input)
+                {
+                    problems.push(format!(
+                        "variable {}: dependency {d:?} is not an input of this model",
+                        v.name
+                    ));
+                }
+            }
         }
         if v.variability == Variability::Continuous && v.base_type() != BaseType::Real {
             problems.push(format!(

@@ -183,7 +183,29 @@ fn description_template<M: FmuModel>() -> String {
     if !outputs.is_empty() {
         x.push_str("    <Outputs>\n");
         for i in &outputs {
-            let _ = writeln!(x, r#"      <Unknown index="{i}"/>"#);
+            let v = &vars[i - 1];
+            let deps = v.dependencies.or(if M::DIRECT_FEEDTHROUGH {
+                None
+            } else {
+                Some(&[])
+            });
+            match deps {
+                None => {
+                    let _ = writeln!(x, r#"      <Unknown index="{i}"/>"#);
+                }
+                Some(names) => {
+                    let idx: Vec<String> = names
+                        .iter()
+                        .filter_map(|n| vars.iter().position(|w| w.name == *n))
+                        .map(|k| (k + 1).to_string())
+                        .collect();
+                    let _ = writeln!(
+                        x,
+                        r#"      <Unknown index="{i}" dependencies="{}"/>"#,
+                        idx.join(" ")
+                    );
+                }
+            }
         }
         x.push_str("    </Outputs>\n");
     }

@@ -77,10 +77,11 @@ static INTEGRATOR_VARS: [IV; 10] = [
         |m, v| m.enabled = v,
     ),
     IV::real_input("u", Some("m/s"), "input", |m| m.u, |m, v| m.u = v),
-    IV::real_output("y", Some("m"), "integral", |m| m.y),
+    IV::real_output("y", Some("m"), "integral", |m| m.y).depends_on(&[]),
     IV::real_output("u_times_gain", Some("m/s"), "direct feedthrough", |m| {
         m.gain * m.u
-    }),
+    })
+    .depends_on(&["u"]),
     IV::boolean_output("positive", "y > 0", |m| m.y > 0.0),
 ];
 
@@ -406,10 +407,25 @@ fn variable_table_and_model_description_are_consistent() {
     assert_eq!(guid, xml::guid::<Integrator>());
     assert_ne!(guid, xml::guid::<Other>());
     assert!(guid.starts_with('{') && guid.ends_with('}') && guid.len() == 38);
-    // outputs at 1-based positions 8, 9, 10 are the Outputs and InitialUnknowns
-    for i in [8, 9, 10] {
-        assert_eq!(xml.matches(&format!("<Unknown index=\"{i}\"/>")).count(), 2);
+    // outputs at 1-based positions 8, 9, 10 are the Outputs (with the declared dependencies:
+    // y on the state only, u_times_gain on u = index 7, positive undeclared = all) and the
+    // InitialUnknowns
+    assert!(xml.contains(r#"<Unknown index="8" dependencies=""/>"#));
+    assert!(xml.contains(r#"<Unknown index="9" dependencies="7"/>"#));
+    assert_eq!(xml.matches(r#"<Unknown index="10"/>"#).count(), 2);
+    for i in [8, 9] {
+        assert_eq!(xml.matches(&format!("<Unknown index=\"{i}\"/>")).count(), 1);
     }
+    // a dependency on something that is not an input is a table error
+    let bad: [IV; 2] = [
+        IV::real_input("u", None, "u", |m| m.u, |m, v| m.u = v),
+        IV::real_output("y", None, "y", |m| m.y).depends_on(&["gain"]),
+    ];
+    let problems = fmi2_export::variables::check_table(&bad).unwrap_err();
+    assert!(
+        problems[0].contains("dependency \"gain\" is not an input"),
+        "{problems:?}"
+    );
     assert!(xml.contains(r#"name="gain" valueReference="0""#));
     assert!(xml.contains(r#"<Real unit="m/s" displayUnit="kn" start="1.0"/>"#));
     assert!(xml.contains(r#"<Integer min="1" max="3" start="1"/>"#));

@@ -2,9 +2,7 @@
 //! `models::hull::mariner` as an FMI 2.0 co-simulation FMU. No physics here: the variable table
 //! maps the model onto FMI variables.
 
-use fmi2_export::{
-    export_fmu, Access, Causality, DefaultExperiment, FmuModel, Variability, Variable,
-};
+use fmi2_export::{export_fmu, DefaultExperiment, FmuModel, Variable};
 use models::hull::mariner::{Mariner, MarinerInputs, MarinerOutputs, MarinerParams, U0_DEFAULT};
 use models::hull::DEG;
 use models::steering_gear::ParamError;
@@ -100,20 +98,13 @@ static VARIABLES: &[V] = &[
         |m| m.trimmed,
         |m, v| m.trimmed = v,
     ),
-    Variable {
-        name: "trim_rudder_command",
-        causality: Causality::CalculatedParameter,
-        variability: Variability::Fixed,
-        description: "The rudder_command that holds the trimmed straight course at nominal_speed \
-                      (about -1.108 deg at 15 kn; the Y'0, N'0 bias terms of section 3.3)",
-        access: Access::Real {
-            get: |m| m.trim,
-            set: None,
-            unit: Some("rad"),
-            min: None,
-            max: None,
-        },
-    },
+    V::real_calculated_parameter(
+        "trim_rudder_command",
+        Some("rad"),
+        "The rudder_command that holds the trimmed straight course at nominal_speed \
+         (about -1.108 deg at 15 kn; the Y'0, N'0 bias terms of section 3.3)",
+        |m| m.trim,
+    ),
     V::real_input(
         "rudder_command",
         Some("rad"),
@@ -200,6 +191,8 @@ static VARIABLES: &[V] = &[
 
 impl FmuModel for MarinerFmu {
     const MODEL_IDENTIFIER: &'static str = "Mariner";
+    /// Every output is a function of the state: no direct feedthrough from the inputs.
+    const DIRECT_FEEDTHROUGH: bool = false;
     const DESCRIPTION: &'static str = "Mariner-class cargo ship: nonlinear 3-DOF surge-sway-yaw \
         manoeuvring model with rudder servo (Chislett & Strom-Tejsen 1965; MSS mariner.m)";
     const DEFAULT_EXPERIMENT: DefaultExperiment = DefaultExperiment {

@@ -327,6 +327,8 @@ static VARIABLES: &[V] = &[
 
 impl FmuModel for NomotoShipFmu {
     const MODEL_IDENTIFIER: &'static str = "NomotoShip";
+    /// Every output is a function of the state: no direct feedthrough from the inputs.
+    const DIRECT_FEEDTHROUGH: bool = false;
     const DESCRIPTION: &'static str = "Linear manoeuvring models of the DDG-51 EKF thesis (2000): \
         the DDG-51 first-order Nomoto model and the linear sway-yaw model with Esso Osaka \
         coefficients, with position kinematics and current";

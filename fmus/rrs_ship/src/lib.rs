@@ -187,6 +187,8 @@ static VARIABLES: &[V] = &[
 
 impl FmuModel for RrsShipFmu {
     const MODEL_IDENTIFIER: &'static str = "RrsShip";
+    /// Every output is a function of the state: no direct feedthrough from the inputs.
+    const DIRECT_FEEDTHROUGH: bool = false;
     const DESCRIPTION: &'static str = "Van der Klugt (1987) rudder-roll-stabilisation ship: the \
         22-knot simulation model with wave-height-driven filters (Tables 2.1, 2.2) and the \
         speed-dependent fifth-order control model (Tables 2.3-2.5)";

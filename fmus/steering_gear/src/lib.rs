@@ -134,23 +134,27 @@ static VARIABLES: [V; 16] = [
         Some("rad/s"),
         "Actual rudder speed d(delta_w)/dt",
         |m| m.gear.rate(),
-    ),
+    )
+    .depends_on(&["rudder_command"]),
     V::real_output(
         "limited_command",
         Some("rad"),
         "Set point after the angle limiter, sat(delta_g, +-angle_max)",
         |m| m.gear.limited_command(),
-    ),
+    )
+    .depends_on(&["rudder_command"]),
     V::boolean_output(
         "command_saturated",
         "The set point exceeds angle_max (angle limiter active)",
         |m| SteeringGear::command_saturated(m.command, &m.gear.params),
-    ),
+    )
+    .depends_on(&["rudder_command"]),
     V::boolean_output(
         "rate_saturated",
         "The rate limiter is active",
         |m| m.gear.rate_saturated(),
-    ),
+    )
+    .depends_on(&["rudder_command"]),
     V::real_output(
         "rate_saturated_time",
         Some("s"),
@@ -161,6 +165,8 @@ static VARIABLES: [V; 16] = [
 
 impl FmuModel for SteeringGearFmu {
     const MODEL_IDENTIFIER: &'static str = "SteeringGear";
+    /// rudder_angle and rate_saturated_time are state; the others declare rudder_command.
+    const DIRECT_FEEDTHROUGH: bool = false;
     const DESCRIPTION: &'static str = "Steering machine with rudder-angle and rudder-rate limits \
         and first- or second-order servo (van der Klugt 1987 Fig. 2.8 and section 6.5.2; \
         DDG-51 6/(s+6) gear; Parsons-Cuong T_r gear)";

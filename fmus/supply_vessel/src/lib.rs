@@ -313,6 +313,8 @@ static VARIABLES: &[V] = &[
 
 impl FmuModel for SupplyVesselFmu {
     const MODEL_IDENTIFIER: &'static str = "SupplyVessel";
+    /// Every output is a function of the state: no direct feedthrough from the inputs.
+    const DIRECT_FEEDTHROUGH: bool = false;
     const DESCRIPTION: &'static str = "Supply vessel Northern Clipper: 3-DOF low-frequency DP \
         model M nu' + D nu = tau + J^T(psi) b with wave-frequency motion superposed on the \
         measurement (Fossen & Strand 1999)";

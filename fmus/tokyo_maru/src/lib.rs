@@ -257,6 +257,8 @@ static VARIABLES: &[V] = &[
 
 impl FmuModel for TokyoMaruFmu {
     const MODEL_IDENTIFIER: &'static str = "TokyoMaru";
+    /// Every output is a function of the state: no direct feedthrough from the inputs.
+    const DIRECT_FEEDTHROUGH: bool = false;
     const DESCRIPTION: &'static str = "Tokyo Maru linear path model in restricted water \
         (Parsons & Cuong 1980): yaw rate, drift, heading and lateral deviation with coefficients \
         versus depth ratio H/T, external N', Y' and lateral current";
