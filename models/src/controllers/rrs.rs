@@ -682,7 +682,11 @@ impl RrsAutopilot {
         }
         let (am, bm) = roll_model(&self.coefficients(i.speed));
         let q = SVector::<f64, 3>::from([self.q_phi, self.params.roll_q2, self.params.roll_q3]);
-        let n = (h / self.params.max_substep).ceil().max(1.0);
+        // a step that is a multiple of max_substep up to rounding (0.1 vs 0.10000000000000002)
+        // must not get an extra sub-step
+        let n = (h / self.params.max_substep * (1.0 - 1e-12))
+            .ceil()
+            .max(1.0);
         let dt = h / n;
         for _ in 0..n as usize {
             self.roll_process.step(&am, &bm, &q, self.params.r, dt);

@@ -19,6 +19,7 @@ pub mod mariner;
 pub mod nomoto_ship;
 pub mod passive_observer;
 pub mod path_controller;
+pub mod rrs_autopilot;
 pub mod path_kalman_filter;
 pub mod rrs_filter;
 pub mod rrs_ship;
@@ -42,6 +43,12 @@ pub const CASES: &[Case] = &[
         "PathController, adaptation 2 (estimates), dither windows of 1 L every 3 L from t' = 1; \
          sinusoidal state-estimate inputs, f23/f25 estimates at deep-water values; h = 0.5 s, 300 s",
         path_controller::adaptive,
+    ),
+    (
+        "rrs_autopilot_adaptive",
+        "RrsAutopilot with criterion adaptation (q_phi(0) = 40, rate_max 0.12 rad/s); roll at 0.63 rad/s growing from 2 to 12 deg, \
+         speed 11 -> 8 m/s, slow heading error; h = 0.1 s, 300 s",
+        rrs_autopilot::adaptive,
     ),
     (
         "steering_gear_sine",
