@@ -105,11 +105,15 @@ fn kleinman_step(a: &M, b: &M, q: &M, r: &M, rinv: &M, p: &M) -> Result<M, Ricca
     lyapunov(&ac.transpose(), &(q + k.transpose() * r * &k))
 }
 
-/// Hamiltonian matrix sign function with determinant scaling.
+/// Hamiltonian matrix sign function with determinant scaling. Stops at convergence, or when the
+/// change stagnates at rounding level (eigenvalues close to the imaginary axis, e.g. a weakly
+/// damped uncontrollable mode, converge only to a few digits); the Newton–Kleinman polish in
+/// [`care`] then restores full accuracy.
 fn sign_function(h: &M) -> Result<M, RiccatiError> {
     let n2 = h.nrows() as f64;
     let mut z = h.clone();
-    for _ in 0..100 {
+    let mut last_change = f64::INFINITY;
+    for _ in 0..200 {
         let zinv = z.clone().try_inverse().ok_or(RiccatiError::NoConvergence(
             "Hamiltonian has eigenvalues on the imaginary axis",
         ))?;
@@ -122,9 +126,10 @@ fn sign_function(h: &M) -> Result<M, RiccatiError> {
         let next = (&z * c + zinv / c) * 0.5;
         let change = (&next - &z).norm() / next.norm().max(1e-300);
         z = next;
-        if change < 1e-13 {
+        if change < 1e-13 || (change < 1e-6 && change >= last_change) {
             return Ok(z);
         }
+        last_change = change;
     }
     Err(RiccatiError::NoConvergence("sign-function iteration"))
 }
@@ -159,7 +164,7 @@ pub fn care(a: &M, b: &M, q: &M, r: &M) -> Result<M, RiccatiError> {
         .map_err(|_| RiccatiError::NoConvergence("sign-function solve"))?;
     let mut p = symmetrize(&p);
     // Newton–Kleinman polish: quadratic convergence from the sign-function estimate.
-    for _ in 0..4 {
+    for _ in 0..8 {
         let next = kleinman_step(a, b, q, r, &rinv, &p)?;
         let change = (&next - &p).norm() / next.norm().max(1e-300);
         p = next;
@@ -546,6 +551,19 @@ mod tests {
             );
             // the spec's printed values, to their last digit
             assert!((k[(0, 0)] - k1_ref).abs() < 6e-6 && (k[(1, 0)] - k2_ref).abs() < 6e-7);
+        }
+    }
+
+    /// A stable but uncontrollable mode at −ε puts Hamiltonian eigenvalues at ±ε (as the random
+    /// walk disturbance states of the 004 design do). Closed form: P = diag(1/(2ε), 1).
+    #[test]
+    fn care_with_hamiltonian_eigenvalues_near_the_axis() {
+        for eps in [1e-2, 1e-4, 1e-6] {
+            let a = dmatrix![-eps, 0.0; 0.0, 0.0];
+            let b = dmatrix![0.0; 1.0];
+            let p = care(&a, &b, &M::identity(2, 2), &dmatrix![1.0]).unwrap();
+            let expected = dmatrix![0.5 / eps, 0.0; 0.0, 1.0];
+            assert!(rel(&p, &expected) < 1e-9, "eps = {eps}: {p}");
         }
     }
 

@@ -209,27 +209,7 @@ impl PathDesignModel {
         a[(3, 3)] = self.a44;
         a[(4, 4)] = self.a55;
         let b = DMatrix::from_element(1, 1, self.b11);
-        let k = match riccati::lqr(&f, &g, &a, &b) {
-            Ok(k) => k,
-            Err(e) => {
-                // The random-walk design with ε ≤ 1e-4 puts Hamiltonian eigenvalues at ±ε, where
-                // the sign-function iteration of `riccati::care` stagnates above its tolerance.
-                // Continuation: a stabilising gain from the same design at ε = 1e-2, then
-                // Newton-Kleinman (quadratically convergent, exact to rounding) at the real ε.
-                let DisturbanceModel::RandomWalk { epsilon } = self.disturbance else {
-                    return Err(e);
-                };
-                if epsilon >= 1e-2 {
-                    return Err(e);
-                }
-                let mut easy = *self;
-                easy.disturbance = DisturbanceModel::RandomWalk { epsilon: 1e-2 };
-                let f0 = Self::dm(&easy.f(true));
-                let k0 = riccati::lqr(&f0, &g, &a, &b)?;
-                let s = riccati::care_newton_kleinman(&f, &g, &a, &b, &k0)?;
-                (&g.transpose() * s) / self.b11
-            }
-        };
+        let k = riccati::lqr(&f, &g, &a, &b)?;
         let mut out = SMatrix::<f64, 1, NX>::zeros();
         for j in 0..NX {
             out[j] = -k[(0, j)];
