@@ -95,12 +95,7 @@ fn test(extra: &[String]) -> Result<()> {
     let root = workspace_root();
     let started = std::time::Instant::now();
     let fmu_dir = fmu::build_fmus(&root)?;
-    eprintln!("xtask: Rust tests (release, sharing the FMU build)");
-    run(cargo()
-        .current_dir(&root)
-        .args(["test", "--release", "--workspace", "--exclude", "xtask"])
-        .args(extra)
-        .env("SHIPSIM_FMU_DIR", &fmu_dir))?;
+    // The binaries first: system tests run the release master and the reference generator.
     run(cargo().current_dir(&root).args([
         "build",
         "--release",
@@ -109,6 +104,12 @@ fn test(extra: &[String]) -> Result<()> {
         "xtask",
         "--bins",
     ]))?;
+    eprintln!("xtask: Rust tests (release, sharing the FMU build)");
+    run(cargo()
+        .current_dir(&root)
+        .args(["test", "--release", "--workspace", "--exclude", "xtask"])
+        .args(extra)
+        .env("SHIPSIM_FMU_DIR", &fmu_dir))?;
     let python = ensure_venv(&root)?;
     eprintln!("xtask: Python checks (FMPy, libcosim) in tests/python");
     let bin = root.join("target/release");
