@@ -19,6 +19,7 @@ fn main() {
         Some("test") => test(&args[1..]),
         Some("demo") => demo(),
         Some("bench") => bench(&args[1..]),
+        Some("report") => report(),
         _ => {
             eprintln!(
                 "usage: cargo xtask <task>\n\n\
@@ -26,6 +27,7 @@ fn main() {
                  build-fmus   build every FMU into target/fmu/<ModelIdentifier>.fmu\n  \
                  test         run every test: Rust, FMU packaging, FMPy and libcosim checks\n  \
                  demo         run the default coupled system\n  \
+                 report       run every coupled system and write the validation report (target/report)\n  \
                  bench        master overhead per FMU-step: shipsim vs libcosim vs FMPy (master/bench)"
             );
             std::process::exit(2);
@@ -124,6 +126,24 @@ fn test(extra: &[String]) -> Result<()> {
         started.elapsed().as_secs_f64()
     );
     Ok(())
+}
+
+/// Runs every study of tests/src/studies and writes target/report/README.md with figures.
+fn report() -> Result<()> {
+    let root = workspace_root();
+    let fmu_dir = fmu::build_fmus(&root)?;
+    run(cargo().current_dir(&root).args([
+        "build",
+        "--release",
+        "-p",
+        "system-tests",
+        "--bin",
+        "report",
+    ]))?;
+    run(Command::new(root.join("target/release/report"))
+        .current_dir(&root)
+        .arg(root.join("target/report"))
+        .env("SHIPSIM_FMU_DIR", fmu_dir))
 }
 
 /// Runs master/bench/bench_master.py in the project venv (extra arguments are passed on).

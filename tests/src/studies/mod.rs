@@ -1,0 +1,24 @@
+//! The registered coupled-system studies (see [`crate::study`]). Each module runs system files
+//! from `systems/` and returns a [`Report`](crate::study::Report).
+//!
+//! To add a study: a module with `pub fn run(env: &Env) -> Result<Report, String>`, one entry
+//! in [`STUDIES`], and one `#[test]` line in `tests/tests/studies.rs`.
+
+use crate::study::{Env, Report};
+
+pub mod steering_gear;
+
+/// A study: id (also its output folder under `target/studies/`), function.
+pub type Study = (&'static str, fn(&Env) -> Result<Report, String>);
+
+pub const STUDIES: &[Study] = &[("steering_gear", steering_gear::run)];
+
+/// Runs the study `id` in `target/studies/<id>/`.
+pub fn run(id: &str) -> Result<Report, String> {
+    let (_, f) = STUDIES
+        .iter()
+        .find(|s| s.0 == id)
+        .ok_or_else(|| format!("no study {id:?}"))?;
+    let env = Env::new(&format!("studies/{id}"))?;
+    f(&env)
+}

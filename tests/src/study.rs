@@ -1,0 +1,295 @@
+//! Coupled-system studies: each runs one or more system files from `systems/` through the
+//! shipsim master (in process, the same code as `shipsim run`), computes the quantities a source
+//! publishes, and compares them with the published (or [DERIVED]) values.
+//!
+//! The same study functions serve the system tests (`tests/tests/studies.rs` asserts that every
+//! check passes) and the validation report (`cargo xtask report`, which writes every study's
+//! table and figures to Markdown).
+//!
+//! A study is `fn(&Env) -> Result<Report, String>`; register it in [`crate::studies::STUDIES`].
+
+use shipsim::master::{run_system, Output, RunOptions};
+use shipsim::plot::{plot_panels, Panel, Series, Table};
+use shipsim::system::System;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+/// Where the FMUs, system files and outputs are.
+#[derive(Clone, Debug)]
+pub struct Env {
+    /// Workspace root.
+    pub root: PathBuf,
+    /// Built FMUs (`SHIPSIM_FMU_DIR`, default `target/fmu`).
+    pub fmu_dir: PathBuf,
+    /// Where runs write CSVs and figures (`target/studies/<study id>/` by default).
+    pub out_dir: PathBuf,
+}
+
+impl Env {
+    /// The default environment; `out` names the output folder below `target/`.
+    pub fn new(out: &str) -> Result<Env, String> {
+        let root = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .parent()
+            .ok_or("no workspace root")?
+            .to_path_buf();
+        let fmu_dir = std::env::var_os("SHIPSIM_FMU_DIR")
+            .map(PathBuf::from)
+            .unwrap_or_else(|| root.join("target/fmu"));
+        if !fmu_dir.is_dir() {
+            return Err(format!(
+                "{} is missing: run `cargo xtask build-fmus` first (or set SHIPSIM_FMU_DIR)",
+                fmu_dir.display()
+            ));
+        }
+        let out_dir = root.join("target").join(out);
+        Ok(Env {
+            root,
+            fmu_dir,
+            out_dir,
+        })
+    }
+
+    /// Runs `systems/<file>` with `--set`-style overrides (`instance.variable=value`), writing
+    /// `<out_dir>/<csv>`; returns the recorded table. FMU paths of the system file are resolved
+    /// by file name in [`Env::fmu_dir`].
+    pub fn run(&self, file: &str, sets: &[String], csv: &str) -> Result<Table, String> {
+        let path = self.root.join("systems").join(file);
+        let mut system = System::load(&path).map_err(|e| e.to_string())?;
+        for inst in &mut system.instances {
+            let name = inst
+                .fmu
+                .file_name()
+                .ok_or_else(|| format!("{}: instance {} has no FMU file", file, inst.name))?;
+            let candidate = self.fmu_dir.join(name);
+            if !candidate.exists() {
+                return Err(format!(
+                    "{}: instance {}: {} is missing: run `cargo xtask build-fmus`",
+                    file,
+                    inst.name,
+                    candidate.display()
+                ));
+            }
+            inst.fmu = candidate;
+        }
+        system.apply_overrides(sets).map_err(|e| e.to_string())?;
+        std::fs::create_dir_all(&self.out_dir).map_err(|e| e.to_string())?;
+        let out = self.out_dir.join(csv);
+        run_system(&system, Output::File(out.clone()), &RunOptions::default())
+            .map_err(|e| format!("{file}: {e}"))?;
+        Table::read(&out).map_err(|e| e.to_string())
+    }
+
+    /// Draws a figure into the output folder; returns its path.
+    pub fn figure(&self, name: &str, title: &str, panels: &[Panel]) -> Result<PathBuf, String> {
+        let p = self.out_dir.join(name);
+        plot_panels(&p, title, panels).map_err(|e| e.to_string())?;
+        Ok(p)
+    }
+}
+
+/// A curve from a table column, scaled (e.g. by 180/π for degrees).
+pub fn series(table: &Table, column: &str, label: &str, scale: f64) -> Result<Series, String> {
+    Ok(Series {
+        label: label.to_string(),
+        t: table.time().to_vec(),
+        y: table
+            .column(column)
+            .map_err(|e| e.to_string())?
+            .iter()
+            .map(|v| v * scale)
+            .collect(),
+    })
+}
+
+/// One compared quantity.
+#[derive(Clone, Debug)]
+pub struct Check {
+    pub quantity: String,
+    /// The published value as the source prints it (with [DERIVED] where the spec derived it).
+    pub published: String,
+    pub ours: String,
+    /// The acceptance rule, in words.
+    pub tolerance: String,
+    pub pass: bool,
+}
+
+impl Check {
+    /// |ours − published| ≤ tol.
+    pub fn abs(quantity: &str, published: f64, ours: f64, tol: f64, unit: &str) -> Check {
+        Check {
+            quantity: quantity.to_string(),
+            published: format!("{} {unit}", fmt_num(published)).trim().to_string(),
+            ours: format!("{} {unit}", fmt_num(ours)).trim().to_string(),
+            tolerance: format!("±{} {unit}", fmt_num(tol)).trim().to_string(),
+            pass: (ours - published).abs() <= tol,
+        }
+    }
+
+    /// |ours − published| ≤ rel·|published|.
+    pub fn rel(quantity: &str, published: f64, ours: f64, rel: f64, unit: &str) -> Check {
+        Check {
+            quantity: quantity.to_string(),
+            published: format!("{} {unit}", fmt_num(published)).trim().to_string(),
+            ours: format!("{} {unit}", fmt_num(ours)).trim().to_string(),
+            tolerance: format!("±{}%", rel * 100.0),
+            pass: (ours - published).abs() <= rel * published.abs(),
+        }
+    }
+
+    /// lo ≤ ours ≤ hi (for published ranges such as "60-78 %").
+    pub fn range(
+        quantity: &str,
+        published: &str,
+        ours: f64,
+        lo: f64,
+        hi: f64,
+        unit: &str,
+    ) -> Check {
+        Check {
+            quantity: quantity.to_string(),
+            published: published.to_string(),
+            ours: format!("{} {unit}", fmt_num(ours)).trim().to_string(),
+            tolerance: format!("[{lo}, {hi}] {unit}").trim().to_string(),
+            pass: (lo..=hi).contains(&ours),
+        }
+    }
+
+    /// A qualitative statement from the source and whether our run shows it.
+    pub fn holds(quantity: &str, published: &str, ours: String, pass: bool) -> Check {
+        Check {
+            quantity: quantity.to_string(),
+            published: published.to_string(),
+            ours,
+            tolerance: "holds".to_string(),
+            pass,
+        }
+    }
+}
+
+/// Four significant digits, plain notation where readable.
+pub fn fmt_num(v: f64) -> String {
+    if v == 0.0 || (1e-3..1e6).contains(&v.abs()) {
+        let digits = (3 - v.abs().log10().floor() as i32).clamp(0, 8) as usize;
+        format!("{v:.digits$}")
+    } else {
+        format!("{v:.4e}")
+    }
+}
+
+/// The result of one study.
+#[derive(Clone, Debug, Default)]
+pub struct Report {
+    pub id: String,
+    pub title: String,
+    /// Source document and section.
+    pub source: String,
+    /// System files run.
+    pub systems: Vec<String>,
+    pub checks: Vec<Check>,
+    /// (caption, path) of the figures.
+    pub figures: Vec<(String, PathBuf)>,
+    /// Readings taken, deviations explained.
+    pub notes: Vec<String>,
+}
+
+impl Report {
+    pub fn passed(&self) -> bool {
+        self.checks.iter().all(|c| c.pass)
+    }
+
+    /// The table and figures as Markdown; figure links relative to `rel_to`.
+    pub fn to_markdown(&self, rel_to: &Path) -> String {
+        let mut m = String::new();
+        let _ = writeln!(m, "## {}\n", self.title);
+        let _ = writeln!(m, "Source: {}. Systems: {}.\n", self.source, {
+            let v: Vec<String> = self
+                .systems
+                .iter()
+                .map(|s| format!("`systems/{s}`"))
+                .collect();
+            v.join(", ")
+        });
+        m.push_str(
+            "| quantity | published | ours | tolerance | |\n| --- | --- | --- | --- | --- |\n",
+        );
+        for c in &self.checks {
+            let _ = writeln!(
+                m,
+                "| {} | {} | {} | {} | {} |",
+                c.quantity,
+                c.published,
+                c.ours,
+                c.tolerance,
+                if c.pass { "pass" } else { "**FAIL**" }
+            );
+        }
+        m.push('\n');
+        for n in &self.notes {
+            let _ = writeln!(m, "- {n}");
+        }
+        if !self.notes.is_empty() {
+            m.push('\n');
+        }
+        for (caption, path) in &self.figures {
+            let rel = path.strip_prefix(rel_to).unwrap_or(path);
+            let _ = writeln!(m, "![{caption}]({})\n", rel.display());
+        }
+        m
+    }
+
+    /// Panics with the whole table when any check fails (for the system tests).
+    pub fn assert_passed(&self) {
+        let table: Vec<String> = self
+            .checks
+            .iter()
+            .map(|c| {
+                format!(
+                    "{} {}: published {}, ours {}, tolerance {}",
+                    if c.pass { "ok  " } else { "FAIL" },
+                    c.quantity,
+                    c.published,
+                    c.ours,
+                    c.tolerance
+                )
+            })
+            .collect();
+        println!("{}\n{}", self.title, table.join("\n"));
+        assert!(
+            self.passed(),
+            "{}: checks failed:\n{}",
+            self.title,
+            table.join("\n")
+        );
+    }
+}
+
+/// Variance of a slice (population, about its mean).
+pub fn variance(v: &[f64]) -> f64 {
+    if v.is_empty() {
+        return f64::NAN;
+    }
+    let mean = v.iter().sum::<f64>() / v.len() as f64;
+    v.iter().map(|x| (x - mean) * (x - mean)).sum::<f64>() / v.len() as f64
+}
+
+/// The part of a column from time `t0` on.
+pub fn after<'a>(table: &'a Table, column: &str, t0: f64) -> Result<&'a [f64], String> {
+    let t = table.time();
+    let start = t.iter().position(|&x| x >= t0).unwrap_or(t.len());
+    Ok(&table.column(column).map_err(|e| e.to_string())?[start..])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn checks_decide_and_format() {
+        assert!(Check::abs("x", 1.0, 1.05, 0.1, "m").pass);
+        assert!(!Check::rel("x", 10.0, 10.3, 0.02, "").pass);
+        assert!(Check::range("r", "60-78 %", 70.0, 60.0, 78.0, "%").pass);
+        assert_eq!(fmt_num(34.8123), "34.81");
+        assert_eq!(fmt_num(0.012345), "0.01235");
+        assert!((variance(&[1.0, 3.0]) - 1.0).abs() < 1e-15);
+    }
+}

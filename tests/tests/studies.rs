@@ -1,0 +1,14 @@
+//! Every coupled-system study passes all its checks against the sources (see
+//! `system_tests::studies`). Needs the FMUs (`cargo xtask build-fmus`).
+
+fn check(id: &str) {
+    match system_tests::studies::run(id) {
+        Ok(report) => report.assert_passed(),
+        Err(e) => panic!("study {id}: {e}"),
+    }
+}
+
+#[test]
+fn steering_gear() {
+    check("steering_gear");
+}
