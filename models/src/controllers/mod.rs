@@ -13,6 +13,8 @@
 
 use std::fmt;
 
+pub mod dp;
+pub mod loop_shaped;
 pub mod lq;
 pub mod path;
 pub mod rrs;

@@ -540,6 +540,9 @@ pub struct RrsAutopilot {
     q_phi: f64,
     roll_variance: f64,
     last_dt: f64,
+    /// The set point sent at the previous sample (None before the first), for eq. 5.3 on the
+    /// total set point.
+    prev_command: Option<f64>,
 }
 
 impl RrsAutopilot {
@@ -557,6 +560,7 @@ impl RrsAutopilot {
                 .min(params.adaptation.q_max),
             roll_variance: 0.0,
             last_dt: 0.0,
+            prev_command: None,
             params,
         })
     }
@@ -632,10 +636,19 @@ impl RrsAutopilot {
             agc.attenuation = 1.0;
             agc.setpoint = agc_in;
         }
-        let command = match p.agc_target {
+        let mut command = match p.agc_target {
             AgcTarget::Total => agc.setpoint,
             AgcTarget::RollOnly => course + agc.setpoint,
         };
+        // Eq. 5.3 holds for the rudder set point δ_g itself: with the attenuation on the roll
+        // rudder only, the (slow) course rudder could still push the sum past δ̇_max, so the
+        // total set point is rate-clamped as well.
+        if let (true, Some(prev)) = (p.agc_enabled, self.prev_command) {
+            if self.last_dt > 0.0 {
+                let step = p.rate_max * self.last_dt;
+                command = command.clamp(prev - step, prev + step);
+            }
+        }
         (
             RrsOutputs {
                 rudder_command: command.clamp(-p.angle_max, p.angle_max),
@@ -661,6 +674,7 @@ impl RrsAutopilot {
         }
         let (out, agc_in, agc) = self.evaluate(i);
         self.agc.commit(agc_in, &agc);
+        self.prev_command = Some(out.rudder_command);
         self.last_dt = h;
         let a = self.params.adaptation;
         // roll variance: first-order low-pass of φ² (Fig. 6.10), exact for the held input
