@@ -284,6 +284,7 @@ pub fn parse(path: &Path, text: &str) -> Result<System> {
                     offset: 0.0,
                     line,
                     either_direction: true,
+                    convert: false,
                 });
             }
             Connection::SignalConnection { variable, signal } => {
@@ -342,6 +343,8 @@ pub fn parse(path: &Path, text: &str) -> Result<System> {
                         offset,
                         line: line_of_needle(text, &format!("function=\"{f}\"")),
                         either_direction: false,
+                        // a LinearTransformation may map one quantity onto another
+                        convert: gain != 1.0 || offset != 0.0,
                     });
                 }
             }

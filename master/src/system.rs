@@ -20,6 +20,7 @@
 //! to = "gear.rudder_command"
 //! gain = 1.0                # to = gain*from + offset (unit conversion)
 //! offset = 0.0
+//! convert = false           # true: the gain maps one quantity onto another (no unit check)
 //!
 //! [[events]]
 //! time = 10.0
@@ -135,6 +136,9 @@ pub struct ConnectionSpec {
     pub line: Option<usize>,
     /// OSP VariableConnection: the direction follows the variables' causalities.
     pub either_direction: bool,
+    /// The gain converts between physically different quantities (e.g. a wave moment in N.m
+    /// into a rudder-equivalent disturbance in rad): the unit check is skipped for it.
+    pub convert: bool,
 }
 
 #[derive(Debug, Clone)]
@@ -222,6 +226,9 @@ struct RawConnectionFull {
     gain: Option<f64>,
     #[serde(default)]
     offset: Option<f64>,
+    /// `convert = true`: the gain converts between different physical quantities; no unit check.
+    #[serde(default)]
+    convert: bool,
 }
 
 #[derive(Deserialize)]
@@ -349,9 +356,15 @@ impl System {
         let mut connections = Vec::new();
         for c in raw.connections {
             let line = Some(line_of(text, c.span().start));
-            let (from, to, gain, offset) = match c.into_inner() {
+            let (from, to, gain, offset, convert) = match c.into_inner() {
                 RawConnection::Short(s) => match s.split_once("->") {
-                    Some((a, b)) => (a.trim().to_string(), b.trim().to_string(), None, None),
+                    Some((a, b)) => (
+                        a.trim().to_string(),
+                        b.trim().to_string(),
+                        None,
+                        None,
+                        false,
+                    ),
                     None => {
                         errors.push(Error::system(
                             path,
@@ -361,7 +374,7 @@ impl System {
                         continue;
                     }
                 },
-                RawConnection::Full(f) => (f.from, f.to, f.gain, f.offset),
+                RawConnection::Full(f) => (f.from, f.to, f.gain, f.offset, f.convert),
             };
             let (Some(f), Some(t)) = (VarRef::parse(&from), VarRef::parse(&to)) else {
                 errors.push(Error::system(
@@ -378,6 +391,7 @@ impl System {
                 offset: offset.unwrap_or(0.0),
                 line,
                 either_direction: false,
+                convert,
             });
         }
         let mut events = Vec::new();
@@ -863,7 +877,7 @@ impl System {
                 ));
             }
             // Units (FMI 2.0 section 2.2.2: BaseUnit exponents must agree).
-            if ft == VarType::Real && tt == VarType::Real {
+            if ft == VarType::Real && tt == VarType::Real && !c.convert {
                 if let (Some(fu), Some(tu)) = (mds[fi].real_unit(fsv), mds[ti].real_unit(tsv)) {
                     if fu != tu {
                         match (unit_si(mds[fi], fu), unit_si(mds[ti], tu)) {

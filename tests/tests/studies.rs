@@ -12,3 +12,8 @@ fn check(id: &str) {
 fn steering_gear() {
     check("steering_gear");
 }
+
+#[test]
+fn rrs() {
+    check("rrs");
+}

@@ -6,12 +6,16 @@
 
 use crate::study::{Env, Report};
 
+pub mod rrs;
 pub mod steering_gear;
 
 /// A study: id (also its output folder under `target/studies/`), function.
 pub type Study = (&'static str, fn(&Env) -> Result<Report, String>);
 
-pub const STUDIES: &[Study] = &[("steering_gear", steering_gear::run)];
+pub const STUDIES: &[Study] = &[
+    ("steering_gear", steering_gear::run),
+    ("rrs", rrs::run),
+];
 
 /// Runs the study `id` in `target/studies/<id>/`.
 pub fn run(id: &str) -> Result<Report, String> {
