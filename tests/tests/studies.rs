@@ -17,3 +17,8 @@ fn steering_gear() {
 fn rrs() {
     check("rrs");
 }
+
+#[test]
+fn path_control() {
+    check("path_control");
+}
