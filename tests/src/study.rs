@@ -101,6 +101,30 @@ pub fn series(table: &Table, column: &str, label: &str, scale: f64) -> Result<Se
     })
 }
 
+/// A curve restricted to t0 ≤ t ≤ t1 (readable windows of long runs).
+pub fn series_window(
+    table: &Table,
+    column: &str,
+    label: &str,
+    scale: f64,
+    t0: f64,
+    t1: f64,
+) -> Result<Series, String> {
+    let full = series(table, column, label, scale)?;
+    let (t, y): (Vec<f64>, Vec<f64>) = full
+        .t
+        .iter()
+        .zip(&full.y)
+        .filter(|(t, _)| (t0..=t1).contains(*t))
+        .map(|(t, y)| (*t, *y))
+        .unzip();
+    Ok(Series {
+        label: full.label,
+        t,
+        y,
+    })
+}
+
 /// One compared quantity.
 #[derive(Clone, Debug)]
 pub struct Check {

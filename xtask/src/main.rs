@@ -160,82 +160,20 @@ fn bench(extra: &[String]) -> Result<()> {
         .env("SHIPSIM_BIN", root.join("target/release/shipsim")))
 }
 
-/// The built-in default system: currently the steering-gear classification manoeuvre
-/// (systems/steering_gear_classification.toml) run by the shipsim master; it becomes the rudder
-/// roll stabilization system when the hull, disturbance, observer and controller FMUs land.
+/// The built-in default system: rudder roll stabilization (systems/rrs.toml) with RRS off and
+/// on, through the shipsim master; a table on stdout, CSVs and a plot in target/demo/.
 fn demo() -> Result<()> {
     let root = workspace_root();
-    fmu::build_fmus(&root)?;
-    run(cargo()
+    let fmu_dir = fmu::build_fmus(&root)?;
+    run(cargo().current_dir(&root).args([
+        "build",
+        "--release",
+        "-p",
+        "system-tests",
+        "--bin",
+        "demo",
+    ]))?;
+    run(Command::new(root.join("target/release/demo"))
         .current_dir(&root)
-        .args(["build", "--release", "-p", "shipsim", "--bins"]))?;
-    let out_dir = root.join("target/demo");
-    std::fs::create_dir_all(&out_dir)?;
-    let system = root.join("systems/steering_gear_classification.toml");
-    run(Command::new(root.join("target/release/shipsim"))
-        .current_dir(&root)
-        .arg("run")
-        .arg(&system))?;
-    let csv = out_dir.join("steering_gear_classification.csv");
-    let text =
-        std::fs::read_to_string(&csv).with_context(|| format!("reading {}", csv.display()))?;
-    let mut lines = text.lines();
-    let header: Vec<&str> = lines.next().unwrap_or_default().split(',').collect();
-    let rows: Vec<Vec<f64>> = lines
-        .map(|l| {
-            l.split(',')
-                .map(|v| v.parse().unwrap_or(f64::NAN))
-                .collect()
-        })
-        .collect();
-    let col = |name: &str| header.iter().position(|h| *h == name);
-    let target = 35f64.to_radians();
-    println!();
-    println!(
-        "Hard over 35 deg port -> 35 deg starboard at t = 5 s (van der Klugt 1987, section 2.3)"
-    );
-    println!(
-        "{:<6} {:>16} {:>20} {:>20}",
-        "gear", "max rate [deg/s]", "to within 0.1 deg [s]", "rate-limited [s]"
-    );
-    for gear in ["slow", "rrs"] {
-        let (Some(a), Some(r), Some(s)) = (
-            col(&format!("{gear}.rudder_angle")),
-            col(&format!("{gear}.rudder_rate")),
-            col(&format!("{gear}.rate_saturated_time")),
-        ) else {
-            bail!("{} lacks the {gear} columns", csv.display());
-        };
-        let max_rate = rows.iter().map(|row| row[r].abs()).fold(0.0, f64::max);
-        let arrival = rows
-            .iter()
-            .find(|row| (row[a] - target).abs() < 0.1f64.to_radians())
-            .map(|row| row[0] - 5.0);
-        let sat = rows.last().map(|row| row[s]).unwrap_or(f64::NAN);
-        println!(
-            "{gear:<6} {:>16.2} {:>20} {:>20.2}",
-            max_rate.to_degrees(),
-            arrival.map_or("not reached".to_string(), |t| format!("{t:.2}")),
-            sat
-        );
-    }
-    println!("(classification rule: 70 deg within 30 s, i.e. 2.5 deg/s suffices)");
-    let png = out_dir.join("steering_gear_classification.png");
-    run(Command::new(root.join("target/release/shipsim"))
-        .arg("plot")
-        .arg(&csv)
-        .args([
-            "--panel",
-            "rudder angle [deg]=slow.rudder_angle,rrs.rudder_angle",
-            "--panel",
-            "rudder rate [deg/s]=slow.rudder_rate,rrs.rudder_rate",
-            "--scale",
-            "57.29577951308232",
-            "--title",
-            "Hard over 35 deg port to 35 deg starboard: 2.5 deg/s vs 15 deg/s gear",
-            "-o",
-        ])
-        .arg(&png))?;
-    println!("results: {} and {}", csv.display(), png.display());
-    Ok(())
+        .env("SHIPSIM_FMU_DIR", fmu_dir))
 }

@@ -7,7 +7,7 @@
 //! spec prescribe, the open-loop roll is tuned to the reported variances (16 and 47 deg²) by the
 //! wave roll gain, and the closed-loop reduction is the result compared.
 
-use crate::study::{after, series, variance, Check, Env, Report};
+use crate::study::{after, series_window, variance, Check, Env, Report};
 use shipsim::plot::{Panel, Table};
 
 const DEG: f64 = std::f64::consts::PI / 180.0;
@@ -90,27 +90,27 @@ pub fn demo(env: &Env) -> Result<(RunStats, RunStats, std::path::PathBuf), Strin
 fn overlay(env: &Env, off: &Table, on: &Table, name: &str) -> Result<std::path::PathBuf, String> {
     env.figure(
         name,
-        "RRS ship in beam seas, 15 deg/s gear, U = 11 m/s: RRS off (course keeping) vs on",
+        "RRS ship in beam seas, 15 deg/s gear, U = 11 m/s: RRS off (course keeping) vs on (400-600 s)",
         &[
             Panel {
                 y_label: "roll [deg]".into(),
                 series: vec![
-                    series(off, "ship.roll", "RRS off", 1.0 / DEG)?,
-                    series(on, "ship.roll", "RRS on", 1.0 / DEG)?,
+                    series_window(off, "ship.roll", "RRS off", 1.0 / DEG, 400.0, 600.0)?,
+                    series_window(on, "ship.roll", "RRS on", 1.0 / DEG, 400.0, 600.0)?,
                 ],
             },
             Panel {
                 y_label: "heading [deg]".into(),
                 series: vec![
-                    series(off, "ship.heading", "RRS off", 1.0 / DEG)?,
-                    series(on, "ship.heading", "RRS on", 1.0 / DEG)?,
+                    series_window(off, "ship.heading", "RRS off", 1.0 / DEG, 400.0, 600.0)?,
+                    series_window(on, "ship.heading", "RRS on", 1.0 / DEG, 400.0, 600.0)?,
                 ],
             },
             Panel {
                 y_label: "rudder [deg]".into(),
                 series: vec![
-                    series(off, "gear.rudder_angle", "RRS off", 1.0 / DEG)?,
-                    series(on, "gear.rudder_angle", "RRS on", 1.0 / DEG)?,
+                    series_window(off, "gear.rudder_angle", "RRS off", 1.0 / DEG, 400.0, 600.0)?,
+                    series_window(on, "gear.rudder_angle", "RRS on", 1.0 / DEG, 400.0, 600.0)?,
                 ],
             },
         ],
