@@ -22,3 +22,8 @@ fn rrs() {
 fn path_control() {
     check("path_control");
 }
+
+#[test]
+fn dp_observer() {
+    check("dp_observer");
+}

@@ -14,9 +14,11 @@ use std::io::Write;
 
 pub mod container_ship;
 pub mod current;
+pub mod dgps_kalman;
 pub mod manoeuvre;
 pub mod mariner;
 pub mod nomoto_ship;
+pub mod parameter_ekf;
 pub mod passive_observer;
 pub mod path_controller;
 pub mod rrs_autopilot;
@@ -180,5 +182,26 @@ pub const CASES: &[Case] = &[
         "passive_observer",
         "PassiveObserver with default parameters (Northern Clipper, eq. 59 gains, mass-normalised injection); north = 0.02 t + 3 sin(0.9 t), east = 5 sin(0.01 t) - 2 cos(0.85 t), heading = 0.1 + 0.01 sin(0.9 t), tau = 1e5 (sin 0.05 t, sin 0.1 t, sin 0.07 t); h = 1 s, 600 s",
         passive_observer::case,
+    ),
+    (
+        "dgps_kalman_steady",
+        "DgpsKalman with default parameters (steady-state form, S_p 0.01, R 4 m2) and \
+         initial_velocity_north = 7 m/s; 7 m/s ship \
+         turning at 0.03 rad/s from 60 s, fixes with ~2 m deterministic noise, heading = course \
+         + 0.1 sin(0.02 t); h = 1 s, 600 s",
+        dgps_kalman::steady,
+    ),
+    (
+        "dgps_kalman_full_recursion",
+        "DgpsKalman as dgps_kalman_steady with full_recursion = true, process_noise_level = \
+         0.1; h = 2 s (two filter cycles per step), 600 s",
+        dgps_kalman::full_recursion,
+    ),
+    (
+        "parameter_ekf",
+        "ParameterEkf with default parameters (Esso Osaka preset, Table 4.1 noise); inputs from \
+         the Esso Osaka linear model in a 10/10 zig-zag (u = U, v, r, n = 80 + 0.5 sin(0.1 t) \
+         rpm, rudder stepped); h = 0.5 s, 900 s",
+        parameter_ekf::case,
     ),
 ];
