@@ -15,6 +15,7 @@ use std::io::Write;
 pub mod container_ship;
 pub mod current;
 pub mod dgps_kalman;
+pub mod dp_controller;
 pub mod manoeuvre;
 pub mod mariner;
 pub mod nomoto_ship;
@@ -40,6 +41,11 @@ pub type Case = (
 );
 
 pub const CASES: &[Case] = &[
+    (
+        "dp_controller",
+        "DpController with default gains (Northern Clipper, bandwidth 0.05 rad/s, zeta 0.9, r 10) and the eq. 61 test input scaled to 1e5/1e5/1e7; sinusoidal estimates, ramped set points; h = 1 s, 600 s",
+        dp_controller::case,
+    ),
     (
         "path_controller_adaptive",
         "PathController, adaptation 2 (estimates), dither windows of 1 L every 3 L from t' = 1; \
