@@ -16,6 +16,7 @@ pub mod container_ship;
 pub mod current;
 pub mod dgps_kalman;
 pub mod dp_controller;
+pub mod loop_shaped;
 pub mod manoeuvre;
 pub mod mariner;
 pub mod nomoto_ship;
@@ -41,6 +42,18 @@ pub type Case = (
 );
 
 pub const CASES: &[Case] = &[
+    (
+        "heading_autopilot_track_change",
+        "HeadingAutopilot with the track-change generator (-90 deg at 0.05 rad/s from 10 s, 60 s leg); \
+         heading input a lagging pseudo-response; h = 0.05 s, 200 s",
+        loop_shaped::heading_track_change,
+    ),
+    (
+        "track_controller_offset",
+        "TrackController with external reference (20 m step at 5 s), cross_track input \
+         15(1 - exp(-t/30)) + 0.5 sin(0.9 t) m; h = 0.05 s, 200 s",
+        loop_shaped::track_offset,
+    ),
     (
         "dp_controller",
         "DpController with default gains (Northern Clipper, bandwidth 0.05 rad/s, zeta 0.9, r 10) and the eq. 61 test input scaled to 1e5/1e5/1e7; sinusoidal estimates, ramped set points; h = 1 s, 600 s",
