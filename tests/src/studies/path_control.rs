@@ -709,7 +709,7 @@ pub fn run(env: &Env) -> Result<Report, String> {
         0.02,
         "deg",
     ));
-    c.push(Check::rel(
+    c.push(Check::abs(
         "S1 max |δ|, Appendix-A loop with the Jacobi exchange, vs ours",
         peak(&a1c),
         dm,
