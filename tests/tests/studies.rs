@@ -27,3 +27,8 @@ fn path_control() {
 fn dp_observer() {
     check("dp_observer");
 }
+
+#[test]
+fn dgps_trial() {
+    check("dgps_trial");
+}

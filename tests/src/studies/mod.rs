@@ -6,6 +6,7 @@
 
 use crate::study::{Env, Report};
 
+pub mod dgps_trial;
 pub mod dp_observer;
 pub mod path_control;
 pub mod rrs;
@@ -17,6 +18,7 @@ pub type Study = (&'static str, fn(&Env) -> Result<Report, String>);
 pub const STUDIES: &[Study] = &[
     ("steering_gear", steering_gear::run),
     ("dp_observer", dp_observer::run),
+    ("dgps_trial", dgps_trial::run),
     ("rrs", rrs::run),
     ("path_control", path_control::run),
 ];
