@@ -1,16 +1,19 @@
 """DgpsKalman.fmu in FMPy and libcosim reproduces the Rust model (models::observers::dgps_kalman)
 to 1e-12 of each output's scale for the same inputs (cases `dgps_kalman_steady` and
-`dgps_kalman_full_recursion` of model-reference). `drift_angle` feeds the heading input through:
-both importers sample it after a step, before the next inputs are set, as the reference does."""
+`dgps_kalman_full_recursion` of model-reference). `drift_angle` and the ground/water body
+velocities feed the heading and current inputs through: both importers sample them after a step,
+before the next inputs are set, as the reference does."""
 import numpy as np
 import pytest
 from fmpy import simulate_fmu
 
 from cosim import run_libcosim
 
-INPUTS = ["north_measured", "east_measured", "heading"]
+INPUTS = ["north_measured", "east_measured", "heading", "current_speed", "current_direction"]
 OUTPUTS = ["velocity_north_estimate", "velocity_east_estimate", "north_estimate", "east_estimate",
-           "speed_over_ground", "course_over_ground", "drift_angle", "gain_velocity", "gain_position"]
+           "speed_over_ground", "course_over_ground", "drift_angle", "gain_velocity", "gain_position",
+           "surge_velocity_ground", "sway_velocity_ground", "surge_velocity_water",
+           "sway_velocity_water", "drift_angle_water"]
 CASES = {
     "dgps_kalman_steady": {"initial_velocity_north": 7.0},
     "dgps_kalman_full_recursion": {"initial_velocity_north": 7.0, "full_recursion": True,

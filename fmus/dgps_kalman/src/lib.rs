@@ -12,6 +12,8 @@ pub struct DgpsKalmanFmu {
     x0: [f64; 4],
     z: [f64; 2],
     heading: f64,
+    /// Current speed [m/s] and the direction it flows toward [rad] (§2.1).
+    current: [f64; 2],
     filter: DgpsKalman,
 }
 
@@ -22,6 +24,7 @@ impl Default for DgpsKalmanFmu {
             x0: [0.0; 4],
             z: [0.0; 2],
             heading: 0.0,
+            current: [0.0; 2],
             filter: DgpsKalman::new(DgpsKalmanParams::default(), [0.0; 4]).expect("preset"),
         }
     }
@@ -29,7 +32,7 @@ impl Default for DgpsKalmanFmu {
 
 type V = Variable<DgpsKalmanFmu>;
 
-static VARIABLES: [V; 21] = [
+static VARIABLES: [V; 28] = [
     V::real_parameter(
         "time_step",
         Some("s"),
@@ -131,55 +134,113 @@ static VARIABLES: [V; 21] = [
         Some("m/s"),
         "Estimated v_NS",
         |m| m.filter.estimate()[0],
-    ),
+    )
+    .depends_on(&[]),
     V::real_output(
         "velocity_east_estimate",
         Some("m/s"),
         "Estimated v_EW",
         |m| m.filter.estimate()[1],
-    ),
+    )
+    .depends_on(&[]),
     V::real_output(
         "north_estimate",
         Some("m"),
         "Estimated north position",
         |m| m.filter.estimate()[2],
-    ),
+    )
+    .depends_on(&[]),
     V::real_output(
         "east_estimate",
         Some("m"),
         "Estimated east position",
         |m| m.filter.estimate()[3],
-    ),
+    )
+    .depends_on(&[]),
     V::real_output(
         "speed_over_ground",
         Some("m/s"),
         "v_xy = sqrt(v_NS^2 + v_EW^2) (eq. 6)",
         |m| m.filter.speed_over_ground(),
-    ),
+    )
+    .depends_on(&[]),
     V::real_output(
         "course_over_ground",
         Some("rad"),
         "atan2(v_EW, v_NS)",
         |m| m.filter.course_over_ground(),
-    ),
+    )
+    .depends_on(&[]),
     V::real_output(
         "drift_angle",
         Some("rad"),
         "beta_A = psi - atan2(v_EW, v_NS), wrapped (eq. 7); overestimated in turns by the filter lag",
         |m| m.filter.drift_angle(m.heading),
-    ),
+    )
+    .depends_on(&["heading"]),
     V::real_output(
         "gain_velocity",
         Some("1/s"),
         "Steady-state velocity gain k_v of K_inf (S_p = 0.01: 0.042688)",
         |m| m.filter.steady_gain()[(0, 0)],
-    ),
+    )
+    .depends_on(&[]),
     V::real_output(
         "gain_position",
         None,
         "Steady-state position gain k_p of K_inf (S_p = 0.01: 0.271106)",
         |m| m.filter.steady_gain()[(2, 0)],
+    )
+    .depends_on(&[]),
+    V::real_input(
+        "current_speed",
+        Some("m/s"),
+        "Sea-current speed |v_c| for the ground-to-water correction (section 1 of 002)",
+        |m| m.current[0],
+        |m, v| m.current[0] = v,
     ),
+    V::real_input(
+        "current_direction",
+        Some("rad"),
+        "Direction the current flows toward, gamma_c (0: a north current moving the ship north)",
+        |m| m.current[1],
+        |m, v| m.current[1] = v,
+    ),
+    V::real_output(
+        "surge_velocity_ground",
+        Some("m/s"),
+        "Ground-related body velocity v_x = D^T(psi) [v_NS, v_EW] (surge)",
+        |m| m.filter.body_velocity_over_ground(m.heading)[0],
+    )
+    .depends_on(&["heading"]),
+    V::real_output(
+        "sway_velocity_ground",
+        Some("m/s"),
+        "Ground-related body velocity v_y (sway, to starboard)",
+        |m| m.filter.body_velocity_over_ground(m.heading)[1],
+    )
+    .depends_on(&["heading"]),
+    V::real_output(
+        "surge_velocity_water",
+        Some("m/s"),
+        "Water-related surge v_x - [D^T(psi) v_c]_x (current correction, 002 line 34)",
+        |m| m.filter.body_velocity_through_water(m.heading, m.current[0], m.current[1])[0],
+    )
+    .depends_on(&["heading", "current_speed", "current_direction"]),
+    V::real_output(
+        "sway_velocity_water",
+        Some("m/s"),
+        "Water-related sway v_y - [D^T(psi) v_c]_y",
+        |m| m.filter.body_velocity_through_water(m.heading, m.current[0], m.current[1])[1],
+    )
+    .depends_on(&["heading", "current_speed", "current_direction"]),
+    V::real_output(
+        "drift_angle_water",
+        Some("rad"),
+        "Water-related drift angle atan2(-v_y_water, v_x_water) (002 line 44)",
+        |m| m.filter.drift_angle_through_water(m.heading, m.current[0], m.current[1]),
+    )
+    .depends_on(&["heading", "current_speed", "current_direction"]),
 ];
 
 impl FmuModel for DgpsKalmanFmu {

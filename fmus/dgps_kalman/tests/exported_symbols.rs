@@ -116,3 +116,51 @@ fn variable_table_passes_the_layer_checks() {
     let xml = fmi2_export::xml::model_description::<dgps_kalman_fmu::DgpsKalmanFmu>();
     assert!(xml.contains(r#"name="north_measured""#));
 }
+
+/// T8 through the C API: initial estimate v = [0, 7] m/s (course east), heading 90 deg, a
+/// 0.25 m/s north current: water-related body velocity [7.0, 0.25] m/s, drift angle -2.045 deg.
+#[test]
+fn current_correction_t8_through_the_api() {
+    let guid = CString::new(fmi2_export::xml::guid::<dgps_kalman_fmu::DgpsKalmanFmu>()).unwrap();
+    let name = CString::new("dgps").unwrap();
+    let cb = callbacks();
+    unsafe {
+        let c = fmi2Instantiate(
+            name.as_ptr(),
+            fmi2CoSimulation,
+            guid.as_ptr(),
+            null(),
+            &cb,
+            0,
+            0,
+        );
+        assert!(!c.is_null());
+        assert_eq!(fmi2SetupExperiment(c, 0, 0.0, 0.0, 0, 0.0), fmi2OK);
+        assert_eq!(fmi2EnterInitializationMode(c), fmi2OK);
+        let set = [
+            vr("initial_velocity_east"),
+            vr("heading"),
+            vr("current_speed"),
+            vr("current_direction"),
+        ];
+        let val = [7.0, std::f64::consts::FRAC_PI_2, 0.25, 0.0];
+        assert_eq!(fmi2SetReal(c, set.as_ptr(), 4, val.as_ptr()), fmi2OK);
+        assert_eq!(fmi2ExitInitializationMode(c), fmi2OK);
+        let outs = [
+            vr("surge_velocity_water"),
+            vr("sway_velocity_water"),
+            vr("drift_angle_water"),
+            vr("drift_angle"),
+        ];
+        let mut v = [0.0; 4];
+        assert_eq!(fmi2GetReal(c, outs.as_ptr(), 4, v.as_mut_ptr()), fmi2OK);
+        assert!(
+            (v[0] - 7.0).abs() < 1e-12 && (v[1] - 0.25).abs() < 1e-12,
+            "{v:?}"
+        );
+        assert!((v[2].to_degrees() + 2.045).abs() < 5e-4, "{v:?}");
+        assert!(v[3].abs() < 1e-12);
+        assert_eq!(fmi2Terminate(c), fmi2OK);
+        fmi2FreeInstance(c);
+    }
+}

@@ -14,6 +14,11 @@
 //! * S_p in m²/s³ (PSD of a white acceleration; the paper gives no unit), Δt = 1 s.
 //! * Eq. 7 is evaluated with atan2 and wrapped to (−π, π]; ψ is the gyro heading (the paper's
 //!   "course angle ψ", line 130, is the heading).
+//! * §2.1 current correction (line 34): the body-frame water-related velocity is the
+//!   ground-related one minus Dᵀ(ψ)·|v_c|[cos γ_c, sin γ_c], γ_c the direction the current flows
+//!   *toward* (0 = a north current moving the ship north, line 40), and
+//!   tan β_A^water = −v_y^water / v_x^water (line 44), evaluated with atan2 as Eq. 7. The
+//!   ground-related body velocity is the filter's [v_NS, v_EW] rotated by Dᵀ(ψ).
 //! * The steady-state form (Eq. 5, the paper's results) is the default; the full time-varying
 //!   recursion from P₀ is an option. A co-simulation step h is ⌈h/Δt⌉ filter cycles with the
 //!   measurement held.
@@ -205,6 +210,56 @@ impl DgpsKalman {
     }
 }
 
+impl DgpsKalman {
+    /// Ground-related body velocity [v_x, v_y] = Dᵀ(ψ)[v_NS, v_EW] [m/s] (surge, sway to
+    /// starboard) at gyro heading `heading`.
+    pub fn body_velocity_over_ground(&self, heading: f64) -> [f64; 2] {
+        rotate_to_body(heading, self.x[0], self.x[1])
+    }
+
+    /// Water-related body velocity (§2.1) for a current of `current_speed` [m/s] flowing toward
+    /// `current_direction` [rad from north, clockwise].
+    pub fn body_velocity_through_water(
+        &self,
+        heading: f64,
+        current_speed: f64,
+        current_direction: f64,
+    ) -> [f64; 2] {
+        let g = self.body_velocity_over_ground(heading);
+        water_velocity(heading, g, current_speed, current_direction)
+    }
+
+    /// Water-related drift angle β_A^water = atan2(−v_y^water, v_x^water) (§2.1, line 44).
+    pub fn drift_angle_through_water(
+        &self,
+        heading: f64,
+        current_speed: f64,
+        current_direction: f64,
+    ) -> f64 {
+        let w = self.body_velocity_through_water(heading, current_speed, current_direction);
+        (-w[1]).atan2(w[0])
+    }
+}
+
+/// Dᵀ(ψ)[a_N, a_E] = [cos ψ a_N + sin ψ a_E, −sin ψ a_N + cos ψ a_E] (§2.1, line 38).
+pub fn rotate_to_body(heading: f64, north: f64, east: f64) -> [f64; 2] {
+    let (s, c) = heading.sin_cos();
+    [c * north + s * east, -s * north + c * east]
+}
+
+/// §2.1 (line 34): water-related body velocity = ground-related body velocity `ground` minus
+/// Dᵀ(ψ)·|v_c|[cos γ_c, sin γ_c].
+pub fn water_velocity(
+    heading: f64,
+    ground: [f64; 2],
+    current_speed: f64,
+    current_direction: f64,
+) -> [f64; 2] {
+    let (s, c) = current_direction.sin_cos();
+    let cb = rotate_to_body(heading, current_speed * c, current_speed * s);
+    [ground[0] - cb[0], ground[1] - cb[1]]
+}
+
 /// Eq. 7: β_A = ψ − atan2(v_EW, v_NS), wrapped.
 pub fn drift_angle(heading: f64, v_ns: f64, v_ew: f64) -> f64 {
     wrap_pi(heading - v_ew.atan2(v_ns))
@@ -347,6 +402,36 @@ mod tests {
         );
         assert!((vn - 4.6985).abs() < 1e-4 && (ve - 1.7101).abs() < 1e-4);
         assert!((drift_angle(30f64.to_radians(), vn, ve).to_degrees() - 10.0).abs() < 1e-9);
+    }
+
+    /// T8 (§2.1 worked example): ψ = 90°, ground body velocity [7, 0] m/s, a 0.25 m/s north
+    /// current (γ_c = 0) ⇒ Dᵀ·[0.25, 0] = [0, −0.25], water velocity [7.0, 0.25] m/s and
+    /// β_A^water = atan(−0.25/7) = −2.045° while β_A^ground = 0. Also through the filter: a
+    /// filter holding v = [0, 7] (course east) at heading 90° gives the same numbers.
+    #[test]
+    fn current_correction_t8() {
+        let psi = 90f64.to_radians();
+        let w = water_velocity(psi, [7.0, 0.0], 0.25, 0.0);
+        assert!(
+            (w[0] - 7.0).abs() < 1e-12 && (w[1] - 0.25).abs() < 1e-12,
+            "{w:?}"
+        );
+        let mut f = DgpsKalman::new(DgpsKalmanParams::default(), [0.0, 7.0, 0.0, 0.0]).unwrap();
+        let g = f.body_velocity_over_ground(psi);
+        assert!((g[0] - 7.0).abs() < 1e-12 && g[1].abs() < 1e-12);
+        let wf = f.body_velocity_through_water(psi, 0.25, 0.0);
+        assert!((wf[0] - 7.0).abs() < 1e-12 && (wf[1] - 0.25).abs() < 1e-12);
+        let beta = f.drift_angle_through_water(psi, 0.25, 0.0).to_degrees();
+        assert!((beta + 2.045).abs() < 5e-4, "{beta}");
+        assert!(f.drift_angle(psi).abs() < 1e-12);
+        // Without current the water and ground drift angles agree (Eq. 7 vs line 44).
+        for k in 1..100 {
+            f.cycle(k as f64 * 0.5, k as f64 * 6.9);
+        }
+        for psi in [0.3, 1.4, -2.0] {
+            let d = wrap_pi(f.drift_angle_through_water(psi, 0.0, 1.0) - f.drift_angle(psi));
+            assert!(d.abs() < 1e-12);
+        }
     }
 
     /// T2: the full recursion from any P₀ becomes the steady-state form.

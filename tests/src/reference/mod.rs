@@ -207,7 +207,8 @@ pub const CASES: &[Case] = &[
         "DgpsKalman with default parameters (steady-state form, S_p 0.01, R 4 m2) and \
          initial_velocity_north = 7 m/s; 7 m/s ship \
          turning at 0.03 rad/s from 60 s, fixes with ~2 m deterministic noise, heading = course \
-         + 0.1 sin(0.02 t); h = 1 s, 600 s",
+         + 0.1 sin(0.02 t), current 0.3 + 0.1 sin(0.01 t) m/s toward 1 + 0.2 cos(0.015 t) rad; \
+         h = 1 s, 600 s",
         dgps_kalman::steady,
     ),
     (
