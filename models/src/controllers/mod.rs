@@ -16,6 +16,7 @@ use std::fmt;
 pub mod dp;
 pub mod loop_shaped;
 pub mod lq;
+pub mod mve;
 pub mod path;
 pub mod rrs;
 
