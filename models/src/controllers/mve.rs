@@ -378,6 +378,113 @@ mod tests {
         );
     }
 
+    /// S14 (Table 16, Figs. 28–31): truth at H/T = 1.89 from t′ = 0; controller, filter model and
+    /// estimator initialised for ∞; dither ±0.5 rad, period 0.5 L, in the first 2.5 L of every
+    /// 6.25 L; the path controller applies the estimates at the end of each dither window (Table 10
+    /// rule) and the path Kalman filter takes the same coefficients; Table 3 noise in the control
+    /// loop, Table 9 noise for the estimator; ℓ = 10, P0 of eq. 117, Φ = 0, α = 0; 10 L (200
+    /// estimates). Results are seed-dependent (the report's seeds are unknown); asserted against
+    /// the spec's ranges from an independent implementation (3 seeds) and the printed values:
+    /// max η′ 0.178–0.205 derived / 0.1738 printed (OCR "0.01738") → asserted 0.15–0.23;
+    /// final f̂23 5.47–6.41 derived / 5.4886 printed → 4.9–6.8; RMS(118) of f̂23 11.7–17.0 / 12.83
+    /// → 8–20; f22, f33, f35 "slow and generally ineffective": stay within 0.25 of their initial
+    /// values (printed final −1.93, −0.66, −0.162 from −1.95, −0.64, −0.162).
+    #[test]
+    fn s14_constant_bottom_with_noise() {
+        use crate::controllers::path::{
+            Adaptation, Dither, PathController, PathControllerParams, PathInputs,
+        };
+        use crate::hull::tokyo_maru::{L, TABLE_2, T_R, U};
+        use crate::observers::path_kalman::PathKalmanFilter;
+        use crate::observers::path_model::PathDesignModel;
+        use rand::SeedableRng;
+        use rand_distr::{Distribution, Normal};
+        let truth = TABLE_2[2];
+        let deep = TABLE_2[4];
+        let (fs, gs, _) = truth.eq11(T_R);
+        for seed in [1u64, 2, 3] {
+            let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+            let n01 = Normal::new(0.0, 1.0).unwrap();
+            let params = PathControllerParams {
+                design_depth_ratio: f64::INFINITY,
+                adaptation: Adaptation::Estimated,
+                dither: Dither {
+                    enabled: true,
+                    ..Dither::default()
+                },
+                ..Default::default()
+            };
+            let mut ctl = PathController::new(params).unwrap();
+            let design = |c| PathDesignModel {
+                coefficients: c,
+                ..params.design
+            };
+            let mut kf = PathKalmanFilter::new(design(deep), [0.0; 7]).unwrap();
+            let mut mve = Mve::new(MveParams::default(), parameters_of(&deep)).unwrap();
+            let dt = 0.005;
+            let h = dt * L / U;
+            let mut x = SVector::<f64, 5>::zeros();
+            let (mut eta_max, mut t_max) = (0.0f64, 0.0);
+            let mut sq = [0.0f64; 6];
+            let truth_p = parameters_of(&truth);
+            let mut updates = 0;
+            let sigma3 = [1.611e-3, 7.563e-3, 9.549e-3];
+            for k in 0..2000 {
+                let xh = *kf.estimate();
+                let inputs = PathInputs {
+                    heading: xh[0],
+                    yaw_rate: xh[1] * U / L,
+                    drift_angle: xh[2],
+                    cross_track: xh[3] * L,
+                    rudder: xh[4],
+                    yaw_moment_prime: xh[5],
+                    sway_force_prime: xh[6],
+                    depth_ratio: 1.89,
+                    estimates: mve.estimate(),
+                };
+                if k == 0 {
+                    ctl.start(&inputs);
+                }
+                let u = ctl.command(&inputs);
+                let z = SVector::<f64, 3>::new(
+                    x[0] + sigma3[0] * n01.sample(&mut rng),
+                    x[1] + sigma3[1] * n01.sample(&mut rng),
+                    x[3] + sigma3[2] * n01.sample(&mut rng),
+                );
+                let zm: [f64; 4] =
+                    std::array::from_fn(|i| x[i] + SIGMA_TABLE_9[i] * n01.sample(&mut rng));
+                if mve.sample(zm, x[4]) {
+                    let p = mve.estimate();
+                    for i in 0..6 {
+                        sq[i] += (p[i] - truth_p[i]).powi(2);
+                    }
+                }
+                x += (fs * x + gs * u) * dt;
+                kf.euler_step_prime(&z, u, dt);
+                ctl.step(&inputs, h).unwrap();
+                if ctl.updates() != updates {
+                    updates = ctl.updates();
+                    kf.set_design(design(*ctl.coefficients())).unwrap();
+                }
+                if x[3].abs() > eta_max {
+                    eta_max = x[3].abs();
+                    t_max = (k + 1) as f64 * dt;
+                }
+            }
+            let p = mve.estimate();
+            let rms: [f64; 6] = sq.map(f64::sqrt);
+            eprintln!(
+                "S14 seed {seed}: max eta' {eta_max:.4} at {t_max:.2}, updates {updates}, final {p:.4?}, RMS(118) {rms:.3?}"
+            );
+            assert!((0.15..=0.23).contains(&eta_max), "eta {eta_max}");
+            assert!((4.9..=6.8).contains(&p[1]), "f23 {}", p[1]);
+            assert!((8.0..=20.0).contains(&rms[1]), "RMS f23 {}", rms[1]);
+            assert!((p[0] - deep.f22).abs() < 0.25 && (p[4] - deep.f33).abs() < 0.25);
+            assert!((p[5] - deep.f35).abs() < 0.01);
+            assert!(updates >= 1);
+        }
+    }
+
     #[test]
     fn bad_settings_are_errors() {
         let p = MveParams {
