@@ -219,6 +219,22 @@ impl Mve {
         &self.m
     }
 
+    /// Changes the sample step Δt′ (recomputes R_eq and G; p̂ and P carry over).
+    pub fn set_dt(&mut self, dt: f64) -> Result<(), ControlError> {
+        let params = MveParams { dt, ..self.params };
+        self.m = params.matrices()?;
+        self.params = params;
+        Ok(())
+    }
+
+    /// Replaces the settings (recomputes the matrices; p̂ and P carry over).
+    pub fn set_params(&mut self, params: MveParams) -> Result<(), ControlError> {
+        self.m = params.matrices()?;
+        self.phi = M6::from_diagonal(&V6::from(params.phi));
+        self.params = params;
+        Ok(())
+    }
+
     /// p̂ = [f22, f23, f25, f32, f33, f35].
     pub fn estimate(&self) -> [f64; 6] {
         self.p_hat.into()

@@ -23,6 +23,7 @@ pub mod nomoto_ship;
 pub mod parameter_ekf;
 pub mod passive_observer;
 pub mod path_controller;
+pub mod path_estimator;
 pub mod rrs_autopilot;
 pub mod path_kalman_filter;
 pub mod rrs_filter;
@@ -64,6 +65,12 @@ pub const CASES: &[Case] = &[
         "PathController, adaptation 2 (estimates), dither windows of 1 L every 3 L from t' = 1; \
          sinusoidal state-estimate inputs, f23/f25 estimates at deep-water values; h = 0.5 s, 300 s",
         path_controller::adaptive,
+    ),
+    (
+        "path_estimator_dither",
+        "PathEstimator (MVE) on the noise-free Tokyo Maru at H/T = 1.89 under a +-0.5 rad dither; \
+         h = 0.25 s, 600 steps",
+        path_estimator::dither,
     ),
     (
         "rrs_autopilot_adaptive",
