@@ -354,6 +354,15 @@ unsafe fn get_values<M: FmuModel, T>(
         if vr.is_null() || out.is_null() {
             return inst.error(&format!("{function}: NULL array with nvr = {n}"));
         }
+        if inst.core.state == LifeState::InitializationMode && inst.dirty {
+            // In Initialization Mode the outputs (InitialUnknowns) must reflect the parameters
+            // and start values set so far (FMI 2.0 §3.2.3/§4.2.4): rebuild the model from them.
+            // `initialize` is idempotent; an error is reported by fmi2ExitInitializationMode.
+            if inst.model.initialize(inst.core.start_time).is_ok() {
+                inst.model.calculate_outputs();
+            }
+            inst.dirty = false;
+        }
         inst.refresh_outputs();
         let vrs = std::slice::from_raw_parts(vr, n);
         for (i, &r) in vrs.iter().enumerate() {

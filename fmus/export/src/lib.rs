@@ -75,7 +75,8 @@ pub trait FmuModel: Clone + Default + Serialize + DeserializeOwned + 'static {
 
     /// Called in `fmi2ExitInitializationMode` after parameters and start values are set:
     /// validate parameters and compute the outputs at the start time. The message should name
-    /// the offending variable and value.
+    /// the offending variable and value. Must be idempotent: it is also called when an importer
+    /// reads outputs in Initialization Mode after changing parameters or start values.
     fn initialize(&mut self, start_time: f64) -> Result<(), String>;
 
     /// Called after a tunable parameter changed in step mode; on error the old value is restored.

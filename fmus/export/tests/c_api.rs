@@ -723,6 +723,21 @@ fn values_are_validated_and_errors_name_the_variable() {
     assert_eq!(fmu.get_bool(VR_ENABLED), (fmi2OK, false));
 }
 
+/// In Initialization Mode the outputs reflect the parameters set so far (InitialUnknowns).
+#[test]
+fn outputs_in_initialization_mode_follow_the_parameters() {
+    let host = Host::new();
+    let fmu = host.instantiate("init");
+    assert_eq!(fmu.set(VR_OFFSET, 3.0), fmi2OK);
+    assert_eq!(fmu.setup(0.0, None), fmi2OK);
+    assert_eq!(fmu.enter(), fmi2OK);
+    assert_eq!(fmu.get(VR_Y), 3.0);
+    assert_eq!(fmu.set(VR_OFFSET, 4.0), fmi2OK);
+    assert_eq!(fmu.get(VR_Y), 4.0);
+    assert_eq!(fmu.exit(), fmi2OK);
+    assert_eq!(fmu.get(VR_Y), 4.0);
+}
+
 #[test]
 fn invalid_parameters_fail_initialization_with_the_name() {
     let host = Host::new();

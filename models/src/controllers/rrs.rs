@@ -543,6 +543,10 @@ pub struct RrsAutopilot {
     /// The set point sent at the previous sample (None before the first), for eq. 5.3 on the
     /// total set point.
     prev_command: Option<f64>,
+    /// The outputs computed at the last sample, held until the next (a sampled controller: the
+    /// set point seen downstream is exactly the sequence the AGC constrained). None before the
+    /// first sample, when the outputs follow the inputs.
+    held: Option<RrsOutputs>,
 }
 
 impl RrsAutopilot {
@@ -561,6 +565,7 @@ impl RrsAutopilot {
             roll_variance: 0.0,
             last_dt: 0.0,
             prev_command: None,
+            held: None,
             params,
         })
     }
@@ -661,8 +666,15 @@ impl RrsAutopilot {
         )
     }
 
-    /// Outputs for the current inputs (direct feedthrough; no state change).
+    /// The outputs: those computed at the last sample and held (zero-order hold of a sampled
+    /// controller, thesis §6.3: the output for sample k is computed from data up to k − 1);
+    /// before the first sample, the outputs for the current inputs.
     pub fn outputs(&self, i: &RrsInputs) -> RrsOutputs {
+        self.held.unwrap_or_else(|| self.control_law(i))
+    }
+
+    /// The control law evaluated now for the inputs `i` (what the next sample will commit).
+    pub fn control_law(&self, i: &RrsInputs) -> RrsOutputs {
         self.evaluate(i).0
     }
 
@@ -675,6 +687,7 @@ impl RrsAutopilot {
         let (out, agc_in, agc) = self.evaluate(i);
         self.agc.commit(agc_in, &agc);
         self.prev_command = Some(out.rudder_command);
+        self.held = Some(out);
         self.last_dt = h;
         let a = self.params.adaptation;
         // roll variance: first-order low-pass of φ² (Fig. 6.10), exact for the held input
@@ -1008,6 +1021,35 @@ mod tests {
 
     /// The innovation process inside the autopilot reaches the CARE roll gains; RRS off computes
     /// the gains but applies no roll rudder; forced roll inverts it; the output is clamped to δ_max.
+    /// Eq. 5.3 on the set point the steering gear sees: with the AGC on the roll rudder only,
+    /// course-rudder jumps (heading-error steps) and a growing roll demand, the held output
+    /// never moves faster than δ̇_max between samples.
+    #[test]
+    fn held_set_point_respects_the_rate_limit() {
+        let mut p = RrsAutopilotParams::default();
+        p.rate_max = 7.0 * std::f64::consts::PI / 180.0;
+        let mut ap = RrsAutopilot::new(p).unwrap();
+        let dt = 0.1;
+        let mut prev = None;
+        for k in 0..3000 {
+            let t = k as f64 * dt;
+            let i = RrsInputs {
+                roll: 0.002 * t * (0.63 * t).sin(),
+                roll_rate: 0.002 * t * 0.63 * (0.63 * t).cos(),
+                heading_error: if (k / 400) % 2 == 0 { 0.05 } else { -0.05 },
+                speed: 11.0,
+                ..Default::default()
+            };
+            let out = ap.outputs(&i).rudder_command;
+            if let Some(prev) = prev {
+                let rate: f64 = (out - prev) / dt;
+                assert!(rate.abs() <= p.rate_max * (1.0 + 1e-12), "t = {t}: {rate}");
+            }
+            prev = Some(out);
+            ap.step(&i, dt);
+        }
+    }
+
     #[test]
     fn autopilot_modes_and_gains() {
         let mut p = RrsAutopilotParams::default();
@@ -1031,7 +1073,7 @@ mod tests {
             want.as_slice(),
             1e-3 * want.norm(),
         );
-        let on = ap.outputs(&i);
+        let on = ap.control_law(&i);
         let k = ap.roll_gains(11.0);
         assert!((on.roll_rudder + k[0] * 0.02 + k[1] * 0.01 + k[2] * 0.001).abs() < 1e-15);
         let kc = ap.course_gains(11.0);
@@ -1039,18 +1081,18 @@ mod tests {
         assert!((on.rudder_command - (on.roll_rudder + on.course_rudder)).abs() < 1e-15);
         p.roll_mode = RollMode::Off;
         ap.set_params(p).unwrap();
-        let off = ap.outputs(&i);
+        let off = ap.control_law(&i);
         assert_eq!(off.roll_rudder, 0.0);
         assert_eq!(off.rudder_command, off.course_rudder);
         p.roll_mode = RollMode::Forced;
         ap.set_params(p).unwrap();
-        assert_eq!(ap.outputs(&i).roll_rudder, -on.roll_rudder);
+        assert_eq!(ap.control_law(&i).roll_rudder, -on.roll_rudder);
         p.course_auto = false;
         p.roll_mode = RollMode::On;
         ap.set_params(p).unwrap();
         let big = RrsInputs { wheel: 1.0, ..i };
-        assert_eq!(ap.outputs(&big).course_rudder, 1.0);
-        assert_eq!(ap.outputs(&big).rudder_command, p.angle_max);
+        assert_eq!(ap.control_law(&big).course_rudder, 1.0);
+        assert_eq!(ap.control_law(&big).rudder_command, p.angle_max);
     }
 
     /// Criterion adaptation: with small roll, rule 1 (Δq1 = −1) drives q_φ to 0 ("switched off

@@ -267,8 +267,8 @@ fn within_seeds(quantity: &str, printed: &str, s: &Spread, half_digit: f64, unit
 /// with the exchange of the co-simulation: the Jacobi master hands the filter the measurement of
 /// the previous step (the Sensors output is a direct feedthrough of the hull's output, one
 /// exchange old) and the gear the command of the previous step (the controller output is a
-/// direct feedthrough of the filter's output), the first command is 0 (the filter's outputs in
-/// initialization mode are its defaults, see the note), the controller reads the gear's actual
+/// direct feedthrough of the filter's output), the first command is C x̂_0 (the filter's
+/// outputs in initialization mode follow its initial_* parameters), the controller reads the gear's actual
 /// rudder and the gear is integrated exactly (SteeringGear). Returns (t′, η m, δ deg).
 fn appendix_a(
     truth: TokyoMaruCoefficients,
@@ -286,7 +286,13 @@ fn appendix_a(
     let mut x = [0.0, 0.0, 0.0, eta0 / L, 0.0];
     let mut xh = [0.0, 0.0, 0.0, eta0 / L, 0.0, 0.0, 0.0];
     let mut z_prev = [x[0], x[1], x[3]];
-    let mut u_prev = 0.0;
+    // The first command: the controller sees the filter's initial estimate during the master's
+    // initial exchange (outputs in Initialization Mode follow the parameters), so u_0 = C x̂_0.
+    let mut u_prev: f64 = {
+        let mut xc0 = xh;
+        xc0[4] = x[4];
+        (0..7).map(|j| g.c[j] * xc0[j]).sum()
+    };
     let decay = (-DT / T_R).exp();
     let mut out = Vec::with_capacity(steps + 1);
     for k in 0..=steps {
@@ -1047,10 +1053,9 @@ pub fn run(env: &Env) -> Result<Report, String> {
         ));
     }
     n.push(
-        "Initialization: the PathKalmanFilter FMU computes its outputs from initial_* only at \
-         fmi2ExitInitializationMode (export-layer rule), so during the master's initial exchange the \
-         controller sees x̂ = 0 and the first command (t′ = 0) is 0; C14·η′(0) = 11.38° appears at \
-         t′ = 0.005. Part of the one-step command delay above; reported as a finding."
+        "Initialization: in Initialization Mode the FMUs' outputs follow their parameters and \
+         start values (export layer), so the master's initial exchange gives the controller the \
+         filter's initial estimate and the first command at t′ = 0 is C14·η′(0) = 11.38°."
             .into(),
     );
     n.push(
