@@ -19,6 +19,7 @@ pub mod lq;
 pub mod mve;
 pub mod path;
 pub mod rrs;
+pub mod wls;
 
 /// Why a controller could not be designed or configured: names the parameter or the design step.
 #[derive(Clone, Debug, PartialEq)]
