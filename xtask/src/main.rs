@@ -19,7 +19,7 @@ fn main() {
         Some("test") => test(&args[1..]),
         Some("demo") => demo(),
         Some("bench") => bench(&args[1..]),
-        Some("report") => report(),
+        Some("report") => report(args.get(1).map(String::as_str)),
         _ => {
             eprintln!(
                 "usage: cargo xtask <task>\n\n\
@@ -27,7 +27,7 @@ fn main() {
                  build-fmus   build every FMU into target/fmu/<ModelIdentifier>.fmu\n  \
                  test         run every test: Rust, FMU packaging, FMPy and libcosim checks\n  \
                  demo         run the default coupled system\n  \
-                 report       run every coupled system and write the validation report (target/report)\n  \
+                 report [DIR] run every coupled system and write the validation report (target/report)\n  \
                  bench        master overhead per FMU-step: shipsim vs libcosim vs FMPy (master/bench)"
             );
             std::process::exit(2);
@@ -128,8 +128,9 @@ fn test(extra: &[String]) -> Result<()> {
     Ok(())
 }
 
-/// Runs every study of tests/src/studies and writes target/report/README.md with figures.
-fn report() -> Result<()> {
+/// Runs every study of tests/src/studies and writes `<dir>/README.md` with figures (default
+/// target/report; `cargo xtask report docs/report` refreshes the copy the README links).
+fn report(dir: Option<&str>) -> Result<()> {
     let root = workspace_root();
     let fmu_dir = fmu::build_fmus(&root)?;
     run(cargo().current_dir(&root).args([
@@ -142,7 +143,7 @@ fn report() -> Result<()> {
     ]))?;
     run(Command::new(root.join("target/release/report"))
         .current_dir(&root)
-        .arg(root.join("target/report"))
+        .arg(root.join(dir.unwrap_or("target/report")))
         .env("SHIPSIM_FMU_DIR", fmu_dir))
 }
 
