@@ -32,3 +32,8 @@ fn dp_observer() {
 fn dgps_trial() {
     check("dgps_trial");
 }
+
+#[test]
+fn autopilot() {
+    check("autopilot");
+}

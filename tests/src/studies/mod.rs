@@ -6,6 +6,7 @@
 
 use crate::study::{Env, Report};
 
+pub mod autopilot;
 pub mod dgps_trial;
 pub mod dp_observer;
 pub mod path_control;
@@ -21,6 +22,7 @@ pub const STUDIES: &[Study] = &[
     ("dgps_trial", dgps_trial::run),
     ("rrs", rrs::run),
     ("path_control", path_control::run),
+    ("autopilot", autopilot::run),
 ];
 
 /// Runs the study `id` in `target/studies/<id>/`.
