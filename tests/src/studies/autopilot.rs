@@ -115,13 +115,11 @@ fn current_rejection(env: &Env, report: &mut Report) -> Result<(), String> {
         0.01,
         "L",
     ));
-    report.checks.push(Check::holds(
-        "AT-7 peak lateral offset vs the thesis",
-        "≈ 0.3 L (L2351, L2367)",
-        format!(
-            "{peak:.3} L: set by the assumed sway decay (T' L/U), not by the autopilot; not reproducible (see notes)"
-        ),
-        true,
+    // Not a check: the peak is set by the assumed current decay, not by the autopilot.
+    report.notes.push(format!(
+        "AT-7 peak lateral offset: thesis ≈ 0.3 L (L2351, L2367); ours {peak:.3} L, set by the \
+         assumed sway decay (T' L/U), not by the autopilot: not reproducible on the first-order \
+         Nomoto plant (see the other notes)."
     ));
     let psi_max = max_abs(col(&t, "ship.heading")?) / DEG;
     report.checks.push(Check::holds(
@@ -210,14 +208,6 @@ fn track_change(env: &Env, report: &mut Report) -> Result<(), String> {
         .collect();
     let xte: Vec<f64> = leg.iter().map(|&k| (x[k] - xd[k]) / L).collect();
     let xte_end = *xte.last().unwrap();
-    report.checks.push(Check::holds(
-        "AT-8 cross-track after the first 90 deg turn",
-        "≈ 3 L (L2501), from speed loss and sway in the turn",
-        format!(
-            "{xte_end:.3} L (heading lag only: the linear Nomoto plant has neither speed loss nor sway); not reproducible (see notes)"
-        ),
-        xte_end.abs() < 3.0,
-    ));
     let heading = col(&t, "ship.heading")?;
     let steady: Vec<f64> = leg
         .iter()
@@ -240,12 +230,6 @@ fn track_change(env: &Env, report: &mut Report) -> Result<(), String> {
         .collect();
     let sweep = turn.iter().cloned().fold(f64::MIN, f64::max)
         - turn.iter().cloned().fold(f64::MAX, f64::min);
-    report.checks.push(Check::holds(
-        "AT-8 actual-rudder sweep in the first turn (1 deg/s heading ramp)",
-        "≈ 20 deg over ≈ 3 min (L2523)",
-        format!("{sweep:.2} deg"),
-        true,
-    ));
     let _ = (y, yd);
     report.notes.push(format!(
         "AT-8: the ramp rate and leg length are not given; we use 1 deg/s and a 600 s leg. On the \
