@@ -1,6 +1,6 @@
 """Rudder roll stabilization (source 003, issue 8 system 1) in libcosim.
 
-systems/rrs.toml (RrsShip + SteeringGear + Waves + Sensors + RrsFilter + RrsAutopilot, multi-rate,
+systems/rrs.toml (RrsShip + SteeringGear + Waves + Wind + Sensors + RrsFilter + RrsAutopilot, multi-rate,
 wave moments mapped onto rudder-equivalent disturbances by LinearTransformation functions),
 exported with `shipsim export-osp`, runs in libcosim (libcosimpy) with the same results as in
 shipsim, RRS on and off.
@@ -12,7 +12,7 @@ import pytest
 from test_master_interop import assert_same_as_libcosim, read_csv, shipsim
 from test_path_control_libcosim import localise
 
-FMUS = ["RrsShip", "SteeringGear", "Waves", "Sensors", "RrsFilter", "RrsAutopilot"]
+FMUS = ["RrsShip", "SteeringGear", "Waves", "Wind", "Sensors", "RrsFilter", "RrsAutopilot"]
 
 
 @pytest.mark.parametrize("roll_mode", ["1", "0"])

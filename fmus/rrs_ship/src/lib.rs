@@ -16,6 +16,10 @@ pub struct RrsShipFmu {
     min_speed: f64,
     max_substep: f64,
     inputs: RrsShipInputs,
+    /// Second disturbance channel (e.g. wind, eqs. 2.19-2.20), added to the first: w_φ and w_ψ
+    /// of eq. 3.29 are the sums of all rudder-equivalent disturbances.
+    wind_roll: f64,
+    wind_yaw: f64,
     ship: RrsShip,
 }
 
@@ -34,6 +38,8 @@ impl Default for RrsShipFmu {
                 speed: U_22KN,
                 ..Default::default()
             },
+            wind_roll: 0.0,
+            wind_yaw: 0.0,
             ship,
         }
     }
@@ -183,6 +189,22 @@ static VARIABLES: &[V] = &[
         "Wave-induced roll contribution y_wp (model 1; rudder-equivalent, model units)",
         |m| m.out().wave_roll,
     ),
+    V::real_input(
+        "wind_roll_disturbance",
+        Some("rad"),
+        "Second rudder-equivalent roll disturbance (e.g. the wind moment of eq. 2.19), added to \
+         roll_disturbance",
+        |m| m.wind_roll,
+        |m, v| m.wind_roll = v,
+    ),
+    V::real_input(
+        "wind_yaw_disturbance",
+        Some("rad"),
+        "Second rudder-equivalent yaw disturbance (e.g. the wind moment of eq. 2.20), added to \
+         yaw_disturbance",
+        |m| m.wind_yaw,
+        |m, v| m.wind_yaw = v,
+    ),
 ];
 
 impl FmuModel for RrsShipFmu {
@@ -227,7 +249,10 @@ impl FmuModel for RrsShipFmu {
     }
 
     fn do_step(&mut self, _t: f64, h: f64) -> Result<(), String> {
-        self.ship.step(&self.inputs, h);
+        let mut inputs = self.inputs;
+        inputs.roll_disturbance += self.wind_roll;
+        inputs.yaw_disturbance += self.wind_yaw;
+        self.ship.step(&inputs, h);
         Ok(())
     }
 }

@@ -22,7 +22,8 @@ fn main() {
     };
     println!();
     println!("Rudder roll stabilization, van der Klugt (1987): RRS ship (Table 2.4) at 11 m/s in beam seas,");
-    println!("15 deg/s steering gear, roll and yaw filters, RRS autopilot with AGC and criterion adaptation.");
+    println!("beam wind with gusts, 15 deg/s steering gear, roll and yaw filters, RRS autopilot with AGC and");
+    println!("criterion adaptation.");
     println!("Statistics over 200-1200 s; the open-loop roll is tuned to Table 7.1's 16 deg^2.");
     println!();
     println!("{:<28} {:>12} {:>12}", "", "RRS off", "RRS on");
