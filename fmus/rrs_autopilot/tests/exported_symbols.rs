@@ -3,36 +3,10 @@
 
 use fmi2::*;
 use models::controllers::rrs::{RrsAutopilot, RrsAutopilotParams, RrsInputs};
-use std::ffi::{c_char, CString};
+use std::ffi::CString;
 use std::ptr::null;
 
-extern "C" {
-    fn fmi2Instantiate(
-        name: fmi2String,
-        kind: fmi2Type,
-        guid: fmi2String,
-        res: fmi2String,
-        f: *const fmi2CallbackFunctions,
-        visible: fmi2Boolean,
-        logging: fmi2Boolean,
-    ) -> fmi2Component;
-    fn fmi2FreeInstance(c: fmi2Component);
-    fn fmi2SetupExperiment(
-        c: fmi2Component,
-        a: fmi2Boolean,
-        b: f64,
-        s: f64,
-        d: fmi2Boolean,
-        e: f64,
-    ) -> fmi2Status;
-    fn fmi2EnterInitializationMode(c: fmi2Component) -> fmi2Status;
-    fn fmi2ExitInitializationMode(c: fmi2Component) -> fmi2Status;
-    fn fmi2SetReal(c: fmi2Component, vr: *const u32, n: usize, v: *const f64) -> fmi2Status;
-    fn fmi2GetReal(c: fmi2Component, vr: *const u32, n: usize, v: *mut f64) -> fmi2Status;
-    fn fmi2DoStep(c: fmi2Component, t: f64, h: f64, p: fmi2Boolean) -> fmi2Status;
-    fn fmi2Terminate(c: fmi2Component) -> fmi2Status;
-    fn fmi2GetVersion() -> *const c_char;
-}
+fmi2::declare_fmi2_functions!();
 
 #[test]
 fn exported_api_reproduces_the_model() {

@@ -3,40 +3,10 @@
 
 use fmi2::*;
 use models::sensors::{SensorParams, Sensors, CHANNELS};
-use std::ffi::{c_char, CString};
+use std::ffi::CString;
 use std::ptr::null;
 
-extern "C" {
-    fn fmi2GetVersion() -> *const c_char;
-    fn fmi2Instantiate(
-        name: fmi2String,
-        kind: fmi2Type,
-        guid: fmi2String,
-        res: fmi2String,
-        f: *const fmi2CallbackFunctions,
-        visible: fmi2Boolean,
-        logging: fmi2Boolean,
-    ) -> fmi2Component;
-    fn fmi2FreeInstance(c: fmi2Component);
-    fn fmi2SetupExperiment(
-        c: fmi2Component,
-        a: fmi2Boolean,
-        b: f64,
-        s: f64,
-        d: fmi2Boolean,
-        e: f64,
-    ) -> fmi2Status;
-    fn fmi2EnterInitializationMode(c: fmi2Component) -> fmi2Status;
-    fn fmi2ExitInitializationMode(c: fmi2Component) -> fmi2Status;
-    fn fmi2SetReal(c: fmi2Component, vr: *const u32, n: usize, v: *const f64) -> fmi2Status;
-    fn fmi2SetInteger(c: fmi2Component, vr: *const u32, n: usize, v: *const i32) -> fmi2Status;
-    fn fmi2GetReal(c: fmi2Component, vr: *const u32, n: usize, v: *mut f64) -> fmi2Status;
-    fn fmi2DoStep(c: fmi2Component, t: f64, h: f64, p: fmi2Boolean) -> fmi2Status;
-    fn fmi2GetFMUstate(c: fmi2Component, s: *mut fmi2FMUstate) -> fmi2Status;
-    fn fmi2SetFMUstate(c: fmi2Component, s: fmi2FMUstate) -> fmi2Status;
-    fn fmi2FreeFMUstate(c: fmi2Component, s: *mut fmi2FMUstate) -> fmi2Status;
-    fn fmi2Terminate(c: fmi2Component) -> fmi2Status;
-}
+fmi2::declare_fmi2_functions!();
 
 fn vr(name: &str) -> u32 {
     use fmi2_export::FmuModel;
