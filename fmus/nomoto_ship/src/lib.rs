@@ -278,6 +278,16 @@ static VARIABLES: &[V] = &[
         |m| m.inputs.current_direction,
         |m, v| m.inputs.current_direction = v,
     ),
+    V::real_input(
+        "yaw_disturbance",
+        Some("rad"),
+        "Rudder-equivalent environmental disturbance delta_w added to the rudder in the \
+         dynamics (T' r'' + r' = K'(delta + delta_w)); e.g. Waves.yaw_moment through a \
+         converting connection gain. The thesis does not say how its sea-state-4 disturbance \
+         enters the hull (spec section 2.18)",
+        |m| m.inputs.yaw_disturbance,
+        |m, v| m.inputs.yaw_disturbance = v,
+    ),
     V::real_output(
         "sway_velocity",
         Some("m/s"),

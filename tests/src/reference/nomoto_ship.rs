@@ -12,7 +12,7 @@ fn case(
 ) -> std::io::Result<()> {
     writeln!(
         out,
-        "time,rudder_angle,current_speed,current_direction,sway_velocity,sway_velocity_prime,\
+        "time,rudder_angle,current_speed,current_direction,yaw_disturbance,sway_velocity,sway_velocity_prime,\
          yaw_rate,yaw_rate_prime,heading,x,y,speed_over_ground,time_prime"
     )?;
     for k in 0..=n {
@@ -21,10 +21,11 @@ fn case(
         let o = ship.outputs();
         writeln!(
             out,
-            "{t:?},{:?},{:?},{:?},{:?},{:?},{:?},{:?},{:?},{:?},{:?},{:?},{:?}",
+            "{t:?},{:?},{:?},{:?},{:?},{:?},{:?},{:?},{:?},{:?},{:?},{:?},{:?},{:?}",
             u.rudder,
             u.current_speed,
             u.current_direction,
+            u.yaw_disturbance,
             o.sway_velocity,
             o.v_prime,
             o.yaw_rate,
@@ -41,13 +42,14 @@ fn case(
     Ok(())
 }
 
-/// `model = 1` (DDG-51 Nomoto), rudder 0.1 sin(0.05 t), current 0.5 m/s toward 1 rad;
-/// h = 0.1 s, 300 s.
+/// `model = 1` (DDG-51 Nomoto), rudder 0.1 sin(0.05 t), current 0.5 m/s toward 1 rad,
+/// rudder-equivalent disturbance 0.02 sin(0.4 t); h = 0.1 s, 300 s.
 pub fn ddg51(out: &mut dyn Write) -> std::io::Result<()> {
     case(out, NomotoShip::ddg51(), 0.1, 3000, |t| NomotoInputs {
         rudder: 0.1 * (0.05 * t).sin(),
         current_speed: 0.5,
         current_direction: 1.0,
+        yaw_disturbance: 0.02 * (0.4 * t).sin(),
     })
 }
 
