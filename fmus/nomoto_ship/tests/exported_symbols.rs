@@ -74,21 +74,32 @@ unsafe fn check(model_preset: i32, mut model: NomotoShip, h: f64) {
     let c = instantiate();
     assert_eq!(fmi2SetInteger(c, &vr("model"), 1, &model_preset), fmi2OK);
     assert_eq!(fmi2ExitInitializationMode(c), fmi2OK);
-    let ins: Vec<u32> = ["rudder_angle", "current_speed", "current_direction"]
-        .iter()
-        .map(|n| vr(n))
-        .collect();
+    let ins: Vec<u32> = [
+        "rudder_angle",
+        "current_speed",
+        "current_direction",
+        "yaw_disturbance",
+    ]
+    .iter()
+    .map(|n| vr(n))
+    .collect();
     let outs: Vec<u32> = OUTPUTS.iter().map(|n| vr(n)).collect();
     for k in 0..1000 {
         let t = k as f64 * h;
-        let u = [0.1 * (0.05 * t).sin(), 0.5, 1.0 + 0.001 * t];
-        assert_eq!(fmi2SetReal(c, ins.as_ptr(), 3, u.as_ptr()), fmi2OK);
+        let u = [
+            0.1 * (0.05 * t).sin(),
+            0.5,
+            1.0 + 0.001 * t,
+            0.02 * (0.4 * t).cos(),
+        ];
+        assert_eq!(fmi2SetReal(c, ins.as_ptr(), 4, u.as_ptr()), fmi2OK);
         assert_eq!(fmi2DoStep(c, t, h, 1), fmi2OK);
         model.step(
             &NomotoInputs {
                 rudder: u[0],
                 current_speed: u[1],
                 current_direction: u[2],
+                yaw_disturbance: u[3],
             },
             h,
         );
