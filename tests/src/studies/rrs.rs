@@ -1,7 +1,9 @@
 //! Rudder roll stabilization (van der Klugt 1987, seed 003): systems/rrs.toml with RRS off
 //! (course keeping only, "ASA") and on, same seed; roll reduction 100(1 − σ²_on/σ²_off)
 //! (eq. 5.7); a sweep over steering-gear rate and wave direction for the trends of results R3-R5
-//! and R7 (spec rrs_controller_results.md §4.2).
+//! and R7 (spec rrs_controller_results.md §4.2); and a robustness run in which the same
+//! autopilot and filters, designed on the control model, steer the thesis's 22-knot simulation
+//! model (systems/rrs_simulation_plant.toml, [`simulation_plant`]).
 //!
 //! The thesis gives no sea state for its analog-model trials (Table 7.1): as the issue and the
 //! spec prescribe, the open-loop roll is tuned to the reported variances (16 and 47 deg²) by the
@@ -12,6 +14,9 @@ use shipsim::plot::{Panel, Table};
 
 const DEG: f64 = std::f64::consts::PI / 180.0;
 const SYSTEM: &str = "rrs.toml";
+/// The robustness system: plant = the 22-knot simulation model (RrsShip model 1, Tables 2.1/2.2)
+/// driven by the wave height; its wave connection gain (0.014670) is tuned for 16 deg² open loop.
+const SYSTEM_SIM: &str = "rrs_simulation_plant.toml";
 /// Statistics skip the start-up transient (filters, innovation process, adaptation).
 const SETTLE: f64 = 200.0;
 /// Wave roll gain of systems/rrs.toml: open-loop roll variance 16 deg² (Table 7.1, exp. 1),
@@ -65,18 +70,28 @@ fn stats(t: &Table) -> Result<RunStats, String> {
     })
 }
 
-/// One off/on pair with extra overrides; returns (off, on, tables).
+/// One off/on pair of systems/rrs.toml with extra overrides; returns (off, on, tables).
 fn pair(
     env: &Env,
     tag: &str,
     sets: &[String],
 ) -> Result<(RunStats, RunStats, Table, Table), String> {
+    pair_of(env, SYSTEM, tag, sets)
+}
+
+/// One off/on pair (same seeds) of `system` with extra overrides; returns (off, on, tables).
+fn pair_of(
+    env: &Env,
+    system: &str,
+    tag: &str,
+    sets: &[String],
+) -> Result<(RunStats, RunStats, Table, Table), String> {
     let mut off_sets = sets.to_vec();
     off_sets.push("autopilot.roll_mode=0".into());
-    let off = env.run(SYSTEM, &off_sets, &format!("{tag}_off.csv"))?;
+    let off = env.run(system, &off_sets, &format!("{tag}_off.csv"))?;
     let mut on_sets = sets.to_vec();
     on_sets.push("autopilot.roll_mode=1".into());
-    let on = env.run(SYSTEM, &on_sets, &format!("{tag}_on.csv"))?;
+    let on = env.run(system, &on_sets, &format!("{tag}_on.csv"))?;
     Ok((stats(&off)?, stats(&on)?, off, on))
 }
 
@@ -95,14 +110,23 @@ fn rate_sets(rate_deg_s: f64) -> Vec<String> {
 /// Off/on in beam seas at the system's defaults (experiment 1): the `cargo xtask demo` run.
 pub fn demo(env: &Env) -> Result<(RunStats, RunStats, std::path::PathBuf), String> {
     let (off, on, toff, ton) = pair(env, "exp1", &[])?;
-    let fig = overlay(env, &toff, &ton, "rrs_off_on.png")?;
+    let fig = overlay(env, &toff, &ton, "rrs_off_on.png", TITLE_EXP1)?;
     Ok((off, on, fig))
 }
 
-fn overlay(env: &Env, off: &Table, on: &Table, name: &str) -> Result<std::path::PathBuf, String> {
+const TITLE_EXP1: &str =
+    "RRS ship in beam seas, 15 deg/s gear, U = 11 m/s: RRS off (course keeping) vs on (400-600 s)";
+
+fn overlay(
+    env: &Env,
+    off: &Table,
+    on: &Table,
+    name: &str,
+    title: &str,
+) -> Result<std::path::PathBuf, String> {
     env.figure(
         name,
-        "RRS ship in beam seas, 15 deg/s gear, U = 11 m/s: RRS off (course keeping) vs on (400-600 s)",
+        title,
         &[
             Panel {
                 y_label: "roll [deg]".into(),
@@ -135,7 +159,7 @@ pub fn run(env: &Env) -> Result<Report, String> {
         title: "Rudder roll stabilization: Table 7.1 and the trends of R3-R5, R7".into(),
         source: "van der Klugt (1987) Table 7.1, §7.2-7.4 (seed 003; spec rrs_controller_results.md §4.2)"
             .into(),
-        systems: vec![SYSTEM.into()],
+        systems: vec![SYSTEM.into(), SYSTEM_SIM.into()],
         ..Default::default()
     };
     // Experiment 1: open loop tuned to 16 deg².
@@ -208,6 +232,8 @@ pub fn run(env: &Env) -> Result<Report, String> {
             && (on1.mean_roll - off1.mean_roll).abs() < 0.1 * off1.mean_roll
             && (on1.mean_rudder - off1.mean_rudder).abs() < 0.2,
     ));
+    // Robustness: the same autopilot and filters on the 22-knot simulation model.
+    let sim_fig = simulation_plant(env, &mut report, &off1, &on1)?;
     // Gear-rate sweep (R3, R5, R7: 6-7 deg/s too slow, 15 much better, 22 a little better).
     let mut by_rate = Vec::new();
     for rate in [7.0, 15.0, 22.0] {
@@ -321,10 +347,132 @@ pub fn run(env: &Env) -> Result<Report, String> {
          4 deg²); with the adaptation off and q_φ fixed at 30 the reductions are 71.5 % and 69.3 %."
             .into(),
     );
-    let fig = overlay(env, &toff1, &ton1, "rrs_off_on.png")?;
+    let fig = overlay(env, &toff1, &ton1, "rrs_off_on.png", TITLE_EXP1)?;
     report.figures.push((
         "Experiment 1: roll, heading and rudder with RRS off and on".into(),
         fig,
     ));
+    report.figures.push((
+        "Robustness: the same autopilot on the 22-knot simulation model (Tables 2.1/2.2), RRS off and on"
+            .into(),
+        sim_fig,
+    ));
     Ok(report)
+}
+
+/// Robustness run (systems/rrs_simulation_plant.toml): the autopilot and the roll/yaw filters,
+/// designed on the control model of Table 2.4 (evaluated at the plant's 22 kn), steer the
+/// thesis's 22-knot simulation model (Fig. 2.5, Tables 2.1/2.2) driven by the wave height
+/// through its own wave filters; wind as in rrs.toml; same seeds, RRS off and on. Pushes the
+/// checks and notes to `report`; `ctrl_off`/`ctrl_on` are experiment 1 on the control model (same
+/// sea, same tuned 16 deg²) for the comparison. Returns the overlay figure.
+///
+/// The thesis gives no roll reduction for this model: its digital simulations (PSI, §7.2.1, the
+/// model used is not named) appear only as Fig. 7.2 ("a reasonable roll reduction"). What it does report at 15 deg/s is
+/// 78 % and 68 % on the analog model (Table 7.1), "up to 60 %" on the MARIN simulator with ship 2
+/// (R5) and ≈ 60 % on the scale model and at full scale (R6-R8). The band checked is therefore
+/// the issue's 60-78 % for beam seas, 15 deg/s: from the thesis's typical ≈ 60 % on plants that
+/// differ from the control model to its best laboratory figure. The second check is the thesis's
+/// own criterion for the control model (§7.2): results on a plant with dynamics outside the
+/// control model must agree with those on the model itself. "Agree" is ±10 points: the seed
+/// spread of one plant is ±3 points (waves.seed 1-8, both systems: control model 69.3-73.8 %,
+/// simulation model 71.2-75.0 %, measured when this run was added), while the thesis's platforms
+/// at 15 deg/s spread over 18 points (60-78 %).
+fn simulation_plant(
+    env: &Env,
+    report: &mut Report,
+    ctrl_off: &RunStats,
+    ctrl_on: &RunStats,
+) -> Result<std::path::PathBuf, String> {
+    let (off, on, toff, ton) = pair_of(env, SYSTEM_SIM, "simplant", &[])?;
+    let red = reduction(&off, &on);
+    let red_ctrl = reduction(ctrl_off, ctrl_on);
+    let c = &mut report.checks;
+    c.push(Check::abs(
+        "simulation plant (Tables 2.1/2.2, 22 kn): open-loop (ASA) roll variance, tuned",
+        16.0,
+        off.roll_var,
+        0.5,
+        "deg²",
+    ));
+    c.push(Check::range(
+        "simulation plant: roll reduction with the control-model autopilot, 15 deg/s",
+        "no figure for this model (digital simulations, Fig. 7.2: \"a reasonable roll \
+         reduction\"); 15 deg/s: 78/68 % analog, ≤ 60 % MARIN ship 2, ≈ 60 % full scale; \
+         issue: 60-78 %",
+        red,
+        60.0,
+        78.0,
+        "%",
+    ));
+    c.push(Check::holds(
+        "simulation plant: reduction agrees with the control-model run (±10 points)",
+        "MARIN runs with dynamics outside the control model should agree with the laboratory \
+         simulations if the control model is sufficiently accurate (§7.2)",
+        format!("{red:.1} % vs {red_ctrl:.1} % on the control model (exp. 1, same sea)"),
+        (red - red_ctrl).abs() <= 10.0,
+    ));
+    c.push(Check::holds(
+        "simulation plant: course keeping and heel rejection survive the mismatch",
+        "course-keeping deterioration small (σ_ψ² ≤ 0.47 deg² in Table 7.1; ≤ 1 deg² here); \
+         constant heel not counteracted (§4.4, §6.3.1)",
+        format!(
+            "σ_ψ² {:.3} → {:.3} deg²; mean heel {:.2}° off / {:.2}° on",
+            off.heading_var, on.heading_var, off.mean_roll, on.mean_roll
+        ),
+        on.heading_var <= 1.0
+            && off.mean_roll > 1.0
+            && (on.mean_roll - off.mean_roll).abs() < 0.1 * off.mean_roll,
+    ));
+    report.notes.push(format!(
+        "Simulation plant (systems/{SYSTEM_SIM}), readings: σ²_φ {:.2} → {:.2} deg² ({red:.1} %; \
+         control model {:.2} → {:.2}, {red_ctrl:.1} %); σ²_ψ {:.3} → {:.3} deg² (control model \
+         {:.3} → {:.3}); σ²_δ {:.3} → {:.1} deg² (control model {:.1}; thesis exp. 1: 41); rate \
+         limiter active {:.1} s of 1000 s with RRS (control model {:.1} s); largest commanded \
+         rudder rate {:.2} deg/s; mean heel {:.2}° / {:.2}°, mean rudder {:.2}° / {:.2}° off / on.",
+        off.roll_var,
+        on.roll_var,
+        ctrl_off.roll_var,
+        ctrl_on.roll_var,
+        off.heading_var,
+        on.heading_var,
+        ctrl_off.heading_var,
+        ctrl_on.heading_var,
+        off.rudder_var,
+        on.rudder_var,
+        ctrl_on.rudder_var,
+        on.rate_saturated,
+        ctrl_on.rate_saturated,
+        on.max_command_rate,
+        off.mean_roll,
+        on.mean_roll,
+        off.mean_rudder,
+        on.mean_rudder
+    ));
+    report.notes.push(format!(
+        "Model mismatch of the robustness run: the filters and the innovation process use \
+         Table 2.4 at 22 kn (ω_n 0.63, z_n 0.107, k_dp −0.179, k_vp 2.38, k_dv 0.113, τ_v \
+         6.9 s, τ_r 1.15 s, k_vr −0.46, no yaw-to-sway coupling) while the plant is Table 2.1 \
+         (ω_n 0.64, z_n 0.094, k_dp −0.17, k_vp 3.7, k_dv 0.08, τ_v 9 s, τ_r 1.3 s, k_vr −0.7, \
+         k_rv 0.13), an independent identification of the same design at the same speed. The \
+         DC gains agree within 5 %, but at 0.63 rad/s the plant's |φ/δ| is 0.888 against \
+         0.822, with 7° more phase lead [derived from the tables]; its roll is less damped, \
+         and its sway state (the v_δ that the roll controller feeds back from the filter's \
+         open-loop submodel) has another scale and time constant. The waves enter through \
+         the Table 2.2 wave-height filters (roll directly and through sway, plus some yaw even \
+         at beam seas) instead of the rudder-equivalent w_φ of eq. 3.29. Their unit is \
+         unknown, so the elevation is scaled by a connection gain tuned for 16 deg² open loop \
+         (wind included), on the same sea (seed 1) as the control-model run. The plant's \
+         larger rudder effect at resonance and lower damping (more to gain from added damping) \
+         are the likely reasons why the reduction differs from the design-model run by \
+         {:+.1} points.",
+        red - red_ctrl
+    ));
+    overlay(
+        env,
+        &toff,
+        &ton,
+        "rrs_simulation_plant_off_on.png",
+        "22-kn simulation model, control-model autopilot, 15 deg/s: RRS off vs on (400-600 s)",
+    )
 }
