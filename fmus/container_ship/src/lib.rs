@@ -30,6 +30,8 @@ pub struct ContainerShipFmu {
     start_at_equilibrium: bool,
     initial_surge_velocity: f64,
     initial_shaft_speed: f64,
+    /// Initial sway velocity v [m/s] (variant 1).
+    initial_sway_velocity: f64,
     inputs: ContainerShipInputs,
     hull: Hull,
 }
@@ -50,6 +52,7 @@ impl Default for ContainerShipFmu {
             start_at_equilibrium: true,
             initial_surge_velocity: 8.0,
             initial_shaft_speed: DEFAULT_SHAFT_SPEED,
+            initial_sway_velocity: 0.0,
             inputs: ContainerShipInputs {
                 rudder_command: DEFAULT_RUDDER_COMMAND,
                 shaft_command_rpm: DEFAULT_SHAFT_SPEED,
@@ -96,9 +99,15 @@ impl ContainerShipFmu {
                 } else {
                     self.initial_surge_velocity
                 };
+                let v = self.initial_sway_velocity;
+                if !v.is_finite() {
+                    return Err(format!(
+                        "parameter initial_sway_velocity = {v} must be finite"
+                    ));
+                }
                 let ship = ContainerShip::new(
                     self.params.clone(),
-                    [u, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, n],
+                    [u, v, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, n],
                 )
                 .map_err(param_error)?;
                 Ok(Hull::Nonlinear(ship))
@@ -235,6 +244,15 @@ static VARIABLES: &[V] = &[
          speed (70 rpm: 7.32959 m/s, 80 rpm: 8.37667 m/s)",
         |m| m.initial_shaft_speed,
         |m, v| m.initial_shaft_speed = v,
+    ),
+    V::real_parameter(
+        "initial_sway_velocity",
+        Some("m/s"),
+        false,
+        "Variant 1: initial sway velocity v (to starboard; default 0). The DDG-51 thesis applies its \
+         5-kn current to the autopilot runs this way (spec ddg51_ekf_autopilot.md section 2.18)",
+        |m| m.initial_sway_velocity,
+        |m, v| m.initial_sway_velocity = v,
     ),
     V::real_parameter(
         "nominal_speed",
