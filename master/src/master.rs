@@ -8,8 +8,13 @@
 //! fmi2ExitInitializationMode -> { set inputs; fmi2DoStep(t_k, m*h); get outputs }* ->
 //! fmi2Terminate -> fmi2FreeInstance.
 //!
-//! Time grid: communication points are t_k = t0 + k*h with integer k (never accumulated).
-//! Instance i steps at every k divisible by its step multiple m_i, from t_k with size m_i*h.
+//! Time grid: communication points are computed from the integer step index k, never
+//! accumulated. When t0 and h are whole numbers of nanoseconds (the usual case) t_k is the double
+//! nearest to t0 + k*h taken exactly in nanoseconds, (t0_ns + k*h_ns)/1e9, which is how libcosim
+//! keeps its clock (integer ns; `to_double_time_point`), otherwise t0 + k*h. Instance i steps at
+//! every k divisible by its step multiple m_i, from t_k with size t_(k+m_i) - t_k, so that
+//! t + h is exactly the next communication point (libcosim's `to_double_duration` rule). With
+//! both rules shipsim hands every FMU bit-for-bit the times and step sizes libcosim does.
 //!
 //! Jacobi: every instance that steps at k takes its inputs from the outputs published at the
 //! last communication point; an instance's outputs are published when its own step ends
@@ -489,6 +494,7 @@ pub fn run(plan: &Plan, fmus: &[Arc<Fmu>], output: Output, opts: &RunOptions) ->
     };
     let loop_start = Instant::now();
     let n_steps = plan.n_steps;
+    let grid = TimeGrid::new(t0, h, n_steps);
     let dec = plan.decimation as u64;
     let events = &plan.events;
     let mut ev = 0usize;
@@ -498,7 +504,7 @@ pub fn run(plan: &Plan, fmus: &[Arc<Fmu>], output: Output, opts: &RunOptions) ->
     let order = &plan.order;
     let interrupt = opts.interrupt.clone();
     'outer: while k < n_steps {
-        let t = t0 + k as f64 * h;
+        let t = grid.at(k);
         if let Some(flag) = &interrupt {
             if flag.load(Ordering::Relaxed) {
                 if let Some(r) = rec.as_mut() {
@@ -528,7 +534,7 @@ pub fn run(plan: &Plan, fmus: &[Arc<Fmu>], output: Output, opts: &RunOptions) ->
                 }
                 for s in slots.iter_mut() {
                     if k % s.m == 0 {
-                        let Some(hi) = step_size(k, s.m, n_steps, s.var_step, t0, h) else {
+                        let Some(hi) = grid.step_size(k, s.m, n_steps, s.var_step) else {
                             continue;
                         };
                         fmu_steps += 1;
@@ -560,7 +566,7 @@ pub fn run(plan: &Plan, fmus: &[Arc<Fmu>], output: Output, opts: &RunOptions) ->
                             .map_err(|err| at_time(err, t, &e.name))?;
                     }
                     if k % s.m == 0 {
-                        if let Some(hi) = step_size(k, s.m, n_steps, s.var_step, t0, h) {
+                        if let Some(hi) = grid.step_size(k, s.m, n_steps, s.var_step) {
                             fmu_steps += 1;
                             if let StepOutcome::Terminated {
                                 last_successful_time,
@@ -580,13 +586,13 @@ pub fn run(plan: &Plan, fmus: &[Arc<Fmu>], output: Output, opts: &RunOptions) ->
         k += 1;
         if let Some(r) = rec.as_mut() {
             if k % dec == 0 || k == n_steps || terminated_by.is_some() {
-                r.row(t0 + k as f64 * h, &vals).map_err(io_err)?;
+                r.row(grid.at(k), &vals).map_err(io_err)?;
             }
         }
         if let Some(pb) = &progress {
             if k & 0xfff == 0 {
                 pb.set_position(k);
-                pb.set_message(format!("{:.2}", t0 + k as f64 * h));
+                pb.set_message(format!("{:.2}", grid.at(k)));
             }
         }
         if terminated_by.is_some() {
@@ -613,7 +619,7 @@ pub fn run(plan: &Plan, fmus: &[Arc<Fmu>], output: Output, opts: &RunOptions) ->
         macro_steps: k,
         fmu_steps,
         start_time: t0,
-        end_time: t0 + k as f64 * h,
+        end_time: grid.at(k),
         wall_time: wall,
         total_wall_time: t_begin.elapsed(),
         rows,
@@ -622,16 +628,50 @@ pub fn run(plan: &Plan, fmus: &[Arc<Fmu>], output: Output, opts: &RunOptions) ->
     })
 }
 
-/// Step size of an instance stepping at k: m*h, shortened at the end of the run if the FMU can
-/// take a variable step, else None (the last partial step is dropped).
-#[inline]
-fn step_size(k: u64, m: u64, n_steps: u64, var_step: bool, t0: f64, h: f64) -> Option<f64> {
-    if k + m <= n_steps {
-        Some(m as f64 * h)
-    } else if var_step {
-        Some((t0 + n_steps as f64 * h) - (t0 + k as f64 * h))
-    } else {
-        None
+/// The communication points t_k (module documentation).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TimeGrid {
+    t0: f64,
+    h: f64,
+    /// (t0, h) in whole nanoseconds, when both are and t_n stays exact in an i64.
+    ns: Option<(i64, i64)>,
+}
+
+impl TimeGrid {
+    /// The grid from t0 with base step h over `n_steps` steps.
+    pub fn new(t0: f64, h: f64, n_steps: u64) -> TimeGrid {
+        let whole_ns = |x: f64| {
+            let n = (x * 1e9).round();
+            (n.abs() < 1e15 && n / 1e9 == x).then_some(n as i64)
+        };
+        let ns = match (whole_ns(t0), whole_ns(h)) {
+            (Some(a), Some(b)) if b > 0 && (n_steps as f64) * (b as f64) < 4e18 => Some((a, b)),
+            _ => None,
+        };
+        TimeGrid { t0, h, ns }
+    }
+
+    /// t_k.
+    #[inline]
+    pub fn at(&self, k: u64) -> f64 {
+        match self.ns {
+            Some((t0, h)) => (t0 + k as i64 * h) as f64 / 1e9,
+            None => self.t0 + k as f64 * self.h,
+        }
+    }
+
+    /// Step size of an instance stepping at k with step multiple m: t_(k+m) - t_k, shortened to
+    /// t_n - t_k at the end of the run if the FMU can take a variable step, else None (the last
+    /// partial step is dropped).
+    #[inline]
+    pub fn step_size(&self, k: u64, m: u64, n_steps: u64, var_step: bool) -> Option<f64> {
+        if k + m <= n_steps {
+            Some(self.at(k + m) - self.at(k))
+        } else if var_step {
+            Some(self.at(n_steps) - self.at(k))
+        } else {
+            None
+        }
     }
 }
 

@@ -16,8 +16,9 @@ fn run_file(path: &std::path::Path, out: &std::path::Path) -> shipsim::master::S
 }
 
 /// Controller every 10 base steps, plant every base step; after 1e6 steps the grid is exact:
-/// every communication point each FMU received equals t0 + k*h (computed in the FMU with its own
-/// integer step count), and the final time is exactly t0 + 1e6*h.
+/// every communication point each FMU received equals t_k = (t0_ns + k h_ns)/1e9, libcosim's
+/// nanosecond clock (computed in the FMU with its own integer step count), each step starts
+/// exactly where the previous one ended (t + h), and the final time is exactly t_(1e6).
 #[test]
 fn multi_rate_time_grid_is_exact_after_a_million_steps() {
     let d = tempfile::tempdir().unwrap();
@@ -52,7 +53,9 @@ decimation = 100000
     let (h, rows) = read_csv(&out);
     assert_eq!(rows.len(), 11);
     let last = rows.last().unwrap();
-    let t_end = 0.3 + 1_000_000f64 * 0.001;
+    let t_ns = |k: u64| (300_000_000 + k * 1_000_000) as f64 / 1e9;
+    let t_end = t_ns(1_000_000);
+    assert_eq!(t_end, 1000.3);
     assert_eq!(last[0], t_end, "time column");
     assert_eq!(last[col(&h, "plant.t_last")], t_end);
     assert_eq!(last[col(&h, "ctrl.t_last")], t_end);
@@ -61,7 +64,7 @@ decimation = 100000
     assert_eq!(last[col(&h, "plant.steps")], 1_000_000.0);
     assert_eq!(last[col(&h, "ctrl.steps")], 100_000.0);
     for (j, r) in rows.iter().enumerate() {
-        assert_eq!(r[0], 0.3 + (j as u64 * 100_000) as f64 * 0.001);
+        assert_eq!(r[0], t_ns(j as u64 * 100_000));
     }
 }
 

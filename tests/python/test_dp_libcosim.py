@@ -7,14 +7,11 @@ paper's open-loop simulation study (Eq. 61 thrust, Markov bias with T = 1000 s) 
 tests/src/studies/dp_observer.rs runs it. The stop time is shortened to 1200 s and every base
 step recorded (decimation 1) so that each libcosim step is compared.
 
-Tolerance 1e-9 (relative to max(1, |value|)), NOT the project's 1e-12, and why: the two runs are
-bit-identical for the first base steps, then the ship's state differs by one ulp (first seen at
-t = 0.3 s with extra recorded variables, t = 3 s in the observer otherwise) although every
-recorded input agrees bit for bit; the cause was not found in the time available (open). The
-closed loop (observer integrators, PID integral) carries that ulp and the bias output
-J M J^T b_hat (a difference of 1e7-sized terms) shows it most: measured worst 1.9e-10 (closed
-loop, observer.bias_east_estimate at t = 1138 s) and 2.7e-11 (open loop); 1e-12 is exceeded first
-at t = 173 s. A real semantic difference (a value from another time) would show at 1e-3 or more.
+Tolerance 0: the runs are bit-identical. (They were not while shipsim handed the FMUs t0 + k*h and
+h itself while libcosim hands its nanosecond clock's t_k and fl(t_k+1) - fl(t_k): the ship's state
+then differed by one ulp from t = 0.3 s, and the closed loop carried it to 2e-10 in the bias
+estimate J M J^T b_hat, a difference of 1e7-sized terms. shipsim now keeps libcosim's clock,
+master/src/master.rs TimeGrid.)
 
 Environment: SHIPSIM_BIN (the master), SHIPSIM_FMU_DIR (our built FMUs).
 """
@@ -81,5 +78,5 @@ def test_dp_observer_equals_libcosim(tmp_path, changes, label):
     assert max(meas) - min(meas) > 5.0, label
     assert max(abs(r[col["observer.bias_north_estimate"]]) for r in rows) > 1e4, label
     assert max(abs(r[col["dp.tau_surge"]]) for r in rows[10:]) > 500.0, label
-    worst = assert_same_as_libcosim(osp, out, tol=1e-9)
+    worst = assert_same_as_libcosim(osp, out, tol=0.0)
     print(f"{label}: worst |shipsim - libcosim| = {worst:.3e}")

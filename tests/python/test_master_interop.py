@@ -58,7 +58,7 @@ def libcosim_rows(osp_file, header, n_steps):
     return json.loads(r.stdout)
 
 
-def assert_same_as_libcosim(osp_file, our_csv, tol=1e-12):
+def assert_same_as_libcosim(osp_file, our_csv, tol=0.0):
     header, ours = read_csv(our_csv)
     theirs = libcosim_rows(osp_file, header, len(ours) - 1)
     worst = 0.0

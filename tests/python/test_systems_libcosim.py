@@ -67,24 +67,13 @@ COVERED = {
 MAX_STEPS = 6000
 
 # Tolerance of assert_same_as_libcosim (|shipsim - libcosim| <= tol * max(1, |libcosim|) at every
-# recorded step): the project's 1e-12 unless listed here with the reason.
-#
-# Why the two runs are not always bit-identical: libcosim keeps time in integer nanoseconds and
-# calls fmi2DoStep with t_k = k*h_ns/1e9 and the step size fl(t_k+1) - fl(t_k) (its
-# to_double_duration), shipsim with t0 + k*h and h itself. For h = 0.05 the two agree at k = 0, 1
-# and differ by one ulp from k = 2 (0.15 - 0.1 = 0.04999999999999999): that is where the first
-# differing values appear (t = 0.15 s; with h = 0.1 at t = 0.3 s or 0.4 s; at h = 0.5, a power of
-# two, identification_zigzag is bit-identical). Integration and feedback carry these ulps; they
-# stay below 1e-12 relative in all systems but one:
-TOLERANCE = {
-    # Measured worst 4.2e-12 (ship.y, sensors.cross_track_measured, ctl.cross_track_reference_used
-    # near -1 m at t = 318-329 s): the cosine ramp of the lateral offset, 0.5 (1 - cos(pi x)) for
-    # small x, turns the ulp difference in the controller's clock into a 5e-10 relative difference
-    # of the reference (first at t = 300.15 s), which the loop carries into a cross-track of about
-    # 100 m scale that passes through zero; 4e-12 m there is 4e-14 of that scale. A semantic
-    # difference (a value from another step, an event one step off) shows at 1e-4 or more.
-    "autopilot_track_offset.toml": 1e-10,
-}
+# recorded step): 0, the runs are bit-identical. libcosim keeps time in integer nanoseconds and
+# calls fmi2DoStep with t_k = (t0_ns + k h_ns)/1e9 and the step size fl(t_k+1) - fl(t_k) (its
+# to_double_duration); shipsim uses the same clock (master/src/master.rs, TimeGrid). Before it
+# did (t0 + k*h and h itself) the runs differed by ulps from the third step of h = 0.05 on
+# (0.15 - 0.1 = 0.04999999999999999), which integration and feedback carried up to 4e-12
+# relative (autopilot_track_offset) and 2e-10 (dp_observer). Empty: no system needs an exception.
+TOLERANCE = {}
 
 # Some systems need more than MAX_STEPS to reach what they are about: {system: stop time}.
 STOP_TIME = {
@@ -254,7 +243,7 @@ def test_system_equals_libcosim(system, tmp_path, monkeypatch):
         assert "scenario event(s) are not part of OspSystemStructure.xml" in r.stderr
         scenario = write_scenario(system, spec, tmp_path / "scenario.json")
         monkeypatch.setattr(test_master_interop, "libcosim_rows", libcosim_rows_with_scenario(scenario))
-    worst = assert_same_as_libcosim(osp, out, tol=TOLERANCE.get(system, 1e-12))
+    worst = assert_same_as_libcosim(osp, out, tol=TOLERANCE.get(system, 0.0))
     print(f"{system}: {n} steps, {len(header) - 1} columns, worst |shipsim - libcosim| = {worst:.3e}, "
           f"{time.perf_counter() - start:.1f} s")
 

@@ -2,8 +2,10 @@
  *
  * Real:    0 u (input)  1 y (output, y = x, dx/dt = k*u, explicit Euler over each step)
  *          2 k (parameter)  3 t_last (output: t+h of the last step)
- *          4 grid_error (output: max |t - (t0 + (n*m)*base_step)| over all steps, where n is the
- *            number of steps taken and m = round(h/base_step); exactly 0 on an exact grid)
+ *          4 grid_error (output: max over all steps of |t - t_(n*m)| with the nanosecond grid
+ *            t_j = (round(t0 1e9) + j round(base_step 1e9))/1e9, n the number of steps taken and
+ *            m = round(h/base_step), and of |t - (t_prev + h_prev)|; exactly 0 on an exact,
+ *            contiguous grid)
  *          5 base_step (parameter, 0 = no grid check)  6 y2 (output, y2 = k*u, feed-through)
  * Integer: 0 steps (output)  1 fail_at_step (parameter: fmi2DoStep returns fmi2Error at that
  *          step, -1 = never)  2 n_in (input)  3 n_out (output, n_out = n_in)
@@ -197,8 +199,10 @@ EXPORT fmi2Status fmi2DoStep(fmi2Component c, fmi2Real t, fmi2Real h, fmi2Boolea
     }
     if (p->r[5] > 0) {
         long m = lround(h / p->r[5]);
-        double expected = p->t0 + (double)(p->n * m) * p->r[5];
+        long long j = (long long)p->n * m;
+        double expected = (double)(llround(p->t0 * 1e9) + j * llround(p->r[5] * 1e9)) / 1e9;
         double err = fabs(t - expected);
+        if (p->n > 0 && fabs(t - p->r[3]) > err) err = fabs(t - p->r[3]);
         if (err > p->r[4]) p->r[4] = err;
     }
 #ifdef LOG_EVERY_STEP
