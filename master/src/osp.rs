@@ -435,10 +435,13 @@ pub fn write(sys: &System, out: &Path) -> Result<Vec<String>> {
     if sys.algorithm == Algorithm::GaussSeidel {
         warnings.push("libcosim's fixedStep algorithm is Jacobi-type; the Gauss-Seidel setting is not carried over".to_string());
     }
+    let scenario_path = out.with_file_name("scenario.json");
     if !sys.events.is_empty() {
         warnings.push(format!(
-            "{} scenario event(s) are not part of OspSystemStructure.xml and are not exported",
-            sys.events.len()
+            "{} scenario event(s) are not part of OspSystemStructure.xml: written to {} (libcosim \
+             scenario: `cosim run --scenario`, libcosimpy `CosimExecution.load_scenario`)",
+            sys.events.len(),
+            scenario_path.display()
         ));
     }
     if sys.output.file.is_some() || sys.output.variables.is_some() {
@@ -534,6 +537,61 @@ pub fn write(sys: &System, out: &Path) -> Result<Vec<String>> {
         x.push_str("    </Connections>\n");
     }
     x.push_str("</OspSystemStructure>\n");
+    if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir)
+            .map_err(|e| Error::io(format!("creating {}", dir.display()), e))?;
+    }
     std::fs::write(out, x).map_err(|e| Error::io(format!("writing {}", out.display()), e))?;
+    if !plan.events.is_empty() {
+        std::fs::write(&scenario_path, scenario_json(sys, &plan))
+            .map_err(|e| Error::io(format!("writing {}", scenario_path.display()), e))?;
+    }
     Ok(warnings)
+}
+
+/// The system's events as a libcosim scenario (JSON): each event an "override" of the variable at
+/// its time relative to the start, and "end" = the run's end. Without "end" libcosim ends the
+/// scenario after its last event and resets the overridden variables (a variable with an initial
+/// value falls back to it), unlike shipsim, where a set value stays.
+fn scenario_json(sys: &System, plan: &crate::system::Plan) -> String {
+    use crate::system::TypedValue;
+    let mut j = String::from("{\n  \"description\": \"events of ");
+    j.push_str(&json_esc(&sys.source.display().to_string()));
+    j.push_str(", written by shipsim export-osp\",\n  \"events\": [");
+    for (i, e) in plan.events.iter().enumerate() {
+        let (inst, var) = e.name.split_once('.').unwrap_or(("", e.name.as_str()));
+        let value = match &e.value {
+            TypedValue::Real(v) => format!("{v:?}"),
+            TypedValue::Integer(v) => v.to_string(),
+            TypedValue::Boolean(v) => v.to_string(),
+            TypedValue::String(v) => format!("\"{}\"", json_esc(v)),
+        };
+        let time = e.step as f64 * plan.step_size;
+        let _ = write!(
+            j,
+            "{}\n    {{\"time\": {time:?}, \"model\": \"{}\", \"variable\": \"{}\", \"action\": \"override\", \"value\": {value}}}",
+            if i == 0 { "" } else { "," },
+            json_esc(inst),
+            json_esc(var)
+        );
+    }
+    let _ = write!(
+        j,
+        "\n  ],\n  \"end\": {:?}\n}}\n",
+        plan.stop_time - plan.start_time
+    );
+    j
+}
+
+fn json_esc(s: &str) -> String {
+    let mut o = String::with_capacity(s.len());
+    for c in s.chars() {
+        match c {
+            '"' => o.push_str("\\\""),
+            '\\' => o.push_str("\\\\"),
+            c if (c as u32) < 0x20 => o.push_str(&format!("\\u{:04x}", c as u32)),
+            c => o.push(c),
+        }
+    }
+    o
 }

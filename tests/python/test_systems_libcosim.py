@@ -12,15 +12,14 @@ FMUs from SHIPSIM_FMU_DIR), the run is cut to at most MAX_STEPS base steps (long
 cut keeps the part where the system does something, checked below), every base step is recorded
 (decimation 1, as libcosim_runner.py records every step), then shipsim runs it, exports it, and
 libcosim runs the exported OspSystemStructure.xml; test_master_interop.assert_same_as_libcosim
-compares every recorded value at every step to 1e-12 relative to max(1, |value|) (one system
-needs more, see TOLERANCE for why).
+compares every recorded value at every step: they are bit-identical (see TOLERANCE for why).
 
 What OspSystemStructure.xml cannot carry, and what is done about it:
 * [[events]] (timed changes of an input or tunable parameter): the OSP system structure has no
-  scenario; `export-osp` warns and leaves them out (master/src/osp.rs). libcosim's own place for
-  them is a scenario file next to the system structure (what `cosim run --scenario` loads). The
-  test writes the events as a libcosim scenario (action "override", same time, same value) and
-  runs the exported file with it through libcosim's scenario manager, so the systems with events
+  scenario; `export-osp` writes them to scenario.json next to it, libcosim's own place for them
+  (what `cosim run --scenario` loads). The test checks that file against its own reading of the
+  system's events (action "override", same time, same value) and runs the exported system with
+  it through libcosim's scenario manager, so the systems with events
   are compared in full, not excluded. shipsim sets an event's value before the step that starts
   at the event time; libcosim's scenario manager applies it at the same step's start
   (step_commencing). The override holds to the end, a shipsim event sets the value once: the
@@ -241,7 +240,14 @@ def test_system_equals_libcosim(system, tmp_path, monkeypatch):
             csv.writer(f).writerows([[header[j] for j in real]] + [[repr(r[j]) for j in real] for r in rows])
     if spec.get("events"):
         assert "scenario event(s) are not part of OspSystemStructure.xml" in r.stderr
-        scenario = write_scenario(system, spec, tmp_path / "scenario.json")
+        # export-osp writes the events as a libcosim scenario next to the system structure; it
+        # must say what this file's own reading of the system file says
+        scenario = tmp_path / "scenario.json"
+        exported = json.loads(scenario.read_text())
+        expected = json.loads(write_scenario(system, spec, tmp_path / "expected_scenario.json").read_text())
+        for d in (exported, expected):
+            d.pop("description")
+        assert exported == expected
         monkeypatch.setattr(test_master_interop, "libcosim_rows", libcosim_rows_with_scenario(scenario))
     worst = assert_same_as_libcosim(osp, out, tol=TOLERANCE.get(system, 0.0))
     print(f"{system}: {n} steps, {len(header) - 1} columns, worst |shipsim - libcosim| = {worst:.3e}, "

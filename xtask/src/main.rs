@@ -5,6 +5,8 @@
 //! * `test`: Rust tests, FMUs, a Python venv under `target/venv` with FMPy and libcosimpy, and
 //!   the Python checks in `tests/python`.
 //! * `demo`: the default coupled system (see README).
+//! * `export-osp`: every system file of systems/ as target/osp/<name>/OspSystemStructure.xml
+//!   (+ scenario.json for its events) for libcosim / cosim-cli.
 
 mod fmu;
 
@@ -20,6 +22,7 @@ fn main() {
         Some("demo") => demo(),
         Some("bench") => bench(&args[1..]),
         Some("report") => report(args.get(1).map(String::as_str)),
+        Some("export-osp") => export_osp(),
         _ => {
             eprintln!(
                 "usage: cargo xtask <task>\n\n\
@@ -28,6 +31,7 @@ fn main() {
                  test         run every test: Rust, FMU packaging, FMPy and libcosim checks\n  \
                  demo         run the default coupled system\n  \
                  report [DIR] run every coupled system and write the validation report (target/report)\n  \
+                 export-osp   every system of systems/ as target/osp/<name>/OspSystemStructure.xml for libcosim\n  \
                  bench        master overhead per FMU-step: shipsim vs libcosim vs FMPy (master/bench)"
             );
             std::process::exit(2);
@@ -145,6 +149,41 @@ fn report(dir: Option<&str>) -> Result<()> {
         .current_dir(&root)
         .arg(root.join(dir.unwrap_or("target/report")))
         .env("SHIPSIM_FMU_DIR", fmu_dir))
+}
+
+/// Builds the FMUs and shipsim, then exports every systems/*.toml with `shipsim export-osp` to
+/// target/osp/<name>/OspSystemStructure.xml (FMU paths relative to it, into target/fmu).
+fn export_osp() -> Result<()> {
+    let root = workspace_root();
+    fmu::build_fmus(&root)?;
+    run(cargo()
+        .current_dir(&root)
+        .args(["build", "--release", "-p", "shipsim", "--bins"]))?;
+    let mut systems: Vec<PathBuf> = std::fs::read_dir(root.join("systems"))?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+        .collect();
+    systems.sort();
+    for sys in &systems {
+        let name = sys.file_stem().and_then(|s| s.to_str()).unwrap_or("system");
+        let out = root
+            .join("target/osp")
+            .join(name)
+            .join("OspSystemStructure.xml");
+        run(Command::new(root.join("target/release/shipsim"))
+            .current_dir(&root)
+            .arg("export-osp")
+            .arg(sys)
+            .arg("-o")
+            .arg(&out))?;
+    }
+    eprintln!(
+        "xtask: {} systems exported under {}; run one with `cosim run target/osp/<name>` or \
+         libcosimpy's CosimExecution.from_osp_config_file",
+        systems.len(),
+        root.join("target/osp").display()
+    );
+    Ok(())
 }
 
 /// Runs master/bench/bench_master.py in the project venv (extra arguments are passed on).
