@@ -57,6 +57,39 @@ fn max_window_p2p(v: &[f64], n: usize) -> f64 {
         .fold(0.0, f64::max)
 }
 
+/// Commanded (`cmd`) and actual rudder angle [deg].
+fn rudder_panel(t: &Table, cmd: &str) -> Result<Panel, String> {
+    Ok(Panel {
+        y_label: "rudder [deg]".into(),
+        series: vec![
+            series(t, cmd, "commanded", 1.0 / DEG)?,
+            series(t, "gear.rudder_angle", "actual", 1.0 / DEG)?,
+        ],
+    })
+}
+
+/// Commanded and actual heading [deg] of the heading autopilot.
+fn heading_panel(t: &Table) -> Result<Panel, String> {
+    Ok(Panel {
+        y_label: "heading [deg]".into(),
+        series: vec![
+            series(t, "ap.heading_reference_used", "commanded", 1.0 / DEG)?,
+            series(t, "ship.heading", "actual", 1.0 / DEG)?,
+        ],
+    })
+}
+
+/// Range (max − min) of the actual rudder over t0 ≤ t < t1 [deg].
+fn rudder_sweep(t: &Table, t0: f64, t1: f64) -> Result<f64, String> {
+    let (time, rud) = (t.time(), col(t, "gear.rudder_angle")?);
+    let turn: Vec<f64> = (0..time.len())
+        .filter(|&k| (t0..t1).contains(&time[k]))
+        .map(|k| rud[k] / DEG)
+        .collect();
+    Ok(turn.iter().cloned().fold(f64::MIN, f64::max)
+        - turn.iter().cloned().fold(f64::MAX, f64::min))
+}
+
 pub fn run(env: &Env) -> Result<Report, String> {
     let mut report = Report {
         id: "autopilot".into(),
@@ -180,13 +213,7 @@ fn current_rejection(env: &Env, report: &mut Report) -> Result<(), String> {
                     series(&t, "ship.heading", "actual", 1.0 / DEG)?,
                 ],
             },
-            Panel {
-                y_label: "rudder [deg]".into(),
-                series: vec![
-                    series(&t, "ap.rudder_command", "commanded", 1.0 / DEG)?,
-                    series(&t, "gear.rudder_angle", "actual", 1.0 / DEG)?,
-                ],
-            },
+            rudder_panel(&t, "ap.rudder_command")?,
         ],
     )?;
     report
@@ -227,13 +254,7 @@ fn track_change(env: &Env, report: &mut Report) -> Result<(), String> {
         1.0,
         "%",
     ));
-    let rud = col(&t, "gear.rudder_angle")?;
-    let turn: Vec<f64> = (0..time.len())
-        .filter(|&k| (40.0..300.0).contains(&time[k]))
-        .map(|k| rud[k] / DEG)
-        .collect();
-    let sweep = turn.iter().cloned().fold(f64::MIN, f64::max)
-        - turn.iter().cloned().fold(f64::MAX, f64::min);
+    let sweep = rudder_sweep(&t, 40.0, 300.0)?;
     let _ = (y, yd);
     report.notes.push(format!(
         "AT-8: the ramp rate and leg length are not given; we use 1 deg/s and a 600 s leg. On the \
@@ -247,13 +268,7 @@ fn track_change(env: &Env, report: &mut Report) -> Result<(), String> {
         "autopilot_track_change.png",
         "Heading autopilot, 90 deg track change (AT-8)",
         &[
-            Panel {
-                y_label: "heading [deg]".into(),
-                series: vec![
-                    series(&t, "ap.heading_reference_used", "commanded", 1.0 / DEG)?,
-                    series(&t, "ship.heading", "actual", 1.0 / DEG)?,
-                ],
-            },
+            heading_panel(&t)?,
             Panel {
                 y_label: "x (north) [L]".into(),
                 series: vec![
@@ -265,13 +280,7 @@ fn track_change(env: &Env, report: &mut Report) -> Result<(), String> {
                     },
                 ],
             },
-            Panel {
-                y_label: "rudder [deg]".into(),
-                series: vec![
-                    series(&t, "ap.rudder_command", "commanded", 1.0 / DEG)?,
-                    series(&t, "gear.rudder_angle", "actual", 1.0 / DEG)?,
-                ],
-            },
+            rudder_panel(&t, "ap.rudder_command")?,
         ],
     )?;
     report.figures.push((
@@ -366,13 +375,7 @@ fn current_rejection_nonlinear(env: &Env, report: &mut Report) -> Result<(), Str
                 y_label: "heading [deg]".into(),
                 series: vec![series(&t, "ship.heading", "heading", 1.0 / DEG)?],
             },
-            Panel {
-                y_label: "rudder [deg]".into(),
-                series: vec![
-                    series(&t, "ap.rudder_command", "commanded", 1.0 / DEG)?,
-                    series(&t, "gear.rudder_angle", "actual", 1.0 / DEG)?,
-                ],
-            },
+            rudder_panel(&t, "ap.rudder_command")?,
         ],
     )?;
     report.figures.push((
@@ -423,13 +426,7 @@ fn track_change_nonlinear(env: &Env, report: &mut Report) -> Result<(), String> 
         ),
         xte2.abs() < xte1.abs(),
     ));
-    let rud = col(&t, "gear.rudder_angle")?;
-    let turn: Vec<f64> = (0..time.len())
-        .filter(|&k| (40.0..300.0).contains(&time[k]))
-        .map(|k| rud[k] / DEG)
-        .collect();
-    let sweep = turn.iter().cloned().fold(f64::MIN, f64::max)
-        - turn.iter().cloned().fold(f64::MAX, f64::min);
+    let sweep = rudder_sweep(&t, 40.0, 300.0)?;
     report.checks.push(Check::range(
         "AT-8 (nonlinear plant) rudder sweep in the first turn (1 deg/s ramp)",
         "≈ 20 deg over ≈ 3 min (L2519-2536); band ±25 %",
@@ -470,13 +467,7 @@ fn track_change_nonlinear(env: &Env, report: &mut Report) -> Result<(), String> 
         "autopilot_track_change_nonlinear.png",
         "Heading autopilot on the nonlinear plant, 90 deg track change (AT-8)",
         &[
-            Panel {
-                y_label: "heading [deg]".into(),
-                series: vec![
-                    series(&t, "ap.heading_reference_used", "commanded", 1.0 / DEG)?,
-                    series(&t, "ship.heading", "actual", 1.0 / DEG)?,
-                ],
-            },
+            heading_panel(&t)?,
             Panel {
                 y_label: "north offset from dead reckoning [L]".into(),
                 series: vec![Series {
@@ -489,13 +480,7 @@ fn track_change_nonlinear(env: &Env, report: &mut Report) -> Result<(), String> 
                 y_label: "speed [m/s]".into(),
                 series: vec![series(&t, "ship.speed", "speed", 1.0)?],
             },
-            Panel {
-                y_label: "rudder [deg]".into(),
-                series: vec![
-                    series(&t, "ap.rudder_command", "commanded", 1.0 / DEG)?,
-                    series(&t, "gear.rudder_angle", "actual", 1.0 / DEG)?,
-                ],
-            },
+            rudder_panel(&t, "ap.rudder_command")?,
         ],
     )?;
     report.figures.push((
@@ -616,13 +601,7 @@ fn track_offset(env: &Env, report: &mut Report) -> Result<(), String> {
                 y_label: "heading [deg]".into(),
                 series: vec![series(&t, "ship.heading", "heading", 1.0 / DEG)?],
             },
-            Panel {
-                y_label: "rudder [deg]".into(),
-                series: vec![
-                    series(&t, "ctl.rudder_command", "commanded", 1.0 / DEG)?,
-                    series(&t, "gear.rudder_angle", "actual", 1.0 / DEG)?,
-                ],
-            },
+            rudder_panel(&t, "ctl.rudder_command")?,
         ],
     )?;
     report
