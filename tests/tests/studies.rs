@@ -37,3 +37,8 @@ fn dgps_trial() {
 fn autopilot() {
     check("autopilot");
 }
+
+#[test]
+fn path_estimation() {
+    check("path_estimation");
+}

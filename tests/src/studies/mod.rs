@@ -10,6 +10,7 @@ pub mod autopilot;
 pub mod dgps_trial;
 pub mod dp_observer;
 pub mod path_control;
+pub mod path_estimation;
 pub mod rrs;
 pub mod steering_gear;
 
@@ -23,6 +24,7 @@ pub const STUDIES: &[Study] = &[
     ("rrs", rrs::run),
     ("path_control", path_control::run),
     ("autopilot", autopilot::run),
+    ("path_estimation", path_estimation::run),
 ];
 
 /// Runs the study `id` in `target/studies/<id>/`.
