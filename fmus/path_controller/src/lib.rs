@@ -71,7 +71,7 @@ fn adaptation_code(a: Adaptation) -> i32 {
     }
 }
 
-static VARIABLES: [V; 50] = [
+static VARIABLES: [V; 54] = [
     // ---- design (0..13)
     V::real_parameter(
         "design_depth_ratio",
@@ -462,6 +462,32 @@ static VARIABLES: [V; 50] = [
         None,
         "Number of gain re-designs since the start",
         |m| m.ctl.updates() as f64,
+    ),
+    // ---- the rest of the current design (appended: earlier value references unchanged), for
+    // the PathKalmanFilter's f*_design inputs (004 Fig. 1: C, K and the filter model together)
+    V::real_output(
+        "design_f22",
+        None,
+        "f22 of the current design",
+        |m| m.ctl.coefficients().f22,
+    ),
+    V::real_output(
+        "design_f32",
+        None,
+        "f32 of the current design",
+        |m| m.ctl.coefficients().f32,
+    ),
+    V::real_output(
+        "design_f33",
+        None,
+        "f33 of the current design",
+        |m| m.ctl.coefficients().f33,
+    ),
+    V::real_output(
+        "design_f35",
+        None,
+        "f35 of the current design",
+        |m| m.ctl.coefficients().f35,
     ),
 ];
 

@@ -2,7 +2,7 @@
 //! Tokyo Maru 7-state design model (`models::observers::path_kalman`). No physics here.
 
 use fmi2_export::{export_fmu, DefaultExperiment, FmuModel, Variable};
-use models::hull::tokyo_maru::{L, U};
+use models::hull::tokyo_maru::{TokyoMaruCoefficients, L, U};
 use models::observers::path_kalman::{PathKalmanConfig, PathKalmanFilter};
 use serde::{Deserialize, Serialize};
 
@@ -19,12 +19,17 @@ pub struct PathKalmanFilterFmu {
     /// Inputs: ψ, r, η measured; δ_c.
     z: [f64; 3],
     command: f64,
+    /// Follow the design-coefficient inputs (the gain update of an adaptive loop).
+    follow_design_inputs: bool,
+    /// Inputs: f22, f23, f25, f32, f33, f35 of the design in use (from the PathController).
+    design_inputs: [f64; 6],
     filter: PathKalmanFilter,
 }
 
 impl Default for PathKalmanFilterFmu {
     fn default() -> Self {
         let config = PathKalmanConfig::default();
+        let design_inputs = coefficients_of(&config.design().expect("preset").coefficients);
         PathKalmanFilterFmu {
             filter: PathKalmanFilter::new(config.design().expect("preset"), [0.0; 7])
                 .expect("preset design has a stabilising Riccati solution"),
@@ -35,8 +40,15 @@ impl Default for PathKalmanFilterFmu {
             x0: [0.0; 7],
             z: [0.0; 3],
             command: 0.0,
+            follow_design_inputs: false,
+            design_inputs,
         }
     }
+}
+
+/// f22, f23, f25, f32, f33, f35 of a coefficient set.
+fn coefficients_of(c: &TokyoMaruCoefficients) -> [f64; 6] {
+    [c.f22, c.f23, c.f25, c.f32, c.f33, c.f35]
 }
 
 impl PathKalmanFilterFmu {
@@ -80,7 +92,7 @@ type V = Variable<PathKalmanFilterFmu>;
 
 const UL: f64 = U / L;
 
-static VARIABLES: [V; 46] = [
+static VARIABLES: [V; 53] = [
     V::real_parameter(
         "design_depth_ratio",
         None,
@@ -411,6 +423,58 @@ static VARIABLES: [V; 46] = [
         "U/L of Tokyo Maru at 12 kn (t' = t U/L)",
         |_| UL,
     ),
+    // ---- gain update from an adaptive controller (appended: earlier value references unchanged)
+    V::boolean_parameter(
+        "follow_design_inputs",
+        false,
+        "Re-design the filter model F_e and gain K whenever the f*_design inputs change (004 Fig. 1: the gain \
+         calculation updates C, K and the filter model together; connect all six from the PathController's design_f* \
+         outputs); the gammas stay those of the design depth",
+        |m| m.follow_design_inputs,
+        |m, v| m.follow_design_inputs = v,
+    ),
+    V::real_input(
+        "f22_design",
+        None,
+        "f22 of the design to follow (follow_design_inputs)",
+        |m| m.design_inputs[0],
+        |m, v| m.design_inputs[0] = v,
+    ),
+    V::real_input(
+        "f23_design",
+        None,
+        "f23 of the design to follow (follow_design_inputs)",
+        |m| m.design_inputs[1],
+        |m, v| m.design_inputs[1] = v,
+    ),
+    V::real_input(
+        "f25_design",
+        None,
+        "f25 of the design to follow (follow_design_inputs)",
+        |m| m.design_inputs[2],
+        |m, v| m.design_inputs[2] = v,
+    ),
+    V::real_input(
+        "f32_design",
+        None,
+        "f32 of the design to follow (follow_design_inputs)",
+        |m| m.design_inputs[3],
+        |m, v| m.design_inputs[3] = v,
+    ),
+    V::real_input(
+        "f33_design",
+        None,
+        "f33 of the design to follow (follow_design_inputs)",
+        |m| m.design_inputs[4],
+        |m, v| m.design_inputs[4] = v,
+    ),
+    V::real_input(
+        "f35_design",
+        None,
+        "f35 of the design to follow (follow_design_inputs)",
+        |m| m.design_inputs[5],
+        |m, v| m.design_inputs[5] = v,
+    ),
 ];
 
 impl FmuModel for PathKalmanFilterFmu {
@@ -457,6 +521,24 @@ impl FmuModel for PathKalmanFilterFmu {
     }
 
     fn do_step(&mut self, _t: f64, h: f64) -> Result<(), String> {
+        if self.follow_design_inputs {
+            let mut design = *self.filter.design();
+            if coefficients_of(&design.coefficients) != self.design_inputs {
+                if let Some(i) = self.design_inputs.iter().position(|v| !v.is_finite()) {
+                    let n = ["f22", "f23", "f25", "f32", "f33", "f35"][i];
+                    return Err(format!(
+                        "input {n}_design = {} must be finite",
+                        self.design_inputs[i]
+                    ));
+                }
+                let [f22, f23, f25, f32, f33, f35] = self.design_inputs;
+                let c = &mut design.coefficients;
+                (c.f22, c.f23, c.f25, c.f32, c.f33, c.f35) = (f22, f23, f25, f32, f33, f35);
+                self.filter.set_design(design).map_err(|e| {
+                    format!("Kalman gain design for the f*_design inputs failed: {e}")
+                })?;
+            }
+        }
         self.filter
             .step(self.z[0], self.z[1], self.z[2], self.command, h);
         Ok(())

@@ -98,3 +98,69 @@ fn variable_table_passes_the_layer_checks() {
     let xml = fmi2_export::xml::model_description::<path_kalman_filter_fmu::PathKalmanFilterFmu>();
     assert!(xml.contains(r#"name="heading_measured""#));
 }
+
+/// follow_design_inputs: the f*_design inputs of deep water (Table 2, H/T = inf) re-design the
+/// filter at the next step: K(eta', eta') moves from Table 5's 4.0000 to 4.1330 (the f's of inf with
+/// the gammas of 1.89 kept, as in the adaptive loop), equal to the model filter with that design;
+/// unchanged inputs leave the gain alone; a non-finite input is refused.
+#[test]
+fn follows_the_design_inputs() {
+    use models::hull::tokyo_maru::TABLE_2;
+    let guid = CString::new(fmi2_export::xml::guid::<
+        path_kalman_filter_fmu::PathKalmanFilterFmu,
+    >())
+    .unwrap();
+    let name = CString::new("pkf").unwrap();
+    let cb = callbacks();
+    unsafe {
+        let c = fmi2Instantiate(
+            name.as_ptr(),
+            fmi2CoSimulation,
+            guid.as_ptr(),
+            null(),
+            &cb,
+            0,
+            0,
+        );
+        assert!(!c.is_null());
+        assert_eq!(fmi2SetupExperiment(c, 0, 0.0, 0.0, 0, 0.0), fmi2OK);
+        assert_eq!(fmi2EnterInitializationMode(c), fmi2OK);
+        assert_eq!(
+            fmi2SetBoolean(c, &vr("follow_design_inputs"), 1, &1),
+            fmi2OK
+        );
+        assert_eq!(fmi2ExitInitializationMode(c), fmi2OK);
+        let vg = vr("gain_cross_track_cross_track");
+        let mut g = 0.0;
+        let h = 0.005 * L / U;
+        assert_eq!(fmi2DoStep(c, 0.0, h, 1), fmi2OK);
+        assert_eq!(fmi2GetReal(c, &vg, 1, &mut g), fmi2OK);
+        assert!((g - 4.0000).abs() < 1e-4, "{g}");
+        let d = TABLE_2[4];
+        let f = [d.f22, d.f23, d.f25, d.f32, d.f33, d.f35];
+        let names = [
+            "f22_design",
+            "f23_design",
+            "f25_design",
+            "f32_design",
+            "f33_design",
+            "f35_design",
+        ];
+        let vrs: Vec<u32> = names.iter().map(|n| vr(n)).collect();
+        assert_eq!(fmi2SetReal(c, vrs.as_ptr(), 6, f.as_ptr()), fmi2OK);
+        assert_eq!(fmi2DoStep(c, h, h, 1), fmi2OK);
+        assert_eq!(fmi2GetReal(c, &vg, 1, &mut g), fmi2OK);
+        let mut design = PathKalmanConfig::default().design().unwrap();
+        let cc = &mut design.coefficients;
+        (cc.f22, cc.f23, cc.f25, cc.f32, cc.f33, cc.f35) = (f[0], f[1], f[2], f[3], f[4], f[5]);
+        let want = PathKalmanFilter::new(design, [0.0; 7]).unwrap().gain()[(3, 2)];
+        assert_eq!(g, want);
+        assert!((g - 4.1330).abs() < 1e-4, "{g}");
+        assert_eq!(fmi2DoStep(c, 2.0 * h, h, 1), fmi2OK);
+        assert_eq!(fmi2GetReal(c, &vg, 1, &mut g), fmi2OK);
+        assert_eq!(g, want);
+        let nan = f64::NAN;
+        assert_ne!(fmi2SetReal(c, &vrs[1], 1, &nan), fmi2OK);
+        fmi2FreeInstance(c);
+    }
+}

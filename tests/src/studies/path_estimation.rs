@@ -190,8 +190,10 @@ struct MveStats {
     eta_max: f64,
     t_eta_max: f64,
     /// t′ from which f̂23 stays within ±10 % of its truth to the end of the first cycle (6.25 if
-    /// it is outside at the end).
+    /// it is outside at the end), and t′ where it first comes within ±10 % (6.25: not in the
+    /// first cycle).
     f23_settled: f64,
+    f23_near: f64,
     /// Over the estimates (the rows where an estimate changed): min, mean, max, final, RMS(118).
     stats: [[f64; 6]; 5],
     estimates: usize,
@@ -226,6 +228,7 @@ fn mve_stats(t: &Table) -> Result<MveStats, String> {
     let mut s = MveStats::default();
     let mut est = Vec::new();
     let mut settled = 0.0;
+    let mut near = CYCLE;
     for k in 0..tp.len() {
         if tp[k] <= CYCLE + 1e-9 {
             let e = (eta[k] / L).abs();
@@ -235,6 +238,8 @@ fn mve_stats(t: &Table) -> Result<MveStats, String> {
             }
             if (row(k)[1] - truth[1]).abs() > 0.1 * truth[1] {
                 settled = tp[k] + DT;
+            } else if near == CYCLE {
+                near = tp[k];
             }
         }
         if k > 0 && row(k) != row(k - 1) {
@@ -242,6 +247,7 @@ fn mve_stats(t: &Table) -> Result<MveStats, String> {
         }
     }
     s.f23_settled = settled.min(CYCLE);
+    s.f23_near = near;
     s.estimates = est.len();
     if est.is_empty() {
         return Err("S14: the estimator made no estimate".into());
@@ -537,12 +543,14 @@ fn s14(env: &Env, report: &mut Report) -> Result<(), String> {
         &[t_eta],
         "",
     ));
-    // ---- Fig. 29: f̂23 near its true value in about 3 L
-    let settle = sp(0, &|s| s.f23_settled);
+    // ---- Fig. 29 (the passing-ship run): f̂23 near its true value in about 3 L
+    let near = sp(1, &|s| s.f23_near);
+    let settle = sp(1, &|s| s.f23_settled);
     c.push(Check::abs(
-        "S14 t′ from which f̂23 stays within ±10 % of 5.7359 (seed median; Fig. 29 \"≈3 L\")",
+        "S14 passing ship: t′ where f̂23 first comes within ±10 % of 5.7359 (seed median; Fig. 29 \
+         \"nears its true value in ≈3 L\")",
         3.0,
-        settle.median,
+        near.median,
         1.0,
         "",
     ));
@@ -618,7 +626,7 @@ fn s14(env: &Env, report: &mut Report) -> Result<(), String> {
         ],
         "s14_noise_free.csv",
     )?;
-    let lp = exchange_loop(None, false)?;
+    let lp = exchange_loop(None, true)?;
     let m_eta = col(&nf, "ship.cross_track")?;
     let m_est: Vec<&[f64]> = NAMES
         .iter()
@@ -645,7 +653,7 @@ fn s14(env: &Env, report: &mut Report) -> Result<(), String> {
         1e-9,
         "",
     ));
-    // (b) the filter re-designed at the updates (the report's scheme) vs kept (the FMUs), same noise
+    // (b) what the filter's re-design does (same noise), and the model test's loop
     let mut kept = Vec::new();
     let mut redesigned = Vec::new();
     let mut test = Vec::new();
@@ -661,20 +669,6 @@ fn s14(env: &Env, report: &mut Report) -> Result<(), String> {
     };
     let (k_eta, r_eta) = (lsp(&kept, &|r| r.eta_max), lsp(&redesigned, &|r| r.eta_max));
     let (k_rms, r_rms) = (lsp(&kept, &|r| r.rms[1]), lsp(&redesigned, &|r| r.rms[1]));
-    c.push(Check::rel(
-        "S14 filter kept at ∞ (FMUs) vs re-designed at the updates (report): seed-mean max |η′|",
-        r_eta.mean,
-        k_eta.mean,
-        0.02,
-        "",
-    ));
-    c.push(Check::rel(
-        "S14 filter kept vs re-designed: seed-mean RMS(118) of f̂23",
-        r_rms.mean,
-        k_rms.mean,
-        0.05,
-        "",
-    ));
     let tl_eta = spread(&test.iter().map(|r| r.0).collect::<Vec<_>>());
     let tl_rms = spread(&test.iter().map(|r| r.1).collect::<Vec<_>>());
     let rms23 = sp(0, &|s| s.stats[4][1]);
@@ -743,7 +737,7 @@ fn s14(env: &Env, report: &mut Report) -> Result<(), String> {
         "S14 setup: systems/{MVE} (TokyoMaru at H/T = 1.89, Euler at Δt′ = 0.005; SteeringGear \
          T_r = 10 s; Sensors with Table 3 noise for the filter and an independent Sensors with \
          Table 9 noise for the estimator; PathKalmanFilter, PathEstimator (MVE) and PathController \
-         initialised for H/T = ∞; dither ±0.5 rad, period 0.5 L, in the first 2.5 L of every \
+         initialised for H/T = ∞, the filter following the controller's design; dither ±0.5 rad, period 0.5 L, in the first 2.5 L of every \
          6.25 L; Table 10 rule at the end of each window). {SEEDS} seeds per case (sensors.seed = \
          N, est_sensors.seed = 1000 + N, current.seed = 2000 + N); 10 L per run."
     ));
@@ -773,9 +767,13 @@ fn s14(env: &Env, report: &mut Report) -> Result<(), String> {
     ));
     n.push(format!(
         "S14 estimates: ℓ = 10 gives 199 estimates in 10 L from the first sample at t′ = 0 (the \
-         report counts 200). Table 16 statistics over these; RMS(118) = √Σ (no 1/N). f̂23 stays \
-         within ±10 % of the truth from t′ = {} (seed median; {}..{}, 6.25 = not within the first \
-         cycle).",
+         report counts 200). Table 16 statistics over these; RMS(118) = √Σ (no 1/N). Fig. 29 \
+         (passing-ship run): f̂23 first comes within ±10 % of the truth at t′ = {} (seed median; \
+         {}..{}) and stays there, to the end of the first cycle, from t′ = {} (median; {}..{}; \
+         6.25: not within the first cycle).",
+        fmt_num(near.median),
+        fmt_num(near.min),
+        fmt_num(near.max),
         fmt_num(settle.median),
         fmt_num(settle.min),
         fmt_num(settle.max)
@@ -792,22 +790,20 @@ fn s14(env: &Env, report: &mut Report) -> Result<(), String> {
     n.push(format!(
         "S14 model level: the loop of systems/{MVE} re-built from the models with the master's \
          exchange (exchange_loop in this study) equals the noise-free master run to {} in η′ and \
-         {} in the estimates. The PathKalmanFilter FMU has no inputs for estimated coefficients, \
-         so in the master the filter keeps its deep-water model, where the report re-designs C, K \
-         and the filter model together (Fig. 1). The model loop with the same noise ({SEEDS} \
-         seeds, one stream) bounds what that costs: max |η′| {} with the filter kept, {} \
-         re-designed; RMS(118) of f̂23 {} kept, {} re-designed. In the report's own structure \
-         (filter re-designed, plant, filter and gear in one loop without exchange delays, 500-step \
-         windows) the peak is {}: the exchange delays and the kept filter lower it by about 1 % \
-         each. The S14 test of models/src/controllers/mve.rs (the report's structure, but its \
-         windows end one step late, see the max |η′| note) gives {} and RMS f̂23 {}; the master: \
-         {} and {}.",
+         {} in the estimates. The PathKalmanFilter follows the controller's design \
+         (follow_design_inputs), as the gain calculation of Fig. 1 updates C, K and the filter \
+         model together; with the same noise ({SEEDS} seeds, one stream) the model loop gives max \
+         |η′| {} with the filter re-designed and {} with the filter kept at its deep-water model; \
+         RMS(118) of f̂23 {} and {}. In the report's own structure (plant, filter and gear in one \
+         loop without exchange delays, 500-step windows) the peak is {}. The S14 test of \
+         models/src/controllers/mve.rs (the report's structure, but its windows end one step late, \
+         see the max |η′| note) gives {} and RMS f̂23 {}; the master: {} and {}.",
         fmt_num(d_eta),
         fmt_num(d_est),
-        fmt_spread(&k_eta),
         fmt_spread(&r_eta),
-        fmt_spread(&k_rms),
+        fmt_spread(&k_eta),
         fmt_spread(&r_rms),
+        fmt_spread(&k_rms),
         fmt_spread(&t5_eta),
         fmt_spread(&tl_eta),
         fmt_spread(&tl_rms),
