@@ -13,9 +13,18 @@
 //! is Levenberg–Marquardt with a forward-difference Jacobian (one model run per parameter), so
 //! the evaluation counts of Tables 11–15 are not comparable; the minimiser's result is.
 //! Design-time computation (allocates; runs once per batch period).
+//!
+//! # In the loop
+//! [`WlsEstimator`] is the estimator of Fig. 24 as the PathWlsEstimator FMU runs it: data windows
+//! of length LW repeating every LU (from `window_start`), one sample per step, the fit when a
+//! window is complete, warm-started from the last valid estimate (line 1106), the Table 10
+//! validity of the result. The per-step sample path does not allocate (the window buffers are
+//! sized once, at the first sample); the fit, once per window, does.
 
+use super::path::{validity, UpdateDecision, TABLE_10};
 use super::ControlError;
 use nalgebra::{DMatrix, DVector};
+use serde::{Deserialize, Serialize};
 
 /// A data window: measured states z′_k (k = 0 … n−1, z′_0 at the window start) and rudder δ′_k.
 #[derive(Clone, Debug, PartialEq)]
@@ -27,7 +36,7 @@ pub struct Window {
 }
 
 /// Settings of one WLS fit.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct WlsSettings {
     /// Euler step Δt′ (0.005).
     pub dt: f64,
@@ -87,6 +96,16 @@ fn residuals(p: &[f64; 8], w: &Window, s: &WlsSettings) -> DVector<f64> {
         }
     }
     r
+}
+
+/// Σ_k |z′_k − x_m,k|² of eq. (75) simulated with `p`: the unweighted sum of squares without ½,
+/// the scale the report's printed J seems to have (spec §6 item 13).
+pub fn sum_of_squares(p: &[f64; 8], w: &Window, s: &WlsSettings) -> f64 {
+    let unit = WlsSettings {
+        weight: [1.0; 4],
+        ..*s
+    };
+    residuals(p, w, &unit).norm_squared()
 }
 
 /// Minimises eq. (77) from `p0` by Levenberg–Marquardt.
@@ -165,6 +184,210 @@ pub fn fit(w: &Window, s: &WlsSettings, p0: [f64; 8]) -> Result<WlsFit, ControlE
     })
 }
 
+/// When the data windows are loaded (Fig. 24), in ship lengths t′ from the start: windows of
+/// length LW at `window_start + n·LU` (n = 0, 1, …); the fit runs when a window is complete.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct WlsSchedule {
+    pub window_start: f64,
+    /// LW (2.5 L).
+    pub window_length: f64,
+    /// LU (5, 6 or 6.25 L).
+    pub update_cycle: f64,
+}
+
+impl WlsSchedule {
+    pub fn validate(&self) -> Result<(), ControlError> {
+        super::positive("window_length", self.window_length)?;
+        super::positive("update_cycle", self.update_cycle)?;
+        if self.window_length > self.update_cycle {
+            return Err(ControlError(format!(
+                "parameter window_length = {} must not exceed update_cycle = {}",
+                self.window_length, self.update_cycle
+            )));
+        }
+        if !self.window_start.is_finite() {
+            return Err(ControlError(format!(
+                "parameter window_start = {} must be finite",
+                self.window_start
+            )));
+        }
+        Ok(())
+    }
+
+    /// For a sample at t′ with step Δt′: whether it lies in a window and whether it is the
+    /// window's first or last. Half a step of tolerance at both ends, so that rounding of t′ on
+    /// the grid never moves a window by a sample.
+    fn position(&self, t: f64, dt: f64) -> Option<(bool, bool)> {
+        let s = t - self.window_start;
+        let n = ((s + 0.5 * dt) / self.update_cycle).floor();
+        if n < 0.0 {
+            return None;
+        }
+        let r = s - n * self.update_cycle;
+        let end = self.window_length - 0.5 * dt;
+        if r >= -0.5 * dt && r < end {
+            Some((r < 0.5 * dt, r + dt >= end))
+        } else {
+            None
+        }
+    }
+}
+
+/// The batch estimator in a loop: sampling, windows, fits and the validity of the estimates.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct WlsEstimator {
+    pub settings: WlsSettings,
+    pub schedule: WlsSchedule,
+    /// Current estimate p̂ = [f22, f23, f25, f32, f33, f35, N′, Y′] (the last fit, valid or not).
+    p: [f64; 8],
+    /// The last valid estimate (the start of the next search).
+    p_valid: [f64; 8],
+    z: Vec<[f64; 4]>,
+    rudder: Vec<f64>,
+    x0: [f64; 4],
+    decision: UpdateDecision,
+    evaluations: usize,
+    cost: f64,
+    sum_of_squares: f64,
+    updates: u32,
+    loading: bool,
+}
+
+impl WlsEstimator {
+    /// Starts from `p0` (the estimate before the first fit and the first fit's initial point).
+    pub fn new(
+        settings: WlsSettings,
+        schedule: WlsSchedule,
+        p0: [f64; 8],
+    ) -> Result<Self, ControlError> {
+        schedule.validate()?;
+        super::positive("dt", settings.dt)?;
+        for (i, w) in settings.weight.iter().enumerate() {
+            super::positive(["w_psi", "w_r", "w_beta", "w_eta"][i], *w)?;
+        }
+        if settings.max_evaluations < 10 {
+            return Err(ControlError(format!(
+                "parameter max_evaluations = {} must be >= 10",
+                settings.max_evaluations
+            )));
+        }
+        Ok(WlsEstimator {
+            settings,
+            schedule,
+            p: p0,
+            p_valid: p0,
+            z: Vec::new(),
+            rudder: Vec::new(),
+            x0: [0.0; 4],
+            decision: validity(&std::array::from_fn(|i| p0[i]), &TABLE_10),
+            evaluations: 0,
+            cost: 0.0,
+            sum_of_squares: 0.0,
+            updates: 0,
+            loading: false,
+        })
+    }
+
+    /// One sample at t′ (ship lengths since the start) of a step of Δt′ = `dt`: measured
+    /// z′ = [ψ′, r′, β′, η′], rudder δ′, and the control-loop filter's estimate x̂′ (its first
+    /// value in a window is the model's initial state). Returns whether a fit was made.
+    pub fn sample(
+        &mut self,
+        t: f64,
+        dt: f64,
+        z: [f64; 4],
+        rudder: f64,
+        xhat: [f64; 4],
+    ) -> Result<bool, ControlError> {
+        let Some((first, last)) = self.schedule.position(t, dt) else {
+            self.loading = false;
+            return Ok(false);
+        };
+        if self.z.capacity() == 0 {
+            let n = (self.schedule.window_length / dt).ceil() as usize + 2;
+            self.z.reserve_exact(n);
+            self.rudder.reserve_exact(n);
+        }
+        if first || self.z.is_empty() {
+            self.z.clear();
+            self.rudder.clear();
+            self.x0 = xhat;
+        }
+        self.loading = true;
+        self.z.push(z);
+        self.rudder.push(rudder);
+        if !last {
+            return Ok(false);
+        }
+        self.loading = false;
+        self.settings.dt = dt;
+        let w = Window {
+            z: std::mem::take(&mut self.z),
+            rudder: std::mem::take(&mut self.rudder),
+            x0: self.x0,
+        };
+        let r = fit(&w, &self.settings, self.p_valid);
+        let ss = match &r {
+            Ok(f) => sum_of_squares(&f.p, &w, &self.settings),
+            Err(_) => f64::NAN,
+        };
+        // give the buffers back (keeps their capacity)
+        self.z = w.z;
+        self.rudder = w.rudder;
+        self.z.clear();
+        self.rudder.clear();
+        let r = r?;
+        self.p = r.p;
+        self.evaluations = r.evaluations;
+        self.cost = r.cost;
+        self.sum_of_squares = ss;
+        self.decision = validity(&self.f(), &TABLE_10);
+        if self.decision != UpdateDecision::None {
+            self.p_valid = r.p;
+        }
+        self.updates += 1;
+        Ok(true)
+    }
+
+    /// p̂ = [f22, f23, f25, f32, f33, f35, N′, Y′].
+    pub fn estimate(&self) -> [f64; 8] {
+        self.p
+    }
+
+    /// The six coefficient estimates.
+    pub fn f(&self) -> [f64; 6] {
+        std::array::from_fn(|i| self.p[i])
+    }
+
+    /// Table 10 branch of the current estimate (None: f̂23 or f̂25 out of range).
+    pub fn decision(&self) -> UpdateDecision {
+        self.decision
+    }
+
+    /// Cost evaluations, eq. (77) cost and the unweighted Σ|e|² of the last fit.
+    pub fn evaluations(&self) -> usize {
+        self.evaluations
+    }
+
+    pub fn cost(&self) -> f64 {
+        self.cost
+    }
+
+    pub fn sum_of_squares(&self) -> f64 {
+        self.sum_of_squares
+    }
+
+    /// Number of fits so far.
+    pub fn updates(&self) -> u32 {
+        self.updates
+    }
+
+    /// True while a window is being loaded.
+    pub fn loading(&self) -> bool {
+        self.loading
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -230,6 +453,57 @@ mod tests {
         let nw = g89.try_inverse().unwrap() * ginf * w_true;
         assert!((r.p[6] - nw[0]).abs() < 1e-8 && (r.p[7] - nw[1]).abs() < 1e-8);
         assert!(r.cost < 1e-12);
+    }
+
+    /// The estimator in a loop: windows of LW = 2.5 L every LU = 6 L from t′ = 3.45 on the
+    /// Δt′ = 0.005 grid hold exactly 500 samples, the fit comes with the last one, recovers the
+    /// noise-free truth (deep water under the constant disturbance) and is valid (Table 10).
+    #[test]
+    fn estimator_windows_and_fit_in_a_loop() {
+        let truth = TABLE_2[4];
+        let (f, g, gam) = truth.eq11(T_R);
+        let w_true = SVector::<f64, 2>::new(0.10262e-2, 0.23277e-2);
+        let mut x = SVector::<f64, 5>::new(-0.1428, 0.0, -0.1428, 0.0, 0.1310);
+        let c = TABLE_2[2];
+        let p0 = [c.f22, c.f23, c.f25, c.f32, c.f33, c.f35, 0.0, 0.0];
+        let schedule = WlsSchedule {
+            window_start: 3.45,
+            window_length: 2.5,
+            update_cycle: 6.0,
+        };
+        let mut est = WlsEstimator::new(WlsSettings::default(), schedule, p0).unwrap();
+        let dt = 0.005;
+        let mut fits = Vec::new();
+        let mut loaded = 0;
+        for k in 0..2400 {
+            let t = k as f64 * dt;
+            let u = if ((t / 0.25).floor() as i64) % 2 == 0 {
+                -0.5
+            } else {
+                0.5
+            };
+            let xs = [x[0], x[1], x[2], x[3]];
+            if est.sample(t, dt, xs, x[4], xs).unwrap() {
+                fits.push(k);
+            }
+            if est.loading() {
+                loaded += 1;
+            }
+            x += (f * x + g * u + gam * w_true) * dt;
+        }
+        // windows [3.45, 5.95) and [9.45, 11.95): the fits at the samples of t′ = 5.945, 11.945
+        assert_eq!(fits, vec![1189, 2389]);
+        assert_eq!(loaded, 2 * 499);
+        assert_eq!(est.updates(), 2);
+        let want = [
+            truth.f22, truth.f23, truth.f25, truth.f32, truth.f33, truth.f35,
+        ];
+        for i in 0..6 {
+            assert!((est.f()[i] - want[i]).abs() < 1e-6 * want[i].abs().max(1.0));
+        }
+        assert_eq!(est.decision(), UpdateDecision::All);
+        assert!(est.cost() < 1e-12 && est.sum_of_squares() < 1e-20);
+        assert!(est.evaluations() > 9);
     }
 
     #[test]

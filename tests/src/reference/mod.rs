@@ -25,6 +25,7 @@ pub mod passive_observer;
 pub mod path_controller;
 pub mod path_estimator;
 pub mod path_kalman_filter;
+pub mod path_wls;
 pub mod rrs_autopilot;
 pub mod rrs_filter;
 pub mod rrs_ship;
@@ -71,6 +72,13 @@ pub const CASES: &[Case] = &[
         "PathEstimator (MVE) on the noise-free Tokyo Maru at H/T = 1.89 under a +-0.5 rad dither; \
          h = 0.25 s, 600 steps",
         path_estimator::dither,
+    ),
+    (
+        "path_wls_windows",
+        "PathWlsEstimator (WLS) on the Tokyo Maru in deep water under the constant disturbance and a \
+         +-0.5 rad dither, perturbed measurements; windows of 1 L every 1.5 L from t' = 0.5; \
+         h = 0.25 s, 870 steps",
+        path_wls::windows,
     ),
     (
         "rrs_autopilot_adaptive",
