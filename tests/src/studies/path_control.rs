@@ -11,8 +11,7 @@
 //!   a Jacobi master, which explains the one quantity outside 2 % (the S1 rudder peak).
 //!
 //! S5 (ABC harbour, Fig. 5 lost) and S8 (Table 7, a covariance analysis, not a simulation) are
-//! not run; S9-S16 need the WLS/MVE estimators, which do not exist in `models/` (the
-//! PathController only takes estimates as inputs).
+//! not run; the estimator scenarios (WLS S9-S13, MVE S14) are the `path_estimation` study.
 
 use crate::study::{Check, Env, Report};
 use models::controllers::path::{path_gains, PathDesignModel};
@@ -1099,10 +1098,12 @@ pub fn run(env: &Env) -> Result<Report, String> {
             .into(),
     );
     n.push(
-        "Not run: S5 (ABC harbour; Fig. 5 is lost and needs a strip-theory reconstruction), S8 \
-         (Table 7, a stationary covariance analysis), and the estimator scenarios S9-S16: the WLS \
-         and MVE estimators are not implemented in models/ (models/src/controllers/path.rs only \
-         applies estimates given as inputs, by the Table 10 rule)."
+        "Not run: S5 (ABC harbour; Fig. 5 is lost and needs a strip-theory reconstruction) and S8 \
+         (Table 7, a stationary covariance analysis, not a simulation). The estimator scenarios \
+         (WLS S9-S13, MVE S14) are in the path-estimation study. Not run either: the MVE runs over a \
+         varying bottom, S15/S16 (Table 18): the report's depth-to-coefficient rule is not given (between \
+         H/T = 2.5 and 10 there are no coefficients at all; within 1.3-2.5 no simple interpolation \
+         reproduces its Table 14 truth, spec §6)."
             .into(),
     );
     Ok(report)
