@@ -1867,8 +1867,8 @@ fn wls_table_checks(
     let n_fits: Vec<usize> = runs.iter().map(|r| r.fits.len()).collect();
     let need = updates.iter().max().map_or(0, |m| m + 1);
     c.push(Check::holds(
-        &format!("{id}: fits in every seed"),
-        &format!("{need} update(s)"),
+        &format!("{id}: fits in every seed (at least one per update compared)"),
+        &format!(">= {need} fit(s)"),
         format!(
             "{}..{}",
             n_fits.iter().min().unwrap_or(&0),
