@@ -555,43 +555,33 @@ pub fn write(sys: &System, out: &Path) -> Result<Vec<String>> {
 /// value falls back to it), unlike shipsim, where a set value stays.
 fn scenario_json(sys: &System, plan: &crate::system::Plan) -> String {
     use crate::system::TypedValue;
-    let mut j = String::from("{\n  \"description\": \"events of ");
-    j.push_str(&json_esc(&sys.source.display().to_string()));
-    j.push_str(", written by shipsim export-osp\",\n  \"events\": [");
-    for (i, e) in plan.events.iter().enumerate() {
-        let (inst, var) = e.name.split_once('.').unwrap_or(("", e.name.as_str()));
-        let value = match &e.value {
-            TypedValue::Real(v) => format!("{v:?}"),
-            TypedValue::Integer(v) => v.to_string(),
-            TypedValue::Boolean(v) => v.to_string(),
-            TypedValue::String(v) => format!("\"{}\"", json_esc(v)),
-        };
-        let time = e.step as f64 * plan.step_size;
-        let _ = write!(
-            j,
-            "{}\n    {{\"time\": {time:?}, \"model\": \"{}\", \"variable\": \"{}\", \"action\": \"override\", \"value\": {value}}}",
-            if i == 0 { "" } else { "," },
-            json_esc(inst),
-            json_esc(var)
-        );
-    }
-    let _ = write!(
-        j,
-        "\n  ],\n  \"end\": {:?}\n}}\n",
-        plan.stop_time - plan.start_time
-    );
-    j
-}
-
-fn json_esc(s: &str) -> String {
-    let mut o = String::with_capacity(s.len());
-    for c in s.chars() {
-        match c {
-            '"' => o.push_str("\\\""),
-            '\\' => o.push_str("\\\\"),
-            c if (c as u32) < 0x20 => o.push_str(&format!("\\u{:04x}", c as u32)),
-            c => o.push(c),
-        }
-    }
-    o
+    use serde_json::{json, Value};
+    let events: Vec<Value> = plan
+        .events
+        .iter()
+        .map(|e| {
+            let (inst, var) = e.name.split_once('.').unwrap_or(("", e.name.as_str()));
+            let value = match &e.value {
+                TypedValue::Real(v) => json!(v),
+                TypedValue::Integer(v) => json!(v),
+                TypedValue::Boolean(v) => json!(v),
+                TypedValue::String(v) => json!(v),
+            };
+            json!({
+                "time": e.step as f64 * plan.step_size,
+                "model": inst,
+                "variable": var,
+                "action": "override",
+                "value": value,
+            })
+        })
+        .collect();
+    let scenario = json!({
+        "description": format!("events of {}, written by shipsim export-osp", sys.source.display()),
+        "events": events,
+        "end": plan.stop_time - plan.start_time,
+    });
+    let mut text = serde_json::to_string_pretty(&scenario).unwrap_or_default();
+    text.push('\n');
+    text
 }

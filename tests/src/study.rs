@@ -53,6 +53,17 @@ impl Env {
     /// `<out_dir>/<csv>`; returns the recorded table. FMU paths of the system file are resolved
     /// by file name in [`Env::fmu_dir`].
     pub fn run(&self, file: &str, sets: &[String], csv: &str) -> Result<Table, String> {
+        self.run_steps(file, sets, csv, None)
+    }
+
+    /// [`Env::run`] stopped after `steps` base steps (Some) instead of at the file's stop time.
+    pub fn run_steps(
+        &self,
+        file: &str,
+        sets: &[String],
+        csv: &str,
+        steps: Option<u64>,
+    ) -> Result<Table, String> {
         let path = self.root.join("systems").join(file);
         let mut system = System::load(&path).map_err(|e| e.to_string())?;
         for inst in &mut system.instances {
@@ -72,6 +83,9 @@ impl Env {
             inst.fmu = candidate;
         }
         system.apply_overrides(sets).map_err(|e| e.to_string())?;
+        if let Some(n) = steps {
+            system.stop_time = Some(system.start_time + n as f64 * system.step_size);
+        }
         std::fs::create_dir_all(&self.out_dir).map_err(|e| e.to_string())?;
         let out = self.out_dir.join(csv);
         run_system(&system, Output::File(out.clone()), &RunOptions::default())

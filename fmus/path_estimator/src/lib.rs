@@ -6,6 +6,7 @@
 use fmi2_export::{export_fmu, DefaultExperiment, FmuModel, Variable};
 use models::controllers::mve::{parameters_of, Mve, MveParams};
 use models::hull::tokyo_maru::TokyoMaruCoefficients;
+use models::observers::path_model::states_prime;
 use serde::{Deserialize, Serialize};
 
 /// Parameters, inputs and state of one estimator instance.
@@ -30,12 +31,7 @@ impl PathEstimatorFmu {
     }
 
     fn prime(&self) -> [f64; 4] {
-        [
-            self.z[0],
-            self.z[1] * self.ship_length / self.ship_speed,
-            self.z[2],
-            self.z[3] / self.ship_length,
-        ]
+        states_prime(&self.z, self.ship_length, self.ship_speed)
     }
 }
 

@@ -8,6 +8,7 @@ use fmi2_export::{export_fmu, DefaultExperiment, FmuModel, Variable};
 use models::controllers::path::UpdateDecision;
 use models::controllers::wls::{WlsEstimator, WlsSchedule, WlsSettings};
 use models::hull::tokyo_maru::TokyoMaruCoefficients;
+use models::observers::path_model::states_prime;
 use serde::{Deserialize, Serialize};
 
 /// Parameters, inputs and state of one estimator instance.
@@ -42,18 +43,11 @@ impl PathWlsFmu {
     }
 
     fn initial_estimate(&self) -> [f64; 8] {
-        let c = TokyoMaruCoefficients::at_depth_ratio(self.initial_depth_ratio);
-        [c.f22, c.f23, c.f25, c.f32, c.f33, c.f35, 0.0, 0.0]
+        initial_estimate(self.initial_depth_ratio)
     }
 
-    /// SI → prime: [ψ, r L/U, β, η/L].
     fn prime(&self, v: &[f64; 4]) -> [f64; 4] {
-        [
-            v[0],
-            v[1] * self.ship_length / self.ship_speed,
-            v[2],
-            v[3] / self.ship_length,
-        ]
+        states_prime(v, self.ship_length, self.ship_speed)
     }
 
     fn p(&self, i: usize) -> f64 {
@@ -61,14 +55,23 @@ impl PathWlsFmu {
     }
 }
 
+/// The Table 2 coefficients at H/T = `depth_ratio` with N′ = Y′ = 0.
+fn initial_estimate(depth_ratio: f64) -> [f64; 8] {
+    let c = TokyoMaruCoefficients::at_depth_ratio(depth_ratio);
+    [c.f22, c.f23, c.f25, c.f32, c.f33, c.f35, 0.0, 0.0]
+}
+
 impl Default for PathWlsFmu {
     fn default() -> Self {
-        let mut m = PathWlsFmu {
-            schedule: WlsSchedule {
-                window_start: 3.45,
-                window_length: 2.5,
-                update_cycle: 6.0,
-            },
+        let schedule = WlsSchedule {
+            window_start: 3.45,
+            window_length: 2.5,
+            update_cycle: 6.0,
+        };
+        // WlsSettings::default() is what settings() gives for the parameter defaults below
+        // (gammas at H/T = 1.89, Table 9 weights, 2000 evaluations); initialize rebuilds it.
+        PathWlsFmu {
+            schedule,
             initial_depth_ratio: 1.89,
             gamma_depth_ratio: 1.89,
             r: [1.2976e-9, 7.7215e-10, 8.2777e-10, 5.0651e-9],
@@ -79,20 +82,9 @@ impl Default for PathWlsFmu {
             rudder: 0.0,
             xhat: [0.0; 4],
             start_time: 0.0,
-            est: WlsEstimator::new(
-                WlsSettings::default(),
-                WlsSchedule {
-                    window_start: 3.45,
-                    window_length: 2.5,
-                    update_cycle: 6.0,
-                },
-                [0.0; 8],
-            )
-            .expect("default settings are valid"),
-        };
-        m.est = WlsEstimator::new(m.settings(), m.schedule, m.initial_estimate())
-            .expect("default settings are valid");
-        m
+            est: WlsEstimator::new(WlsSettings::default(), schedule, initial_estimate(1.89))
+                .expect("default settings are valid"),
+        }
     }
 }
 

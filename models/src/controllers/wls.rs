@@ -245,7 +245,6 @@ pub struct WlsEstimator {
     z: Vec<[f64; 4]>,
     rudder: Vec<f64>,
     x0: [f64; 4],
-    decision: UpdateDecision,
     evaluations: usize,
     cost: f64,
     sum_of_squares: f64,
@@ -279,7 +278,6 @@ impl WlsEstimator {
             z: Vec::new(),
             rudder: Vec::new(),
             x0: [0.0; 4],
-            decision: validity(&std::array::from_fn(|i| p0[i]), &TABLE_10),
             evaluations: 0,
             cost: 0.0,
             sum_of_squares: 0.0,
@@ -341,8 +339,7 @@ impl WlsEstimator {
         self.evaluations = r.evaluations;
         self.cost = r.cost;
         self.sum_of_squares = ss;
-        self.decision = validity(&self.f(), &TABLE_10);
-        if self.decision != UpdateDecision::None {
+        if self.decision() != UpdateDecision::None {
             self.p_valid = r.p;
         }
         self.updates += 1;
@@ -361,7 +358,7 @@ impl WlsEstimator {
 
     /// Table 10 branch of the current estimate (None: f̂23 or f̂25 out of range).
     pub fn decision(&self) -> UpdateDecision {
-        self.decision
+        validity(&self.f(), &TABLE_10)
     }
 
     /// Cost evaluations, eq. (77) cost and the unweighted Σ|e|² of the last fit.

@@ -17,9 +17,7 @@ use crate::study::{Check, Env, Report};
 use models::controllers::path::{path_gains, PathDesignModel};
 use models::disturbances::current::{design_current_profile, passing_ship};
 use models::hull::tokyo_maru::{TokyoMaruCoefficients, L, T_R, U};
-use shipsim::master::{run_system, Output, RunOptions};
 use shipsim::plot::{Panel, Series, Table};
-use shipsim::system::System;
 
 const DEG: f64 = std::f64::consts::PI / 180.0;
 /// Half beam B/2 [m]: the initial offset of S1/S3.
@@ -189,7 +187,7 @@ fn run_scenario(env: &Env, s: &Scenario, extra: &[String], csv: &str) -> Result<
     Run::new(table, if s.file == PASSING { HALF_BEAM } else { 0.0 })
 }
 
-/// [`Env::run`] with the stop time set to t′ = `stop_prime` ship lengths.
+/// [`Env::run`] stopped at t′ = `stop_prime` ship lengths (one base step is Δt′ = DT).
 fn run_until(
     env: &Env,
     file: &str,
@@ -197,19 +195,7 @@ fn run_until(
     csv: &str,
     stop_prime: f64,
 ) -> Result<Table, String> {
-    let mut system =
-        System::load(&env.root.join("systems").join(file)).map_err(|e| e.to_string())?;
-    for inst in &mut system.instances {
-        let name = inst.fmu.file_name().ok_or("instance without an FMU file")?;
-        inst.fmu = env.fmu_dir.join(name);
-    }
-    system.apply_overrides(sets).map_err(|e| e.to_string())?;
-    system.stop_time = Some((stop_prime / DT).round() * system.step_size);
-    std::fs::create_dir_all(&env.out_dir).map_err(|e| e.to_string())?;
-    let out = env.out_dir.join(csv);
-    run_system(&system, Output::File(out.clone()), &RunOptions::default())
-        .map_err(|e| format!("{file}: {e}"))?;
-    Table::read(&out).map_err(|e| e.to_string())
+    env.run_steps(file, sets, csv, Some((stop_prime / DT).round() as u64))
 }
 
 fn noise_free(env: &Env, s: &Scenario, csv: &str) -> Result<Run, String> {

@@ -1926,7 +1926,7 @@ fn wls_table_checks(
     Ok(())
 }
 
-/// [`Env::run`] with the stop time at t′ = `stop_prime` ship lengths.
+/// [`Env::run`] stopped at t′ = `stop_prime` ship lengths (one base step is Δt′ = DT).
 fn run_until(
     env: &Env,
     file: &str,
@@ -1934,21 +1934,7 @@ fn run_until(
     csv: &str,
     stop_prime: f64,
 ) -> Result<Table, String> {
-    use shipsim::master::{run_system, Output, RunOptions};
-    use shipsim::system::System;
-    let mut system =
-        System::load(&env.root.join("systems").join(file)).map_err(|e| e.to_string())?;
-    for inst in &mut system.instances {
-        let name = inst.fmu.file_name().ok_or("instance without an FMU file")?;
-        inst.fmu = env.fmu_dir.join(name);
-    }
-    system.apply_overrides(sets).map_err(|e| e.to_string())?;
-    system.stop_time = Some((stop_prime / DT).round() * system.step_size);
-    std::fs::create_dir_all(&env.out_dir).map_err(|e| e.to_string())?;
-    let out = env.out_dir.join(csv);
-    run_system(&system, Output::File(out.clone()), &RunOptions::default())
-        .map_err(|e| format!("{file}: {e}"))?;
-    Table::read(&out).map_err(|e| e.to_string())
+    env.run_steps(file, sets, csv, Some((stop_prime / DT).round() as u64))
 }
 
 pub fn run(env: &Env) -> Result<Report, String> {
