@@ -8,7 +8,7 @@ use crate::model_description::{CoSimulation, ModelDescription, ScalarVariable};
 use fmi2::*;
 use libloading::os::unix::{Library, RTLD_GLOBAL, RTLD_LOCAL, RTLD_NOW};
 use std::collections::HashMap;
-use std::ffi::{c_char, c_void};
+use std::ffi::c_void;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -31,157 +31,19 @@ const LIB_EXT: &str = if cfg!(target_os = "macos") {
 pub type VR = fmi2ValueReference;
 
 /// Every FMI 2.0 common and co-simulation function, resolved once at load (like FMPy, a missing
-/// export makes the FMU unloadable). Signatures from `fmi2FunctionTypes.h`.
-#[allow(non_snake_case, dead_code)]
-pub(crate) struct Api {
-    pub GetTypesPlatform: unsafe extern "C" fn() -> *const c_char,
-    pub GetVersion: unsafe extern "C" fn() -> *const c_char,
-    pub SetDebugLogging:
-        unsafe extern "C" fn(fmi2Component, fmi2Boolean, usize, *const fmi2String) -> fmi2Status,
-    pub Instantiate: unsafe extern "C" fn(
-        fmi2String,
-        fmi2Type,
-        fmi2String,
-        fmi2String,
-        *const fmi2CallbackFunctions,
-        fmi2Boolean,
-        fmi2Boolean,
-    ) -> fmi2Component,
-    pub FreeInstance: unsafe extern "C" fn(fmi2Component),
-    pub SetupExperiment: unsafe extern "C" fn(
-        fmi2Component,
-        fmi2Boolean,
-        fmi2Real,
-        fmi2Real,
-        fmi2Boolean,
-        fmi2Real,
-    ) -> fmi2Status,
-    pub EnterInitializationMode: unsafe extern "C" fn(fmi2Component) -> fmi2Status,
-    pub ExitInitializationMode: unsafe extern "C" fn(fmi2Component) -> fmi2Status,
-    pub Terminate: unsafe extern "C" fn(fmi2Component) -> fmi2Status,
-    pub Reset: unsafe extern "C" fn(fmi2Component) -> fmi2Status,
-    pub GetReal: unsafe extern "C" fn(fmi2Component, *const VR, usize, *mut fmi2Real) -> fmi2Status,
-    pub GetInteger:
-        unsafe extern "C" fn(fmi2Component, *const VR, usize, *mut fmi2Integer) -> fmi2Status,
-    pub GetBoolean:
-        unsafe extern "C" fn(fmi2Component, *const VR, usize, *mut fmi2Boolean) -> fmi2Status,
-    pub GetString:
-        unsafe extern "C" fn(fmi2Component, *const VR, usize, *mut fmi2String) -> fmi2Status,
-    pub SetReal:
-        unsafe extern "C" fn(fmi2Component, *const VR, usize, *const fmi2Real) -> fmi2Status,
-    pub SetInteger:
-        unsafe extern "C" fn(fmi2Component, *const VR, usize, *const fmi2Integer) -> fmi2Status,
-    pub SetBoolean:
-        unsafe extern "C" fn(fmi2Component, *const VR, usize, *const fmi2Boolean) -> fmi2Status,
-    pub SetString:
-        unsafe extern "C" fn(fmi2Component, *const VR, usize, *const fmi2String) -> fmi2Status,
-    pub GetFMUstate: unsafe extern "C" fn(fmi2Component, *mut fmi2FMUstate) -> fmi2Status,
-    pub SetFMUstate: unsafe extern "C" fn(fmi2Component, fmi2FMUstate) -> fmi2Status,
-    pub FreeFMUstate: unsafe extern "C" fn(fmi2Component, *mut fmi2FMUstate) -> fmi2Status,
-    pub SerializedFMUstateSize:
-        unsafe extern "C" fn(fmi2Component, fmi2FMUstate, *mut usize) -> fmi2Status,
-    pub SerializeFMUstate:
-        unsafe extern "C" fn(fmi2Component, fmi2FMUstate, *mut fmi2Byte, usize) -> fmi2Status,
-    pub DeSerializeFMUstate: unsafe extern "C" fn(
-        fmi2Component,
-        *const fmi2Byte,
-        usize,
-        *mut fmi2FMUstate,
-    ) -> fmi2Status,
-    pub GetDirectionalDerivative: unsafe extern "C" fn(
-        fmi2Component,
-        *const VR,
-        usize,
-        *const VR,
-        usize,
-        *const fmi2Real,
-        *mut fmi2Real,
-    ) -> fmi2Status,
-    pub SetRealInputDerivatives: unsafe extern "C" fn(
-        fmi2Component,
-        *const VR,
-        usize,
-        *const fmi2Integer,
-        *const fmi2Real,
-    ) -> fmi2Status,
-    pub GetRealOutputDerivatives: unsafe extern "C" fn(
-        fmi2Component,
-        *const VR,
-        usize,
-        *const fmi2Integer,
-        *mut fmi2Real,
-    ) -> fmi2Status,
-    pub DoStep: unsafe extern "C" fn(fmi2Component, fmi2Real, fmi2Real, fmi2Boolean) -> fmi2Status,
-    pub CancelStep: unsafe extern "C" fn(fmi2Component) -> fmi2Status,
-    pub GetStatus:
-        unsafe extern "C" fn(fmi2Component, fmi2StatusKind, *mut fmi2Status) -> fmi2Status,
-    pub GetRealStatus:
-        unsafe extern "C" fn(fmi2Component, fmi2StatusKind, *mut fmi2Real) -> fmi2Status,
-    pub GetIntegerStatus:
-        unsafe extern "C" fn(fmi2Component, fmi2StatusKind, *mut fmi2Integer) -> fmi2Status,
-    pub GetBooleanStatus:
-        unsafe extern "C" fn(fmi2Component, fmi2StatusKind, *mut fmi2Boolean) -> fmi2Status,
-    pub GetStringStatus:
-        unsafe extern "C" fn(fmi2Component, fmi2StatusKind, *mut fmi2String) -> fmi2Status,
-}
+/// export makes the FMU unloadable). The table and its signatures are `fmi2`'s, shared with the
+/// export layer.
+pub(crate) type Api = Fmi2Functions;
 
-impl Api {
-    /// Resolves all 34 functions; the first missing one is reported by name.
-    unsafe fn resolve(lib: &Library) -> std::result::Result<Api, String> {
-        /// Looks a function up; a missing or NULL export is reported by name.
-        unsafe fn get<T: Copy>(lib: &Library, name: &str) -> std::result::Result<T, String> {
-            let c = format!("{name}\0");
-            match lib.get::<*const c_void>(c.as_bytes()) {
-                Ok(p) if !p.is_null() => {}
-                _ => return Err(format!("the shared library does not export '{name}'")),
-            }
-            lib.get::<T>(c.as_bytes())
-                .map(|s| *s)
-                .map_err(|e| format!("cannot resolve '{name}': {e}"))
+/// Resolves all 34 functions of `lib`; the first missing one is reported by name.
+unsafe fn resolve(lib: &Library) -> std::result::Result<Api, String> {
+    Fmi2Functions::resolve(|name| {
+        let c = format!("{name}\0");
+        match lib.get::<*const c_void>(c.as_bytes()) {
+            Ok(p) => Ok(*p),
+            Err(_) => Ok(std::ptr::null()),
         }
-        macro_rules! sym {
-            ($name:literal) => {
-                get(lib, $name)?
-            };
-        }
-        let api = Api {
-            GetTypesPlatform: sym!("fmi2GetTypesPlatform"),
-            GetVersion: sym!("fmi2GetVersion"),
-            SetDebugLogging: sym!("fmi2SetDebugLogging"),
-            Instantiate: sym!("fmi2Instantiate"),
-            FreeInstance: sym!("fmi2FreeInstance"),
-            SetupExperiment: sym!("fmi2SetupExperiment"),
-            EnterInitializationMode: sym!("fmi2EnterInitializationMode"),
-            ExitInitializationMode: sym!("fmi2ExitInitializationMode"),
-            Terminate: sym!("fmi2Terminate"),
-            Reset: sym!("fmi2Reset"),
-            GetReal: sym!("fmi2GetReal"),
-            GetInteger: sym!("fmi2GetInteger"),
-            GetBoolean: sym!("fmi2GetBoolean"),
-            GetString: sym!("fmi2GetString"),
-            SetReal: sym!("fmi2SetReal"),
-            SetInteger: sym!("fmi2SetInteger"),
-            SetBoolean: sym!("fmi2SetBoolean"),
-            SetString: sym!("fmi2SetString"),
-            GetFMUstate: sym!("fmi2GetFMUstate"),
-            SetFMUstate: sym!("fmi2SetFMUstate"),
-            FreeFMUstate: sym!("fmi2FreeFMUstate"),
-            SerializedFMUstateSize: sym!("fmi2SerializedFMUstateSize"),
-            SerializeFMUstate: sym!("fmi2SerializeFMUstate"),
-            DeSerializeFMUstate: sym!("fmi2DeSerializeFMUstate"),
-            GetDirectionalDerivative: sym!("fmi2GetDirectionalDerivative"),
-            SetRealInputDerivatives: sym!("fmi2SetRealInputDerivatives"),
-            GetRealOutputDerivatives: sym!("fmi2GetRealOutputDerivatives"),
-            DoStep: sym!("fmi2DoStep"),
-            CancelStep: sym!("fmi2CancelStep"),
-            GetStatus: sym!("fmi2GetStatus"),
-            GetRealStatus: sym!("fmi2GetRealStatus"),
-            GetIntegerStatus: sym!("fmi2GetIntegerStatus"),
-            GetBooleanStatus: sym!("fmi2GetBooleanStatus"),
-            GetStringStatus: sym!("fmi2GetStringStatus"),
-        };
-        Ok(api)
-    }
+    })
 }
 
 /// The loaded binary plus the unpacked directory it lives in. Instances keep it alive through
@@ -353,9 +215,9 @@ impl Fmu {
             }
             Error::fmu(path, msg)
         })?;
-        let api = unsafe { Api::resolve(&lib) }.map_err(|m| Error::fmu(path, m))?;
+        let api = unsafe { resolve(&lib) }.map_err(|m| Error::fmu(path, m))?;
         // fmi2GetVersion must be "2.0" (FMI 2.0 section 2.1.4).
-        let version = unsafe { lossy_str((api.GetVersion)()) };
+        let version = unsafe { lossy_str((api.fmi2GetVersion)()) };
         if !version.starts_with("2.") {
             return Err(Error::fmu(
                 path,

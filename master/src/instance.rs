@@ -169,10 +169,10 @@ impl Drop for Core {
         let api = &self.lib.api;
         unsafe {
             if self.phase == Phase::Initialized {
-                (api.Terminate)(self.comp);
+                (api.fmi2Terminate)(self.comp);
             }
             if self.phase != Phase::Fatal {
-                (api.FreeInstance)(self.comp);
+                (api.fmi2FreeInstance)(self.comp);
             }
         }
     }
@@ -229,7 +229,7 @@ impl Fmu {
             componentEnvironment: &mut *target as *mut LogTarget as *mut c_void,
         });
         let comp = unsafe {
-            (self.lib.api.Instantiate)(
+            (self.lib.api.fmi2Instantiate)(
                 name_c.as_ptr(),
                 fmi2CoSimulation,
                 guid.as_ptr(),
@@ -303,7 +303,12 @@ impl<S> Instance<S> {
             return Ok(());
         }
         let s = unsafe {
-            (self.core.lib.api.SetReal)(self.core.comp, vrs.as_ptr(), vrs.len(), values.as_ptr())
+            (self.core.lib.api.fmi2SetReal)(
+                self.core.comp,
+                vrs.as_ptr(),
+                vrs.len(),
+                values.as_ptr(),
+            )
         };
         self.core.check("fmi2SetReal", s, None)
     }
@@ -314,7 +319,12 @@ impl<S> Instance<S> {
             return Ok(());
         }
         let s = unsafe {
-            (self.core.lib.api.SetInteger)(self.core.comp, vrs.as_ptr(), vrs.len(), values.as_ptr())
+            (self.core.lib.api.fmi2SetInteger)(
+                self.core.comp,
+                vrs.as_ptr(),
+                vrs.len(),
+                values.as_ptr(),
+            )
         };
         self.core.check("fmi2SetInteger", s, None)
     }
@@ -325,7 +335,12 @@ impl<S> Instance<S> {
             return Ok(());
         }
         let s = unsafe {
-            (self.core.lib.api.SetBoolean)(self.core.comp, vrs.as_ptr(), vrs.len(), values.as_ptr())
+            (self.core.lib.api.fmi2SetBoolean)(
+                self.core.comp,
+                vrs.as_ptr(),
+                vrs.len(),
+                values.as_ptr(),
+            )
         };
         self.core.check("fmi2SetBoolean", s, None)
     }
@@ -341,7 +356,12 @@ impl<S> Instance<S> {
             .collect::<Result<_>>()?;
         let ptrs: Vec<fmi2String> = cs.iter().map(|c| c.as_ptr()).collect();
         let s = unsafe {
-            (self.core.lib.api.SetString)(self.core.comp, vrs.as_ptr(), vrs.len(), ptrs.as_ptr())
+            (self.core.lib.api.fmi2SetString)(
+                self.core.comp,
+                vrs.as_ptr(),
+                vrs.len(),
+                ptrs.as_ptr(),
+            )
         };
         self.core.check("fmi2SetString", s, None)
     }
@@ -355,7 +375,12 @@ impl<S: Readable> Instance<S> {
             return Ok(());
         }
         let s = unsafe {
-            (self.core.lib.api.GetReal)(self.core.comp, vrs.as_ptr(), vrs.len(), out.as_mut_ptr())
+            (self.core.lib.api.fmi2GetReal)(
+                self.core.comp,
+                vrs.as_ptr(),
+                vrs.len(),
+                out.as_mut_ptr(),
+            )
         };
         self.core.check("fmi2GetReal", s, None)
     }
@@ -366,7 +391,7 @@ impl<S: Readable> Instance<S> {
             return Ok(());
         }
         let s = unsafe {
-            (self.core.lib.api.GetInteger)(
+            (self.core.lib.api.fmi2GetInteger)(
                 self.core.comp,
                 vrs.as_ptr(),
                 vrs.len(),
@@ -382,7 +407,7 @@ impl<S: Readable> Instance<S> {
             return Ok(());
         }
         let s = unsafe {
-            (self.core.lib.api.GetBoolean)(
+            (self.core.lib.api.fmi2GetBoolean)(
                 self.core.comp,
                 vrs.as_ptr(),
                 vrs.len(),
@@ -396,7 +421,7 @@ impl<S: Readable> Instance<S> {
     pub fn get_string(&mut self, vrs: &[VR]) -> Result<Vec<String>> {
         let mut ptrs: Vec<fmi2String> = vec![std::ptr::null(); vrs.len()];
         let s = unsafe {
-            (self.core.lib.api.GetString)(
+            (self.core.lib.api.fmi2GetString)(
                 self.core.comp,
                 vrs.as_ptr(),
                 vrs.len(),
@@ -419,7 +444,7 @@ impl Instance<Instantiated> {
         let lib = self.core.lib.clone();
         let api = &lib.api;
         let s = unsafe {
-            (api.SetupExperiment)(
+            (api.fmi2SetupExperiment)(
                 self.core.comp,
                 tolerance.is_some() as fmi2Boolean,
                 tolerance.unwrap_or(0.0),
@@ -430,7 +455,7 @@ impl Instance<Instantiated> {
         };
         self.core
             .check("fmi2SetupExperiment", s, Some(start_time))?;
-        let s = unsafe { (api.EnterInitializationMode)(self.core.comp) };
+        let s = unsafe { (api.fmi2EnterInitializationMode)(self.core.comp) };
         self.core
             .check("fmi2EnterInitializationMode", s, Some(start_time))?;
         self.core.phase = Phase::Initialized;
@@ -441,7 +466,7 @@ impl Instance<Instantiated> {
 impl Instance<Initializing> {
     /// `fmi2ExitInitializationMode`: the slave is then at its first communication point.
     pub fn exit_initialization_mode(mut self) -> Result<Instance<Stepping>> {
-        let s = unsafe { (self.core.lib.api.ExitInitializationMode)(self.core.comp) };
+        let s = unsafe { (self.core.lib.api.fmi2ExitInitializationMode)(self.core.comp) };
         self.core.check("fmi2ExitInitializationMode", s, None)?;
         Ok(self.transition())
     }
@@ -457,18 +482,19 @@ impl Instance<Stepping> {
         let api: *const crate::fmu::Api = &self.core.lib.api;
         // SAFETY: the Arc'd library outlives this call; a raw pointer avoids an Arc clone per step.
         let api = unsafe { &*api };
-        let s = unsafe { (api.DoStep)(self.core.comp, t, h, fmi2True) };
+        let s = unsafe { (api.fmi2DoStep)(self.core.comp, t, h, fmi2True) };
         if s == fmi2OK || s == fmi2Warning {
             return Ok(StepOutcome::Ok);
         }
         if s == fmi2Discard {
             let mut terminated: fmi2Boolean = fmi2False;
-            let st =
-                unsafe { (api.GetBooleanStatus)(self.core.comp, fmi2Terminated, &mut terminated) };
+            let st = unsafe {
+                (api.fmi2GetBooleanStatus)(self.core.comp, fmi2Terminated, &mut terminated)
+            };
             if st <= fmi2Warning && terminated != fmi2False {
                 let mut last = t;
                 let st = unsafe {
-                    (api.GetRealStatus)(self.core.comp, fmi2LastSuccessfulTime, &mut last)
+                    (api.fmi2GetRealStatus)(self.core.comp, fmi2LastSuccessfulTime, &mut last)
                 };
                 if st > fmi2Warning {
                     last = t;
@@ -485,7 +511,7 @@ impl Instance<Stepping> {
 
     /// `fmi2Terminate` then `fmi2FreeInstance`.
     pub fn terminate(mut self) -> Result<()> {
-        let s = unsafe { (self.core.lib.api.Terminate)(self.core.comp) };
+        let s = unsafe { (self.core.lib.api.fmi2Terminate)(self.core.comp) };
         self.core.phase = Phase::Terminated;
         self.core.check("fmi2Terminate", s, None)
     }

@@ -173,39 +173,7 @@ pub struct ModelVariables {
     pub variables: Vec<ScalarVariable>,
 }
 
-/// `causality` (FMI 2.0 section 2.2.7).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Default)]
-#[serde(rename_all = "camelCase")]
-pub enum Causality {
-    Parameter,
-    CalculatedParameter,
-    Input,
-    Output,
-    #[default]
-    Local,
-    Independent,
-}
-
-/// `variability` (FMI 2.0 section 2.2.7).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Default)]
-#[serde(rename_all = "camelCase")]
-pub enum Variability {
-    Constant,
-    Fixed,
-    Tunable,
-    Discrete,
-    #[default]
-    Continuous,
-}
-
-/// `initial` (FMI 2.0 section 2.2.7).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
-#[serde(rename_all = "camelCase")]
-pub enum Initial {
-    Exact,
-    Approx,
-    Calculated,
-}
+pub use fmi2::{Causality, Initial, Variability};
 
 /// Attributes of a `Real` variable or type.
 #[derive(Debug, Clone, Default, Deserialize)]
@@ -324,31 +292,6 @@ impl VarType {
 impl std::fmt::Display for VarType {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.write_str(self.name())
-    }
-}
-
-impl std::fmt::Display for Causality {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(match self {
-            Causality::Parameter => "parameter",
-            Causality::CalculatedParameter => "calculatedParameter",
-            Causality::Input => "input",
-            Causality::Output => "output",
-            Causality::Local => "local",
-            Causality::Independent => "independent",
-        })
-    }
-}
-
-impl std::fmt::Display for Variability {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(match self {
-            Variability::Constant => "constant",
-            Variability::Fixed => "fixed",
-            Variability::Tunable => "tunable",
-            Variability::Discrete => "discrete",
-            Variability::Continuous => "continuous",
-        })
     }
 }
 

@@ -128,7 +128,7 @@ fn check_binary(path: &Path) -> Result<()> {
         .filter(|s| s.is_definition())
         .filter_map(|s| s.name().ok())
         .collect();
-    let missing: Vec<&str> = fmi2::CS_FUNCTION_NAMES
+    let missing: Vec<&str> = fmi2::FUNCTION_NAMES
         .iter()
         .copied()
         .filter(|n| !exported.contains(n))

@@ -58,11 +58,13 @@ unsafe fn with_instance<M: FmuModel>(
     }
 }
 
-pub fn types_platform() -> *const c_char {
+/// `fmi2GetTypesPlatform`.
+pub fn get_types_platform<M: FmuModel>() -> *const c_char {
     c"default".as_ptr()
 }
 
-pub fn version() -> *const c_char {
+/// `fmi2GetVersion`.
+pub fn get_version<M: FmuModel>() -> *const c_char {
     c"2.0".as_ptr()
 }
 
@@ -851,6 +853,62 @@ pub unsafe fn unsupported<M: FmuModel>(c: fmi2Component, function: &str, why: &s
     with_instance::<M>(c, function, mask::ANY, |inst| {
         inst.error(&format!("{function} is not supported: {why}"))
     })
+}
+
+/// `fmi2GetDirectionalDerivative`: not provided (`providesDirectionalDerivative="false"`).
+///
+/// # Safety
+/// FMI 2.0 arguments.
+pub unsafe fn get_directional_derivative<M: FmuModel>(
+    c: fmi2Component,
+    _v_unknown: *const fmi2ValueReference,
+    _n_unknown: usize,
+    _v_known: *const fmi2ValueReference,
+    _n_known: usize,
+    _dv_known: *const fmi2Real,
+    _dv_unknown: *mut fmi2Real,
+) -> fmi2Status {
+    let why = "providesDirectionalDerivative=\"false\"";
+    unsupported::<M>(c, "fmi2GetDirectionalDerivative", why)
+}
+
+/// `fmi2SetRealInputDerivatives`: not supported (`canInterpolateInputs="false"`).
+///
+/// # Safety
+/// FMI 2.0 arguments.
+pub unsafe fn set_real_input_derivatives<M: FmuModel>(
+    c: fmi2Component,
+    _vr: *const fmi2ValueReference,
+    _nvr: usize,
+    _order: *const fmi2Integer,
+    _value: *const fmi2Real,
+) -> fmi2Status {
+    let why = "canInterpolateInputs=\"false\"";
+    unsupported::<M>(c, "fmi2SetRealInputDerivatives", why)
+}
+
+/// `fmi2GetRealOutputDerivatives`: not supported (`maxOutputDerivativeOrder="0"`).
+///
+/// # Safety
+/// FMI 2.0 arguments.
+pub unsafe fn get_real_output_derivatives<M: FmuModel>(
+    c: fmi2Component,
+    _vr: *const fmi2ValueReference,
+    _nvr: usize,
+    _order: *const fmi2Integer,
+    _value: *mut fmi2Real,
+) -> fmi2Status {
+    let why = "maxOutputDerivativeOrder=\"0\"";
+    unsupported::<M>(c, "fmi2GetRealOutputDerivatives", why)
+}
+
+/// `fmi2CancelStep`: fmi2DoStep never returns fmi2Pending.
+///
+/// # Safety
+/// FMI 2.0 arguments.
+pub unsafe fn cancel_step<M: FmuModel>(c: fmi2Component) -> fmi2Status {
+    let why = "fmi2DoStep never returns fmi2Pending (canRunAsynchronuously=\"false\")";
+    unsupported::<M>(c, "fmi2CancelStep", why)
 }
 
 /// `fmi2DoStep`: checks the communication point and step size, then advances the model.

@@ -9,31 +9,7 @@
 
 use std::fmt;
 
-/// `causality` (FMI 2.0 section 2.2.7).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Causality {
-    Parameter,
-    CalculatedParameter,
-    Input,
-    Output,
-    Local,
-}
-
-/// `variability` (FMI 2.0 section 2.2.7).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Variability {
-    Fixed,
-    Tunable,
-    Discrete,
-    Continuous,
-}
-
-/// `initial` (FMI 2.0 section 2.2.7).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Initial {
-    Exact,
-    Calculated,
-}
+pub use fmi2::{Causality, Initial, Variability};
 
 /// Typed accessors of a variable into the model `M`.
 pub enum Access<M> {
@@ -276,6 +252,27 @@ impl<M> Variable<M> {
         self
     }
 
+    /// An inclusive range `[lo, hi]` of a Real variable (declared in the XML, enforced on set).
+    pub const fn range(self, lo: f64, hi: f64) -> Self {
+        self.with_range(Some(lo), Some(hi))
+    }
+
+    /// A lower bound of a Real variable (declared in the XML, enforced on set).
+    pub const fn min(mut self, lo: f64) -> Self {
+        if let Access::Real { ref mut min, .. } = self.access {
+            *min = Some(lo);
+        }
+        self
+    }
+
+    /// An upper bound of a Real variable (declared in the XML, enforced on set).
+    pub const fn max(mut self, hi: f64) -> Self {
+        if let Access::Real { ref mut max, .. } = self.access {
+            *max = Some(hi);
+        }
+        self
+    }
+
     pub fn base_type(&self) -> BaseType {
         match self.access {
             Access::Real { .. } => BaseType::Real,
@@ -288,7 +285,7 @@ impl<M> Variable<M> {
     pub fn initial(&self) -> Option<Initial> {
         match self.causality {
             Causality::Parameter => Some(Initial::Exact),
-            Causality::Input => None,
+            Causality::Input | Causality::Independent => None,
             Causality::Output | Causality::Local | Causality::CalculatedParameter => {
                 Some(Initial::Calculated)
             }
@@ -470,6 +467,8 @@ pub fn check_table<M: Default>(vars: &[Variable<M>]) -> Result<(), Vec<String>> 
             Causality::Parameter | Causality::CalculatedParameter => {
                 matches!(v.variability, Variability::Fixed | Variability::Tunable)
             }
+            // The export layer has no independent variable (co-simulation time is the master's).
+            Causality::Independent => false,
             Causality::Input | Causality::Output | Causality::Local => {
                 matches!(
                     v.variability,

@@ -1,7 +1,7 @@
 //! Generation of `modelDescription.xml` (FMI 2.0 section 2.2) and `documentation/index.html`
 //! from a model's variable table.
 
-use crate::variables::{base_unit_names, unit_def, Access, Causality, Initial, Variability};
+use crate::variables::{base_unit_names, unit_def, Access, Causality, Initial};
 use crate::{FmuModel, LOG_CATEGORIES};
 use std::fmt::Write;
 
@@ -103,18 +103,11 @@ fn description_template<M: FmuModel>() -> String {
             r#"    <ScalarVariable name="{}" valueReference="{vr}" description="{}" causality="{}" variability="{}""#,
             escape(v.name),
             escape(v.description),
-            causality_str(v.causality),
-            variability_str(v.variability)
+            v.causality.xml_name(),
+            v.variability.xml_name()
         );
         if let Some(init) = v.initial() {
-            let _ = write!(
-                x,
-                r#" initial="{}""#,
-                match init {
-                    Initial::Exact => "exact",
-                    Initial::Calculated => "calculated",
-                }
-            );
+            let _ = write!(x, r#" initial="{}""#, init.xml_name());
         }
         x.push_str(">\n      ");
         match &v.access {
@@ -220,25 +213,6 @@ fn description_template<M: FmuModel>() -> String {
     x
 }
 
-fn causality_str(c: Causality) -> &'static str {
-    match c {
-        Causality::Parameter => "parameter",
-        Causality::CalculatedParameter => "calculatedParameter",
-        Causality::Input => "input",
-        Causality::Output => "output",
-        Causality::Local => "local",
-    }
-}
-
-fn variability_str(v: Variability) -> &'static str {
-    match v {
-        Variability::Fixed => "fixed",
-        Variability::Tunable => "tunable",
-        Variability::Discrete => "discrete",
-        Variability::Continuous => "continuous",
-    }
-}
-
 /// The GUID: a name-based (v5) UUID of the description text, so that any change to the variable
 /// table, units, capabilities or version gives a new GUID and an unchanged FMU keeps its GUID.
 pub fn guid<M: FmuModel>() -> String {
@@ -284,8 +258,8 @@ pub fn documentation_html<M: FmuModel>() -> String {
             h,
             "<tr><td><code>{}</code></td><td>{vr}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
             escape(v.name),
-            causality_str(v.causality),
-            variability_str(v.variability),
+            v.causality.xml_name(),
+            v.variability.xml_name(),
             v.base_type(),
             escape(v.unit().unwrap_or("")),
             escape(&start),

@@ -82,45 +82,12 @@ pub fn status_name(status: fmi2Status) -> &'static str {
     }
 }
 
-/// The names of every FMI 2.0 function a co-simulation FMU exports (25 common + 9 co-simulation),
-/// in the order of the standard's header. FMPy resolves each of these at load time.
-pub const CS_FUNCTION_NAMES: [&str; 34] = [
-    "fmi2GetTypesPlatform",
-    "fmi2GetVersion",
-    "fmi2SetDebugLogging",
-    "fmi2Instantiate",
-    "fmi2FreeInstance",
-    "fmi2SetupExperiment",
-    "fmi2EnterInitializationMode",
-    "fmi2ExitInitializationMode",
-    "fmi2Terminate",
-    "fmi2Reset",
-    "fmi2GetReal",
-    "fmi2GetInteger",
-    "fmi2GetBoolean",
-    "fmi2GetString",
-    "fmi2SetReal",
-    "fmi2SetInteger",
-    "fmi2SetBoolean",
-    "fmi2SetString",
-    "fmi2GetFMUstate",
-    "fmi2SetFMUstate",
-    "fmi2FreeFMUstate",
-    "fmi2SerializedFMUstateSize",
-    "fmi2SerializeFMUstate",
-    "fmi2DeSerializeFMUstate",
-    "fmi2GetDirectionalDerivative",
-    "fmi2SetRealInputDerivatives",
-    "fmi2GetRealOutputDerivatives",
-    "fmi2DoStep",
-    "fmi2CancelStep",
-    "fmi2GetStatus",
-    "fmi2GetRealStatus",
-    "fmi2GetIntegerStatus",
-    "fmi2GetBooleanStatus",
-    "fmi2GetStringStatus",
-];
+mod attributes;
+mod functions;
 
+pub use attributes::{Causality, Initial, Variability};
+
+fmi2_functions!(functions::define_abi);
 /// A non-variadic receiver of formatted log messages: (ctx, instance, status, category, message).
 pub type LogSinkFn =
     unsafe extern "C" fn(*mut c_void, *const c_char, c_int, *const c_char, *const c_char);
@@ -226,160 +193,9 @@ mod tests {
 
     #[test]
     fn function_list_is_complete_and_unique() {
-        let mut names = CS_FUNCTION_NAMES.to_vec();
+        let mut names = FUNCTION_NAMES.to_vec();
         names.sort();
         names.dedup();
         assert_eq!(names.len(), 34);
     }
-}
-
-/// Declares the 34 FMI 2.0 co-simulation functions as `extern "C"` items, for tests that call
-/// the symbols an FMU crate exports (linked from its rlib) exactly as a C importer would.
-/// Use once at module level: `fmi2::declare_fmi2_functions!();`.
-#[macro_export]
-macro_rules! declare_fmi2_functions {
-    () => {
-        #[allow(dead_code)]
-        extern "C" {
-            fn fmi2GetTypesPlatform() -> *const ::std::ffi::c_char;
-            fn fmi2GetVersion() -> *const ::std::ffi::c_char;
-            fn fmi2SetDebugLogging(
-                c: $crate::fmi2Component,
-                on: $crate::fmi2Boolean,
-                n: usize,
-                cats: *const $crate::fmi2String,
-            ) -> $crate::fmi2Status;
-            fn fmi2Instantiate(
-                name: $crate::fmi2String,
-                kind: $crate::fmi2Type,
-                guid: $crate::fmi2String,
-                resources: $crate::fmi2String,
-                functions: *const $crate::fmi2CallbackFunctions,
-                visible: $crate::fmi2Boolean,
-                logging_on: $crate::fmi2Boolean,
-            ) -> $crate::fmi2Component;
-            fn fmi2FreeInstance(c: $crate::fmi2Component);
-            fn fmi2SetupExperiment(
-                c: $crate::fmi2Component,
-                tol_defined: $crate::fmi2Boolean,
-                tol: f64,
-                start: f64,
-                stop_defined: $crate::fmi2Boolean,
-                stop: f64,
-            ) -> $crate::fmi2Status;
-            fn fmi2EnterInitializationMode(c: $crate::fmi2Component) -> $crate::fmi2Status;
-            fn fmi2ExitInitializationMode(c: $crate::fmi2Component) -> $crate::fmi2Status;
-            fn fmi2Terminate(c: $crate::fmi2Component) -> $crate::fmi2Status;
-            fn fmi2Reset(c: $crate::fmi2Component) -> $crate::fmi2Status;
-            fn fmi2GetReal(
-                c: $crate::fmi2Component,
-                vr: *const u32,
-                n: usize,
-                v: *mut f64,
-            ) -> $crate::fmi2Status;
-            fn fmi2GetInteger(
-                c: $crate::fmi2Component,
-                vr: *const u32,
-                n: usize,
-                v: *mut i32,
-            ) -> $crate::fmi2Status;
-            fn fmi2GetBoolean(
-                c: $crate::fmi2Component,
-                vr: *const u32,
-                n: usize,
-                v: *mut i32,
-            ) -> $crate::fmi2Status;
-            fn fmi2GetString(
-                c: $crate::fmi2Component,
-                vr: *const u32,
-                n: usize,
-                v: *mut $crate::fmi2String,
-            ) -> $crate::fmi2Status;
-            fn fmi2SetReal(
-                c: $crate::fmi2Component,
-                vr: *const u32,
-                n: usize,
-                v: *const f64,
-            ) -> $crate::fmi2Status;
-            fn fmi2SetInteger(
-                c: $crate::fmi2Component,
-                vr: *const u32,
-                n: usize,
-                v: *const i32,
-            ) -> $crate::fmi2Status;
-            fn fmi2SetBoolean(
-                c: $crate::fmi2Component,
-                vr: *const u32,
-                n: usize,
-                v: *const i32,
-            ) -> $crate::fmi2Status;
-            fn fmi2SetString(
-                c: $crate::fmi2Component,
-                vr: *const u32,
-                n: usize,
-                v: *const $crate::fmi2String,
-            ) -> $crate::fmi2Status;
-            fn fmi2GetFMUstate(
-                c: $crate::fmi2Component,
-                s: *mut $crate::fmi2FMUstate,
-            ) -> $crate::fmi2Status;
-            fn fmi2SetFMUstate(
-                c: $crate::fmi2Component,
-                s: $crate::fmi2FMUstate,
-            ) -> $crate::fmi2Status;
-            fn fmi2FreeFMUstate(
-                c: $crate::fmi2Component,
-                s: *mut $crate::fmi2FMUstate,
-            ) -> $crate::fmi2Status;
-            fn fmi2SerializedFMUstateSize(
-                c: $crate::fmi2Component,
-                s: $crate::fmi2FMUstate,
-                size: *mut usize,
-            ) -> $crate::fmi2Status;
-            fn fmi2SerializeFMUstate(
-                c: $crate::fmi2Component,
-                s: $crate::fmi2FMUstate,
-                bytes: *mut $crate::fmi2Byte,
-                size: usize,
-            ) -> $crate::fmi2Status;
-            fn fmi2DeSerializeFMUstate(
-                c: $crate::fmi2Component,
-                bytes: *const $crate::fmi2Byte,
-                size: usize,
-                s: *mut $crate::fmi2FMUstate,
-            ) -> $crate::fmi2Status;
-            fn fmi2DoStep(
-                c: $crate::fmi2Component,
-                t: f64,
-                h: f64,
-                no_prior: $crate::fmi2Boolean,
-            ) -> $crate::fmi2Status;
-            fn fmi2CancelStep(c: $crate::fmi2Component) -> $crate::fmi2Status;
-            fn fmi2GetStatus(
-                c: $crate::fmi2Component,
-                kind: $crate::fmi2StatusKind,
-                v: *mut $crate::fmi2Status,
-            ) -> $crate::fmi2Status;
-            fn fmi2GetRealStatus(
-                c: $crate::fmi2Component,
-                kind: $crate::fmi2StatusKind,
-                v: *mut f64,
-            ) -> $crate::fmi2Status;
-            fn fmi2GetIntegerStatus(
-                c: $crate::fmi2Component,
-                kind: $crate::fmi2StatusKind,
-                v: *mut i32,
-            ) -> $crate::fmi2Status;
-            fn fmi2GetBooleanStatus(
-                c: $crate::fmi2Component,
-                kind: $crate::fmi2StatusKind,
-                v: *mut i32,
-            ) -> $crate::fmi2Status;
-            fn fmi2GetStringStatus(
-                c: $crate::fmi2Component,
-                kind: $crate::fmi2StatusKind,
-                v: *mut $crate::fmi2String,
-            ) -> $crate::fmi2Status;
-        }
-    };
 }

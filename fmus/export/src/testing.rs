@@ -1,0 +1,687 @@
+//! Testing an FMU through its C API by variable name.
+//!
+//! [`Harness`] drives one instance through an [`Fmi2Functions`] table, as an importer does:
+//! either the `fmi2*` symbols an FMU crate exports (linked into its test binary by
+//! [`fmu_tests!`](crate::fmu_tests)), or the generic table [`functions`] of any model type. Values
+//! are set and read by name and type-checked against the variable table; every call checks its
+//! status and a failure names the FMU, the variable and the FMU's last log message.
+//!
+//! [`fmu_tests!`](crate::fmu_tests) generates, for an FMU crate, the checks every FMU must pass:
+//! the layer's table rules, the model description read back through the master's parser equal to
+//! the table, every variable readable and writable by name at its start value, and an exact
+//! rollback of the FMU state.
+
+use crate::variables::{check_table, Access, BaseType, Variable};
+use crate::xml::real;
+use crate::FmuModel;
+use fmi2::*;
+use std::ffi::{c_char, c_int, c_void, CString};
+use std::marker::PhantomData;
+use std::ptr::{null, null_mut};
+use std::sync::Mutex;
+
+/// Generic `extern "C"` shims over [`api`], one per FMI function, for any model type.
+macro_rules! shims {
+    (; $($name:ident $ty:ident $impl:ident ($($arg:ident : $argty:ty),*) -> $ret:ty;)*) => {
+        mod shim {
+            use crate::FmuModel;
+            $(
+                #[allow(clippy::unused_unit)]
+                pub unsafe extern "C" fn $impl<M: FmuModel>($($arg: $argty),*) -> $ret {
+                    crate::api::$impl::<M>($($arg),*)
+                }
+            )*
+        }
+
+        /// The FMI 2.0 API of model type `M` as a function table, without exporting symbols (so
+        /// that one test binary can drive several model types).
+        pub fn functions<M: FmuModel>() -> Fmi2Functions {
+            Fmi2Functions { $($name: shim::$impl::<M>,)* }
+        }
+    };
+}
+fmi2::fmi2_functions!(shims);
+
+/// Log lines an instance sent to the importer: (status, category, message).
+#[derive(Default)]
+pub struct Log {
+    lines: Mutex<Vec<(fmi2Status, String, String)>>,
+}
+
+impl Log {
+    /// Every line so far.
+    pub fn lines(&self) -> Vec<(fmi2Status, String, String)> {
+        self.lines.lock().map(|l| l.clone()).unwrap_or_default()
+    }
+    /// Whether any message contains `needle`.
+    pub fn contains(&self, needle: &str) -> bool {
+        self.lines().iter().any(|(_, _, m)| m.contains(needle))
+    }
+    /// How many lines were logged in `category`.
+    pub fn count(&self, category: &str) -> usize {
+        self.lines()
+            .iter()
+            .filter(|(_, c, _)| c == category)
+            .count()
+    }
+    /// The last message ("" if none).
+    pub fn last(&self) -> String {
+        self.lines().last().map(|l| l.2.clone()).unwrap_or_default()
+    }
+}
+
+unsafe extern "C" fn sink(
+    ctx: *mut c_void,
+    _instance: *const c_char,
+    status: c_int,
+    category: *const c_char,
+    message: *const c_char,
+) {
+    let log = &*(ctx as *const Log);
+    if let Ok(mut lines) = log.lines.lock() {
+        lines.push((status, lossy_str(category), lossy_str(message)));
+    }
+}
+
+/// A value of an FMI base type that [`Harness`] can get and set.
+pub trait Value: Copy + std::fmt::Debug {
+    const TYPE: BaseType;
+    /// # Safety
+    /// `c` must be a live instance of `f`.
+    unsafe fn get(
+        f: &Fmi2Functions,
+        c: fmi2Component,
+        vr: fmi2ValueReference,
+    ) -> (fmi2Status, Self);
+    /// # Safety
+    /// `c` must be a live instance of `f`.
+    unsafe fn set(self, f: &Fmi2Functions, c: fmi2Component, vr: fmi2ValueReference) -> fmi2Status;
+}
+
+impl Value for f64 {
+    const TYPE: BaseType = BaseType::Real;
+    unsafe fn get(
+        f: &Fmi2Functions,
+        c: fmi2Component,
+        vr: fmi2ValueReference,
+    ) -> (fmi2Status, Self) {
+        let mut v = f64::NAN;
+        ((f.fmi2GetReal)(c, &vr, 1, &mut v), v)
+    }
+    unsafe fn set(self, f: &Fmi2Functions, c: fmi2Component, vr: fmi2ValueReference) -> fmi2Status {
+        (f.fmi2SetReal)(c, &vr, 1, &self)
+    }
+}
+
+impl Value for i32 {
+    const TYPE: BaseType = BaseType::Integer;
+    unsafe fn get(
+        f: &Fmi2Functions,
+        c: fmi2Component,
+        vr: fmi2ValueReference,
+    ) -> (fmi2Status, Self) {
+        let mut v = 0;
+        ((f.fmi2GetInteger)(c, &vr, 1, &mut v), v)
+    }
+    unsafe fn set(self, f: &Fmi2Functions, c: fmi2Component, vr: fmi2ValueReference) -> fmi2Status {
+        (f.fmi2SetInteger)(c, &vr, 1, &self)
+    }
+}
+
+impl Value for bool {
+    const TYPE: BaseType = BaseType::Boolean;
+    unsafe fn get(
+        f: &Fmi2Functions,
+        c: fmi2Component,
+        vr: fmi2ValueReference,
+    ) -> (fmi2Status, Self) {
+        let mut v = fmi2False;
+        ((f.fmi2GetBoolean)(c, &vr, 1, &mut v), v != fmi2False)
+    }
+    unsafe fn set(self, f: &Fmi2Functions, c: fmi2Component, vr: fmi2ValueReference) -> fmi2Status {
+        let v = self as fmi2Boolean;
+        (f.fmi2SetBoolean)(c, &vr, 1, &v)
+    }
+}
+
+/// One instance of the FMU `M`, driven through `functions` by variable name. Dropping it frees
+/// the instance.
+pub struct Harness<M: FmuModel> {
+    f: Fmi2Functions,
+    c: fmi2Component,
+    log: Box<Log>,
+    _target: Box<LogTarget>,
+    _callbacks: Box<fmi2CallbackFunctions>,
+    _model: PhantomData<M>,
+}
+
+impl<M: FmuModel> Harness<M> {
+    /// `fmi2Instantiate` with the FMU's GUID, a capturing logger and logging off.
+    pub fn instantiate(functions: Fmi2Functions, name: &str) -> Self {
+        let log = Box::new(Log::default());
+        let mut target = Box::new(LogTarget {
+            sink: Some(sink),
+            ctx: &*log as *const Log as *mut c_void,
+        });
+        let callbacks = Box::new(fmi2CallbackFunctions {
+            logger: logger_proxy(),
+            allocateMemory: None,
+            freeMemory: None,
+            stepFinished: None,
+            componentEnvironment: &mut *target as *mut LogTarget as *mut c_void,
+        });
+        let cname = CString::new(name).expect("instance name without NUL");
+        let guid = CString::new(crate::xml::guid::<M>()).expect("GUID without NUL");
+        let c = unsafe {
+            (functions.fmi2Instantiate)(
+                cname.as_ptr(),
+                fmi2CoSimulation,
+                guid.as_ptr(),
+                null(),
+                &*callbacks,
+                fmi2False,
+                fmi2False,
+            )
+        };
+        assert!(
+            !c.is_null(),
+            "{}: fmi2Instantiate returned NULL: {}",
+            M::MODEL_IDENTIFIER,
+            log.last()
+        );
+        Harness {
+            f: functions,
+            c,
+            log,
+            _target: target,
+            _callbacks: callbacks,
+            _model: PhantomData,
+        }
+    }
+
+    /// The function table (for raw calls).
+    pub fn functions(&self) -> &Fmi2Functions {
+        &self.f
+    }
+
+    /// The instance (for raw calls).
+    pub fn component(&self) -> fmi2Component {
+        self.c
+    }
+
+    /// What the instance logged.
+    pub fn log(&self) -> &Log {
+        &self.log
+    }
+
+    fn check(&self, what: &str, status: fmi2Status) {
+        assert_eq!(
+            status,
+            fmi2OK,
+            "{}: {what} returned {}: {}",
+            M::MODEL_IDENTIFIER,
+            status_name(status),
+            self.log.last()
+        );
+    }
+
+    /// `fmi2SetupExperiment` (no tolerance; `stop` if given).
+    pub fn setup(&mut self, start: f64, stop: Option<f64>) -> fmi2Status {
+        let (defined, stop) = (stop.is_some() as fmi2Boolean, stop.unwrap_or(0.0));
+        unsafe { (self.f.fmi2SetupExperiment)(self.c, fmi2False, 0.0, start, defined, stop) }
+    }
+
+    /// `fmi2EnterInitializationMode`.
+    pub fn enter_initialization(&mut self) -> fmi2Status {
+        unsafe { (self.f.fmi2EnterInitializationMode)(self.c) }
+    }
+
+    /// `fmi2ExitInitializationMode`.
+    pub fn exit_initialization(&mut self) -> fmi2Status {
+        unsafe { (self.f.fmi2ExitInitializationMode)(self.c) }
+    }
+
+    /// Setup, enter and exit initialization at `start`, each checked.
+    pub fn initialize(&mut self, start: f64) -> &mut Self {
+        let s = self.setup(start, None);
+        self.check("fmi2SetupExperiment", s);
+        let s = self.enter_initialization();
+        self.check("fmi2EnterInitializationMode", s);
+        let s = self.exit_initialization();
+        self.check("fmi2ExitInitializationMode", s);
+        self
+    }
+
+    /// The table entry of `name` (panics naming the FMU if there is none).
+    pub fn variable(&self, name: &str) -> &'static Variable<M> {
+        &M::variables()[self.vr(name) as usize]
+    }
+
+    /// The value reference of `name` (panics naming the FMU if there is none).
+    pub fn vr(&self, name: &str) -> fmi2ValueReference {
+        match M::variables().iter().position(|v| v.name == name) {
+            Some(i) => i as fmi2ValueReference,
+            None => panic!("{} has no variable {name:?}", M::MODEL_IDENTIFIER),
+        }
+    }
+
+    fn typed<T: Value>(&self, name: &str) -> fmi2ValueReference {
+        let v = self.variable(name);
+        assert_eq!(
+            v.base_type(),
+            T::TYPE,
+            "{}: variable {name:?} is {}, not {}",
+            M::MODEL_IDENTIFIER,
+            v.base_type(),
+            T::TYPE
+        );
+        self.vr(name)
+    }
+
+    /// Sets `name` and returns the status.
+    pub fn try_set<T: Value>(&mut self, name: &str, value: T) -> fmi2Status {
+        let vr = self.typed::<T>(name);
+        unsafe { value.set(&self.f, self.c, vr) }
+    }
+
+    /// Sets `name`, checking the status.
+    pub fn set<T: Value>(&mut self, name: &str, value: T) -> &mut Self {
+        let s = self.try_set(name, value);
+        self.check(&format!("setting {name} = {value:?}"), s);
+        self
+    }
+
+    /// Reads `name` with its status.
+    pub fn try_get<T: Value>(&self, name: &str) -> (fmi2Status, T) {
+        let vr = self.typed::<T>(name);
+        unsafe { T::get(&self.f, self.c, vr) }
+    }
+
+    /// Reads `name`, checking the status.
+    pub fn get<T: Value>(&self, name: &str) -> T {
+        let (s, v) = self.try_get(name);
+        self.check(&format!("getting {name}"), s);
+        v
+    }
+
+    /// Reads a Real.
+    pub fn real(&self, name: &str) -> f64 {
+        self.get(name)
+    }
+
+    /// Reads several Reals with one `fmi2GetReal` call.
+    pub fn reals(&self, names: &[&str]) -> Vec<f64> {
+        let vrs: Vec<fmi2ValueReference> = names.iter().map(|n| self.typed::<f64>(n)).collect();
+        let mut out = vec![f64::NAN; vrs.len()];
+        let s = unsafe { (self.f.fmi2GetReal)(self.c, vrs.as_ptr(), vrs.len(), out.as_mut_ptr()) };
+        self.check(&format!("getting {names:?}"), s);
+        out
+    }
+
+    /// `fmi2DoStep` from `t` over `h`, returning the status.
+    pub fn try_step(&mut self, t: f64, h: f64) -> fmi2Status {
+        unsafe { (self.f.fmi2DoStep)(self.c, t, h, fmi2True) }
+    }
+
+    /// `fmi2DoStep` from `t` over `h`, checked.
+    pub fn step(&mut self, t: f64, h: f64) -> &mut Self {
+        let s = self.try_step(t, h);
+        self.check(&format!("fmi2DoStep({t}, {h})"), s);
+        self
+    }
+
+    /// `fmi2Terminate`.
+    pub fn terminate(&mut self) -> fmi2Status {
+        unsafe { (self.f.fmi2Terminate)(self.c) }
+    }
+
+    /// `fmi2Reset`.
+    pub fn reset(&mut self) -> fmi2Status {
+        unsafe { (self.f.fmi2Reset)(self.c) }
+    }
+
+    /// `fmi2GetFMUstate` into a new state, checked.
+    pub fn get_state(&mut self) -> fmi2FMUstate {
+        let mut s: fmi2FMUstate = null_mut();
+        let st = unsafe { (self.f.fmi2GetFMUstate)(self.c, &mut s) };
+        self.check("fmi2GetFMUstate", st);
+        s
+    }
+
+    /// `fmi2SetFMUstate`.
+    pub fn set_state(&mut self, state: fmi2FMUstate) -> fmi2Status {
+        unsafe { (self.f.fmi2SetFMUstate)(self.c, state) }
+    }
+
+    /// `fmi2FreeFMUstate`, checked.
+    pub fn free_state(&mut self, mut state: fmi2FMUstate) {
+        let st = unsafe { (self.f.fmi2FreeFMUstate)(self.c, &mut state) };
+        self.check("fmi2FreeFMUstate", st);
+    }
+
+    /// `fmi2SerializedFMUstateSize` and `fmi2SerializeFMUstate`, checked.
+    pub fn serialize(&mut self, state: fmi2FMUstate) -> Vec<u8> {
+        let mut size = 0usize;
+        let st = unsafe { (self.f.fmi2SerializedFMUstateSize)(self.c, state, &mut size) };
+        self.check("fmi2SerializedFMUstateSize", st);
+        let mut bytes = vec![0 as c_char; size];
+        let st = unsafe { (self.f.fmi2SerializeFMUstate)(self.c, state, bytes.as_mut_ptr(), size) };
+        self.check("fmi2SerializeFMUstate", st);
+        bytes.into_iter().map(|b| b as u8).collect()
+    }
+
+    /// `fmi2DeSerializeFMUstate` into a new state, with the status.
+    pub fn deserialize(&mut self, bytes: &[u8]) -> (fmi2Status, fmi2FMUstate) {
+        let mut s: fmi2FMUstate = null_mut();
+        let p = bytes.as_ptr() as *const c_char;
+        let st = unsafe { (self.f.fmi2DeSerializeFMUstate)(self.c, p, bytes.len(), &mut s) };
+        (st, s)
+    }
+}
+
+impl<M: FmuModel> Drop for Harness<M> {
+    fn drop(&mut self) {
+        unsafe { (self.f.fmi2FreeInstance)(self.c) }
+    }
+}
+
+/// One variable as `modelDescription.xml` declares it, in a form both the table and an
+/// importer's parser can produce (numbers as their shortest round-trip text).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Declared {
+    pub name: String,
+    pub value_reference: u32,
+    pub description: String,
+    pub causality: Causality,
+    pub variability: Variability,
+    pub initial: Option<Initial>,
+    pub base_type: &'static str,
+    pub unit: Option<String>,
+    pub min: Option<String>,
+    pub max: Option<String>,
+    pub start: Option<String>,
+    /// For outputs: the 1-based indices of the inputs it depends on (`None`: all).
+    pub dependencies: Option<Vec<usize>>,
+}
+
+/// What the table of `M` declares, variable by variable.
+pub fn declared<M: FmuModel>() -> Vec<Declared> {
+    let default = M::default();
+    let vars = M::variables();
+    let dependencies = |v: &Variable<M>| {
+        let names = v.dependencies.or(if M::DIRECT_FEEDTHROUGH {
+            None
+        } else {
+            Some(&[])
+        })?;
+        let index = |n: &&str| vars.iter().position(|w| w.name == *n).map(|k| k + 1);
+        Some(names.iter().filter_map(index).collect())
+    };
+    vars.iter()
+        .enumerate()
+        .map(|(vr, v)| {
+            let (base_type, min, max, start) = match &v.access {
+                Access::Real { get, min, max, .. } => {
+                    ("Real", min.map(real), max.map(real), real(get(&default)))
+                }
+                Access::Integer { get, min, max, .. } => (
+                    "Integer",
+                    min.map(|m| m.to_string()),
+                    max.map(|m| m.to_string()),
+                    get(&default).to_string(),
+                ),
+                Access::Boolean { get, .. } => ("Boolean", None, None, get(&default).to_string()),
+            };
+            Declared {
+                name: v.name.to_string(),
+                value_reference: vr as u32,
+                description: v.description.to_string(),
+                causality: v.causality,
+                variability: v.variability,
+                initial: v.initial(),
+                base_type,
+                unit: v.unit().map(str::to_string),
+                min,
+                max,
+                start: v.has_start().then_some(start),
+                dependencies: (v.causality == Causality::Output)
+                    .then(|| dependencies(v))
+                    .flatten(),
+            }
+        })
+        .collect()
+}
+
+/// The layer's rules for the table of `M` (see [`check_table`]), with the problems listed.
+pub fn check_variable_table<M: FmuModel>() {
+    if let Err(problems) = check_table(M::variables()) {
+        panic!("{}: {}", M::MODEL_IDENTIFIER, problems.join("; "));
+    }
+}
+
+/// Instantiates `M`, checks that every parameter and input reads back its start value by name in
+/// Initialization Mode and accepts it written again, initializes, reads every variable by name,
+/// writes every input and tunable parameter in Step Mode, and takes one step of the default
+/// experiment.
+pub fn check_every_variable<M: FmuModel>(functions: Fmi2Functions) {
+    let default = M::default();
+    let mut h = Harness::<M>::instantiate(functions, "every_variable");
+    let s = h.setup(M::DEFAULT_EXPERIMENT.start_time, None);
+    h.check("fmi2SetupExperiment", s);
+    let s = h.enter_initialization();
+    h.check("fmi2EnterInitializationMode", s);
+    for v in M::variables().iter().filter(|v| v.settable()) {
+        match &v.access {
+            Access::Real { get, .. } => {
+                assert_eq!(
+                    h.get::<f64>(v.name).to_bits(),
+                    get(&default).to_bits(),
+                    "{}",
+                    v.name
+                );
+                h.set(v.name, get(&default));
+            }
+            Access::Integer { get, .. } => {
+                assert_eq!(h.get::<i32>(v.name), get(&default), "{}", v.name);
+                h.set(v.name, get(&default));
+            }
+            Access::Boolean { get, .. } => {
+                assert_eq!(h.get::<bool>(v.name), get(&default), "{}", v.name);
+                h.set(v.name, get(&default));
+            }
+        }
+    }
+    let s = h.exit_initialization();
+    h.check("fmi2ExitInitializationMode", s);
+    let step_mode = |v: &&Variable<M>| {
+        v.causality == Causality::Input
+            || (v.causality == Causality::Parameter && v.variability == Variability::Tunable)
+    };
+    for v in M::variables() {
+        match v.base_type() {
+            BaseType::Real => {
+                let x = h.get::<f64>(v.name);
+                assert!(!x.is_nan(), "{}: {} is NaN", M::MODEL_IDENTIFIER, v.name);
+            }
+            BaseType::Integer => drop(h.get::<i32>(v.name)),
+            BaseType::Boolean => drop(h.get::<bool>(v.name)),
+        }
+    }
+    for v in M::variables().iter().filter(step_mode) {
+        match &v.access {
+            Access::Real { get, .. } => drop(h.set(v.name, get(&default))),
+            Access::Integer { get, .. } => drop(h.set(v.name, get(&default))),
+            Access::Boolean { get, .. } => drop(h.set(v.name, get(&default))),
+        }
+    }
+    let de = M::DEFAULT_EXPERIMENT;
+    h.step(de.start_time, de.step_size);
+    assert_eq!(h.terminate(), fmi2OK);
+}
+
+/// `fmi2GetVersion` is "2.0" and `fmi2Instantiate` refuses a wrong GUID with NULL.
+pub fn check_version_and_guid<M: FmuModel>(functions: Fmi2Functions) {
+    assert_eq!(unsafe { lossy_str((functions.fmi2GetVersion)()) }, "2.0");
+    assert_eq!(
+        unsafe { lossy_str((functions.fmi2GetTypesPlatform)()) },
+        "default"
+    );
+    let callbacks = fmi2CallbackFunctions {
+        logger: None,
+        allocateMemory: None,
+        freeMemory: None,
+        stepFinished: None,
+        componentEnvironment: null_mut(),
+    };
+    let (name, wrong) = (c"wrong_guid", c"{00000000-0000-0000-0000-000000000000}");
+    let c = unsafe {
+        let (kind, res) = (fmi2CoSimulation, null());
+        (functions.fmi2Instantiate)(name.as_ptr(), kind, wrong.as_ptr(), res, &callbacks, 0, 0)
+    };
+    assert!(
+        c.is_null(),
+        "{}: a wrong GUID was accepted",
+        M::MODEL_IDENTIFIER
+    );
+}
+
+/// Takes two default-experiment steps, restores the state saved after the first (directly and
+/// through serialization) and checks that the second step repeats bit for bit.
+pub fn check_state_rollback<M: FmuModel>(functions: Fmi2Functions) {
+    let reals: Vec<&str> = M::variables()
+        .iter()
+        .filter(|v| v.base_type() == BaseType::Real)
+        .map(|v| v.name)
+        .collect();
+    let de = M::DEFAULT_EXPERIMENT;
+    let (t0, dt) = (de.start_time, de.step_size);
+    let mut h = Harness::<M>::instantiate(functions, "rollback");
+    h.initialize(t0);
+    h.step(t0, dt);
+    let saved = h.get_state();
+    h.step(t0 + dt, dt);
+    let first: Vec<u64> = h.reals(&reals).iter().map(|x| x.to_bits()).collect();
+    assert_eq!(h.set_state(saved), fmi2OK);
+    h.step(t0 + dt, dt);
+    let again: Vec<u64> = h.reals(&reals).iter().map(|x| x.to_bits()).collect();
+    assert_eq!(first, again, "{}: rollback", M::MODEL_IDENTIFIER);
+    let bytes = h.serialize(saved);
+    let (st, restored) = h.deserialize(&bytes);
+    assert_eq!(st, fmi2OK);
+    assert_eq!(h.set_state(restored), fmi2OK);
+    h.step(t0 + dt, dt);
+    let third: Vec<u64> = h.reals(&reals).iter().map(|x| x.to_bits()).collect();
+    assert_eq!(first, third, "{}: serialized rollback", M::MODEL_IDENTIFIER);
+    h.free_state(saved);
+    h.free_state(restored);
+}
+
+/// The checks every FMU crate runs, as `#[test]` functions: the table rules, the model
+/// description read back through the master's parser (`shipsim`, a dev-dependency of the FMU
+/// crate) equal to the table, every variable by name, and an exact rollback. Also declares the
+/// FMI symbols the crate exports and `fn fmu() -> Harness<M>` over them, for the crate's own
+/// tests. Use once per test file: `fmi2_export::fmu_tests!(my_fmu::MyFmu);`.
+#[macro_export]
+macro_rules! fmu_tests {
+    ($model:ty) => {
+        $crate::fmi2::declare_fmi2_functions!();
+
+        /// A new instance of the FMU under test, through the symbols its crate exports.
+        #[allow(dead_code)]
+        fn fmu() -> $crate::testing::Harness<$model> {
+            $crate::testing::Harness::instantiate(linked_fmi2_functions(), "test")
+        }
+
+        #[test]
+        fn variable_table_passes_the_layer_checks() {
+            $crate::testing::check_variable_table::<$model>();
+        }
+
+        #[test]
+        fn model_description_read_by_the_master_equals_the_table() {
+            use $crate::FmuDescription;
+            let xml = $crate::xml::model_description::<$model>();
+            let md = ::shipsim::model_description::ModelDescription::parse(&xml)
+                .expect("the master parses the model description");
+            assert_eq!(
+                md.co_simulation
+                    .as_ref()
+                    .map(|c| c.model_identifier.as_str()),
+                Some(<$model>::MODEL_IDENTIFIER)
+            );
+            let outputs = md
+                .model_structure
+                .as_ref()
+                .and_then(|s| s.outputs.clone())
+                .unwrap_or_default()
+                .unknowns;
+            let parsed: Vec<_> = md
+                .model_variables
+                .variables
+                .iter()
+                .enumerate()
+                .map(|(i, v)| {
+                    let (base_type, min, max, start) = if let Some(r) = &v.real {
+                        (
+                            "Real",
+                            r.min.map($crate::xml::real),
+                            r.max.map($crate::xml::real),
+                            r.start.map($crate::xml::real),
+                        )
+                    } else if let Some(n) = &v.integer {
+                        (
+                            "Integer",
+                            n.min.map(|x| x.to_string()),
+                            n.max.map(|x| x.to_string()),
+                            n.start.map(|x| x.to_string()),
+                        )
+                    } else if let Some(b) = &v.boolean {
+                        ("Boolean", None, None, b.start.map(|x| x.to_string()))
+                    } else {
+                        ("other", None, None, None)
+                    };
+                    let output = outputs.iter().find(|u| u.index == i + 1);
+                    $crate::testing::Declared {
+                        name: v.name.clone(),
+                        value_reference: v.value_reference,
+                        description: v.description.clone().unwrap_or_default(),
+                        causality: v.causality,
+                        variability: v.variability,
+                        initial: v.initial,
+                        base_type,
+                        unit: v.real.as_ref().and_then(|r| r.unit.clone()),
+                        min,
+                        max,
+                        start,
+                        dependencies: output.and_then(|u| u.dependency_indices()),
+                    }
+                })
+                .collect();
+            let table = $crate::testing::declared::<$model>();
+            assert_eq!(parsed.len(), table.len());
+            for (p, t) in parsed.iter().zip(&table) {
+                assert_eq!(p, t);
+            }
+            let n_outputs = table
+                .iter()
+                .filter(|v| v.causality == $crate::Causality::Output)
+                .count();
+            assert_eq!(outputs.len(), n_outputs);
+        }
+
+        #[test]
+        fn version_and_guid_are_checked() {
+            $crate::testing::check_version_and_guid::<$model>(linked_fmi2_functions());
+        }
+
+        #[test]
+        fn every_variable_reads_and_writes_by_name() {
+            $crate::testing::check_every_variable::<$model>(linked_fmi2_functions());
+        }
+
+        #[test]
+        fn state_rollback_is_exact() {
+            $crate::testing::check_state_rollback::<$model>(linked_fmi2_functions());
+        }
+    };
+}
