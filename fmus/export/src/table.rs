@@ -54,6 +54,18 @@
 /// ```
 #[macro_export]
 macro_rules! fmu {
+    ($model:ty => $($rest:tt)*) => {
+        $crate::fmu_description!($model => $($rest)*);
+        $crate::export_fmu!($model);
+    };
+}
+
+/// The [`FmuDescription`](crate::FmuDescription) part of [`fmu!`](crate::fmu), without the C
+/// symbols (for tests that put several model types in one binary). Takes the documentation page
+/// either as a file next to the invoking source (`documentation: "documentation.html"`) or as
+/// text (`documentation_html: "<p>..</p>"`).
+#[macro_export]
+macro_rules! fmu_description {
     (
         $model:ty => $id:literal,
         description: $desc:expr,
@@ -62,6 +74,22 @@ macro_rules! fmu {
         documentation: $doc:literal,
         variables: { $($vars:tt)* } $(,)?
     ) => {
+        $crate::fmu_description!(@impl $model, $id, $desc, ($t0, $t1, $h), [$($df)?],
+            include_str!($doc), { $($vars)* });
+    };
+    (
+        $model:ty => $id:literal,
+        description: $desc:expr,
+        experiment: ($t0:expr, $t1:expr, $h:expr),
+        $(direct_feedthrough: $df:expr,)?
+        documentation_html: $html:expr,
+        variables: { $($vars:tt)* } $(,)?
+    ) => {
+        $crate::fmu_description!(@impl $model, $id, $desc, ($t0, $t1, $h), [$($df)?], $html,
+            { $($vars)* });
+    };
+    (@impl $model:ty, $id:literal, $desc:expr, ($t0:expr, $t1:expr, $h:expr), [$($df:expr)?],
+        $html:expr, { $($vars:tt)* }) => {
         impl $crate::FmuDescription for $model {
             const MODEL_IDENTIFIER: &'static str = $id;
             const DESCRIPTION: &'static str = $desc;
@@ -78,11 +106,9 @@ macro_rules! fmu {
             }
 
             fn documentation_html() -> &'static str {
-                include_str!($doc)
+                $html
             }
         }
-
-        $crate::export_fmu!($model);
     };
 }
 

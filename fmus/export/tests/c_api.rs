@@ -3,7 +3,7 @@
 //! The `fmi2*` symbols that `export_fmu!` emits forward one-to-one to these functions.
 
 use fmi2::*;
-use fmi2_export::{api, xml, DefaultExperiment, FmuModel, Variable};
+use fmi2_export::{api, xml, FmuDescription, FmuModel, Variable};
 use serde::{Deserialize, Serialize};
 use std::ffi::{c_char, c_int, c_void, CString};
 use std::ptr::{null, null_mut};
@@ -41,64 +41,26 @@ impl Default for Integrator {
     }
 }
 
-type IV = Variable<Integrator>;
-static INTEGRATOR_VARS: [IV; 10] = [
-    IV::real_parameter("gain", None, true, "gain", |m| m.gain, |m, v| m.gain = v),
-    IV::real_parameter(
-        "offset",
-        Some("m"),
-        false,
-        "initial output",
-        |m| m.offset,
-        |m, v| m.offset = v,
-    ),
-    IV::real_parameter(
-        "panic_at",
-        Some("s"),
-        true,
-        "panic when a step starts at or after this time",
-        |m| m.panic_at,
-        |m, v| m.panic_at = v,
-    ),
-    IV::real_parameter(
-        "fail_at",
-        Some("s"),
-        true,
-        "return an error from do_step at or after this time",
-        |m| m.fail_at,
-        |m, v| m.fail_at = v,
-    ),
-    IV::integer_parameter("mode", false, "mode", 1, 3, |m| m.mode, |m, v| m.mode = v),
-    IV::boolean_parameter(
-        "enabled",
-        true,
-        "integrate when true",
-        |m| m.enabled,
-        |m, v| m.enabled = v,
-    ),
-    IV::real_input("u", Some("m/s"), "input", |m| m.u, |m, v| m.u = v),
-    IV::real_output("y", Some("m"), "integral", |m| m.y).depends_on(&[]),
-    IV::real_output("u_times_gain", Some("m/s"), "direct feedthrough", |m| {
-        m.gain * m.u
-    })
-    .depends_on(&["u"]),
-    IV::boolean_output("positive", "y > 0", |m| m.y > 0.0),
-];
+fmi2_export::fmu_description! {
+    Integrator => "Integrator",
+    description: "test integrator",
+    experiment: (0.0, 10.0, 0.1),
+    documentation_html: "<p>test</p>",
+    variables: {
+        tunable real "gain" (gain), "gain";
+        fixed real "offset" ["m"] (offset), "initial output";
+        tunable real "panic_at" ["s"] (panic_at), "panic when a step starts at or after this time";
+        tunable real "fail_at" ["s"] (fail_at), "return an error from do_step at or after this time";
+        fixed int(1, 3) "mode" (mode), "mode";
+        tunable bool "enabled" (enabled), "integrate when true";
+        input real "u" ["m/s"] (u), "input";
+        output real "y" ["m"] (y).depends_on(&[]), "integral";
+        output real "u_times_gain" ["m/s"] (|m| m.gain * m.u).depends_on(&["u"]), "direct feedthrough";
+        output bool "positive" (|m| m.y > 0.0), "y > 0";
+    }
+}
 
 impl FmuModel for Integrator {
-    const MODEL_IDENTIFIER: &'static str = "Integrator";
-    const DESCRIPTION: &'static str = "test integrator";
-    const DEFAULT_EXPERIMENT: DefaultExperiment = DefaultExperiment {
-        start_time: 0.0,
-        stop_time: 10.0,
-        step_size: 0.1,
-    };
-    fn variables() -> &'static [Variable<Self>] {
-        &INTEGRATOR_VARS
-    }
-    fn documentation_html() -> &'static str {
-        "<p>test</p>"
-    }
     fn initialize(&mut self, _t: f64) -> Result<(), String> {
         if self.gain > 100.0 {
             return Err(format!("parameter gain = {} must be <= 100", self.gain));
@@ -132,17 +94,16 @@ impl FmuModel for Integrator {
 struct Other {
     x: f64,
 }
-static OTHER_VARS: [Variable<Other>; 1] = [Variable::real_output("x", None, "x", |m| m.x)];
+fmi2_export::fmu_description! {
+    Other => "Other",
+    description: "other",
+    experiment: (0.0, 10.0, 0.1),
+    documentation_html: "",
+    variables: {
+        output real "x" (x), "x";
+    }
+}
 impl FmuModel for Other {
-    const MODEL_IDENTIFIER: &'static str = "Other";
-    const DESCRIPTION: &'static str = "other";
-    const DEFAULT_EXPERIMENT: DefaultExperiment = Integrator::DEFAULT_EXPERIMENT;
-    fn variables() -> &'static [Variable<Self>] {
-        &OTHER_VARS
-    }
-    fn documentation_html() -> &'static str {
-        ""
-    }
     fn initialize(&mut self, _t: f64) -> Result<(), String> {
         Ok(())
     }
@@ -417,11 +378,11 @@ fn variable_table_and_model_description_are_consistent() {
         assert_eq!(xml.matches(&format!("<Unknown index=\"{i}\"/>")).count(), 1);
     }
     // a dependency on something that is not an input is a table error
-    let bad: [IV; 2] = [
-        IV::real_input("u", None, "u", |m| m.u, |m, v| m.u = v),
-        IV::real_output("y", None, "y", |m| m.y).depends_on(&["gain"]),
-    ];
-    let problems = fmi2_export::variables::check_table(&bad).unwrap_err();
+    let bad: &[Variable<Integrator>] = fmi2_export::variables!(Integrator;
+        input real "u" (u), "u";
+        output real "y" (y).depends_on(&["gain"]), "y";
+    );
+    let problems = fmi2_export::variables::check_table(bad).unwrap_err();
     assert!(
         problems[0].contains("dependency \"gain\" is not an input"),
         "{problems:?}"
@@ -438,8 +399,8 @@ fn variable_table_and_model_description_are_consistent() {
 #[test]
 fn types_platform_and_version() {
     unsafe {
-        assert_eq!(lossy_str(api::types_platform()), "default");
-        assert_eq!(lossy_str(api::version()), "2.0");
+        assert_eq!(lossy_str(api::get_types_platform::<Integrator>()), "default");
+        assert_eq!(lossy_str(api::get_version::<Integrator>()), "2.0");
     }
 }
 
@@ -940,4 +901,119 @@ fn debug_logging_filters_categories_and_escapes_percent() {
         .log
         .last()
         .contains("unknown log category \"log%s%d%n\""));
+}
+
+// ---------------------------------------------------------------------------------------------
+// The table language (fmu_description!/variables!) and the by-name harness.
+
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+enum Order {
+    First,
+    Second,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+struct Pose {
+    heading: f64,
+    heading_wrapped: f64,
+    x: f64,
+    y: f64,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+struct Table {
+    order: Order,
+    seed: u64,
+    gains: [f64; 2],
+    flag: bool,
+    pose: Pose,
+}
+
+impl Default for Table {
+    fn default() -> Self {
+        let pose = Pose { heading: 4.0, heading_wrapped: 4.0 - 2.0 * std::f64::consts::PI, x: 1.0, y: 2.0 };
+        Table { order: Order::Second, seed: 7, gains: [0.5, 1.5], flag: true, pose }
+    }
+}
+
+fmi2_export::fmu_description! {
+    Table => "Table",
+    description: "table language",
+    experiment: (0.0, 1.0, 0.5),
+    direct_feedthrough: false,
+    documentation_html: "",
+    variables: {
+        fixed int "order" (order => { 1: Order::First, 2: Order::Second }), "servo order";
+        fixed int(0, i32::MAX) "seed" (seed as u64), "seed";
+        tunable real "gain_b" (gains[1]).range(0.0, 2.0), "second gain";
+        tunable int(0, 1) "flag_code" (|m| m.flag as i32, |m, v| m.flag = v == 1), "flag as a code";
+        pose!(pose);
+        output real "sum" (|m| m.gains[0] + m.gains[1]), "sum of the gains";
+    }
+}
+
+impl FmuModel for Table {
+    fn initialize(&mut self, _t: f64) -> Result<(), String> {
+        Ok(())
+    }
+    fn do_step(&mut self, _t: f64, h: f64) -> Result<(), String> {
+        self.pose.x += self.gains[1] * h;
+        Ok(())
+    }
+}
+
+#[test]
+fn the_table_language_declares_enumerations_casts_paths_and_fragments() {
+    use fmi2_export::testing::{check_every_variable, check_state_rollback, functions, Harness};
+    fmi2_export::variables::check_table(Table::variables()).unwrap();
+    let xml = xml::model_description::<Table>();
+    // an enumeration's range is that of its codes; the start is the default's code
+    assert!(xml.contains(r#"name="order" valueReference="0""#));
+    assert!(xml.contains(r#"<Integer min="1" max="2" start="2"/>"#), "{xml}");
+    assert!(xml.contains(r#"<Integer min="0" max="2147483647" start="7"/>"#));
+    assert!(xml.contains(r#"<Real min="0.0" max="2.0" start="1.5"/>"#));
+    // the fragment splices its four entries in at its position
+    let names: Vec<&str> = Table::variables().iter().map(|v| v.name).collect();
+    assert_eq!(
+        names,
+        ["order", "seed", "gain_b", "flag_code", "heading", "heading_wrapped", "x", "y", "sum"]
+    );
+    assert!(xml.contains(r#"<Unknown index="7" dependencies=""/>"#));
+
+    let mut fmu = Harness::<Table>::instantiate(functions::<Table>(), "table");
+    assert_eq!(fmu.setup(0.0, None), fmi2OK);
+    assert_eq!(fmu.enter_initialization(), fmi2OK);
+    assert_eq!(fmu.get::<i32>("order"), 2);
+    fmu.set("order", 1).set("seed", 12).set("gain_b", 2.0).set("flag_code", 0);
+    assert_eq!(fmu.get::<i32>("order"), 1);
+    assert_eq!(fmu.get::<i32>("seed"), 12);
+    assert_eq!(fmu.get::<i32>("flag_code"), 0);
+    // out of the enumeration's range, and out of a Real range: refused, value kept
+    assert_eq!(fmu.try_set("order", 3), fmi2Error);
+    assert!(fmu.log().last().contains("order"), "{}", fmu.log().last());
+    assert_eq!(fmu.get::<i32>("order"), 1);
+    assert_eq!(fmu.try_set("gain_b", 2.5), fmi2Error);
+    assert_eq!(fmu.exit_initialization(), fmi2OK);
+    fmu.step(0.0, 0.5);
+    assert_eq!(fmu.reals(&["x", "y", "sum", "heading"]), [2.0, 2.0, 2.5, 4.0]);
+    check_every_variable::<Table>(functions::<Table>());
+    check_state_rollback::<Table>(functions::<Table>());
+    check_every_variable::<Integrator>(functions::<Integrator>());
+    check_state_rollback::<Integrator>(functions::<Integrator>());
+}
+
+#[test]
+#[should_panic(expected = "Table: variable \"seed\" is Integer, not Real")]
+fn the_harness_refuses_a_value_of_the_wrong_type() {
+    use fmi2_export::testing::{functions, Harness};
+    let mut fmu = Harness::<Table>::instantiate(functions::<Table>(), "table");
+    fmu.set("seed", 1.0);
+}
+
+#[test]
+#[should_panic(expected = "Table has no variable \"speed\"")]
+fn the_harness_names_a_missing_variable() {
+    use fmi2_export::testing::{functions, Harness};
+    let fmu = Harness::<Table>::instantiate(functions::<Table>(), "table");
+    fmu.real("speed");
 }
