@@ -41,6 +41,8 @@ pub struct FmuCrate {
     pub package: String,
     pub lib_name: String,
     pub model_identifier: String,
+    /// `example = true`: an example FMU (examples/), packaged into `target/fmu-examples/`.
+    pub example: bool,
 }
 
 /// Lists the FMU crates from `cargo metadata`.
@@ -63,15 +65,17 @@ pub fn fmu_crates(root: &Path) -> Result<Vec<FmuCrate>> {
         .iter()
         .filter(|p| meta.workspace_members.contains(&p.id))
     {
-        let Some(id) = p
-            .metadata
-            .as_ref()
-            .and_then(|m| m.get("fmu"))
+        let fmu = p.metadata.as_ref().and_then(|m| m.get("fmu"));
+        let Some(id) = fmu
             .and_then(|f| f.get("model-identifier"))
             .and_then(|v| v.as_str())
         else {
             continue;
         };
+        let example = fmu
+            .and_then(|f| f.get("example"))
+            .and_then(|v| v.as_bool())
+            .unwrap_or(false);
         let lib = p
             .targets
             .iter()
@@ -81,6 +85,7 @@ pub fn fmu_crates(root: &Path) -> Result<Vec<FmuCrate>> {
             package: p.name.clone(),
             lib_name: lib.name.clone(),
             model_identifier: id.to_string(),
+            example,
         });
     }
     crates.sort_by(|a, b| a.model_identifier.cmp(&b.model_identifier));
@@ -191,7 +196,8 @@ fn write_fmu(out: &Path, id: &str, xml: &str, so: &Path, html: &str) -> Result<(
     Ok(())
 }
 
-/// Builds and packages every FMU; returns the output folder `target/fmu`.
+/// Builds and packages every FMU; returns the output folder `target/fmu` (example FMUs go to
+/// `target/fmu-examples`).
 pub fn build_fmus(root: &Path) -> Result<PathBuf> {
     let crates = fmu_crates(root)?;
     if crates.is_empty() {
@@ -204,7 +210,9 @@ pub fn build_fmus(root: &Path) -> Result<PathBuf> {
     }
     run(&mut cmd)?;
     let out_dir = root.join("target/fmu");
+    let examples_dir = root.join("target/fmu-examples");
     std::fs::create_dir_all(&out_dir)?;
+    std::fs::create_dir_all(&examples_dir)?;
     for c in &crates {
         let so = root.join(format!("target/release/lib{}.so", c.lib_name));
         check_binary(&so)?;
@@ -213,7 +221,8 @@ pub fn build_fmus(root: &Path) -> Result<PathBuf> {
             .with_context(|| format!("loading {}", so.display()))?;
         let xml = generated_text(&lib, b"shipfmu_model_description")?;
         let html = generated_text(&lib, b"shipfmu_documentation_html")?;
-        let fmu = out_dir.join(format!("{}.fmu", c.model_identifier));
+        let dir = if c.example { &examples_dir } else { &out_dir };
+        let fmu = dir.join(format!("{}.fmu", c.model_identifier));
         write_fmu(&fmu, &c.model_identifier, &xml, &so, &html)?;
         eprintln!("xtask: wrote {}", fmu.display());
     }
