@@ -1,7 +1,7 @@
 //! `Sensors` FMU: sample-and-hold plus Gaussian white measurement noise per channel
 //! (`models::sensors`), with the noise levels of 004 Tables 3/9 and 002's DGPS. No physics here.
 
-use fmi2_export::{export_fmu, DefaultExperiment, FmuModel, Variable};
+use fmi2_export::FmuModel;
 use models::sensors::{SensorParams, Sensors, CHANNELS};
 use serde::{Deserialize, Serialize};
 
@@ -25,97 +25,95 @@ impl Default for SensorsFmu {
     }
 }
 
-type V = Variable<SensorsFmu>;
-
-macro_rules! table {
-    ($( $i:literal, $name:literal, $unit:literal, $what:literal; )*) => {
-        [
-            V::integer_parameter(
-                "seed",
-                false,
-                "Seed of this instance's ChaCha8 streams (one stream per channel)",
-                0,
-                i32::MAX,
-                |m| m.params.seed as i32,
-                |m, v| m.params.seed = v as u64,
-            ),
-            V::real_parameter(
-                "noise_scale",
-                None,
-                true,
-                "Multiplies every sigma (004 uses 1, 0.001 and 0)",
-                |m| m.params.noise_scale,
-                |m, v| m.params.noise_scale = v,
-            )
-            .with_range(Some(0.0), None),
-            $(
-                V::real_parameter(
-                    concat!($name, "_sigma"),
-                    Some($unit),
-                    true,
-                    concat!("Per-sample standard deviation of the ", $what, " noise"),
-                    |m| m.params.channels[$i].sigma,
-                    |m, v| m.params.channels[$i].sigma = v,
-                )
-                .with_range(Some(0.0), None),
-                V::real_parameter(
-                    concat!($name, "_interval"),
-                    Some("s"),
-                    false,
-                    concat!("Sampling interval of the ", $what, " (samples at t0 + k interval, held)"),
-                    |m| m.params.channels[$i].interval,
-                    |m, v| m.params.channels[$i].interval = v,
-                )
-                .with_range(Some(1e-6), None),
-                V::real_input(
-                    $name,
-                    Some($unit),
-                    concat!("True ", $what),
-                    |m| m.input[$i],
-                    |m, v| m.input[$i] = v,
-                ),
-                V::real_output(
-                    concat!($name, "_measured"),
-                    Some($unit),
-                    concat!("Measured ", $what, ": sampled true value plus noise, zero-order hold"),
-                    |m| m.sensors.measured($i),
-                ),
-            )*
-        ]
-    };
+fmi2_export::fmu! {
+    SensorsFmu => "Sensors",
+    description: "Seeded sensor block: sample-and-hold plus Gaussian white \
+        noise for heading, yaw rate, roll, roll rate, position, cross-track, speed and sway \
+        velocity (Parsons & Cuong 1980 Tables 3/9, Artyszuk DGPS 2 m at 1 s)",
+    experiment: (0.0, 100.0, 0.1),
+    documentation: "documentation.html",
+    variables: {
+        fixed int(0, i32::MAX) "seed" (params.seed as u64),
+            "Seed of this instance's ChaCha8 streams (one stream per channel)";
+        tunable real "noise_scale" (params.noise_scale).min(0.0),
+            "Multiplies every sigma (004 uses 1, 0.001 and 0)";
+        // Four entries per channel of models::sensors::CHANNEL_NAMES, in its order.
+        tunable real "heading_sigma" ["rad"] (|m| m.params.channels[0].sigma, |m, v| m.params.channels[0].sigma = v).min(0.0),
+            "Per-sample standard deviation of the heading psi (default: 004 Table 3 compass, sigma' = 1.611e-3 at 0.2349 s) noise";
+        fixed real "heading_interval" ["s"] (|m| m.params.channels[0].interval, |m, v| m.params.channels[0].interval = v).min(1e-6),
+            "Sampling interval of the heading psi (default: 004 Table 3 compass, sigma' = 1.611e-3 at 0.2349 s) (samples at t0 + k interval, held)";
+        input real "heading" ["rad"] (input[0]),
+            "True heading psi (default: 004 Table 3 compass, sigma' = 1.611e-3 at 0.2349 s)";
+        output real "heading_measured" ["rad"] (|m| m.sensors.measured(0)),
+            "Measured heading psi (default: 004 Table 3 compass, sigma' = 1.611e-3 at 0.2349 s): sampled true value plus noise, zero-order hold";
+        tunable real "yaw_rate_sigma" ["rad/s"] (|m| m.params.channels[1].sigma, |m, v| m.params.channels[1].sigma = v).min(0.0),
+            "Per-sample standard deviation of the yaw rate r (default: 004 Table 3 rate gyro, 7.563e-3 U/L at 0.2349 s) noise";
+        fixed real "yaw_rate_interval" ["s"] (|m| m.params.channels[1].interval, |m, v| m.params.channels[1].interval = v).min(1e-6),
+            "Sampling interval of the yaw rate r (default: 004 Table 3 rate gyro, 7.563e-3 U/L at 0.2349 s) (samples at t0 + k interval, held)";
+        input real "yaw_rate" ["rad/s"] (input[1]),
+            "True yaw rate r (default: 004 Table 3 rate gyro, 7.563e-3 U/L at 0.2349 s)";
+        output real "yaw_rate_measured" ["rad/s"] (|m| m.sensors.measured(1)),
+            "Measured yaw rate r (default: 004 Table 3 rate gyro, 7.563e-3 U/L at 0.2349 s): sampled true value plus noise, zero-order hold";
+        tunable real "roll_sigma" ["rad"] (|m| m.params.channels[2].sigma, |m, v| m.params.channels[2].sigma = v).min(0.0),
+            "Per-sample standard deviation of the roll angle phi (no level in the sources: 0) noise";
+        fixed real "roll_interval" ["s"] (|m| m.params.channels[2].interval, |m, v| m.params.channels[2].interval = v).min(1e-6),
+            "Sampling interval of the roll angle phi (no level in the sources: 0) (samples at t0 + k interval, held)";
+        input real "roll" ["rad"] (input[2]),
+            "True roll angle phi (no level in the sources: 0)";
+        output real "roll_measured" ["rad"] (|m| m.sensors.measured(2)),
+            "Measured roll angle phi (no level in the sources: 0): sampled true value plus noise, zero-order hold";
+        tunable real "roll_rate_sigma" ["rad/s"] (|m| m.params.channels[3].sigma, |m, v| m.params.channels[3].sigma = v).min(0.0),
+            "Per-sample standard deviation of the roll rate p (no level in the sources: 0) noise";
+        fixed real "roll_rate_interval" ["s"] (|m| m.params.channels[3].interval, |m, v| m.params.channels[3].interval = v).min(1e-6),
+            "Sampling interval of the roll rate p (no level in the sources: 0) (samples at t0 + k interval, held)";
+        input real "roll_rate" ["rad/s"] (input[3]),
+            "True roll rate p (no level in the sources: 0)";
+        output real "roll_rate_measured" ["rad/s"] (|m| m.sensors.measured(3)),
+            "Measured roll rate p (no level in the sources: 0): sampled true value plus noise, zero-order hold";
+        tunable real "north_sigma" ["m"] (|m| m.params.channels[4].sigma, |m, v| m.params.channels[4].sigma = v).min(0.0),
+            "Per-sample standard deviation of the north position (default: 002 DGPS, 2 m at 1 s) noise";
+        fixed real "north_interval" ["s"] (|m| m.params.channels[4].interval, |m, v| m.params.channels[4].interval = v).min(1e-6),
+            "Sampling interval of the north position (default: 002 DGPS, 2 m at 1 s) (samples at t0 + k interval, held)";
+        input real "north" ["m"] (input[4]),
+            "True north position (default: 002 DGPS, 2 m at 1 s)";
+        output real "north_measured" ["m"] (|m| m.sensors.measured(4)),
+            "Measured north position (default: 002 DGPS, 2 m at 1 s): sampled true value plus noise, zero-order hold";
+        tunable real "east_sigma" ["m"] (|m| m.params.channels[5].sigma, |m, v| m.params.channels[5].sigma = v).min(0.0),
+            "Per-sample standard deviation of the east position (default: 002 DGPS, 2 m at 1 s) noise";
+        fixed real "east_interval" ["s"] (|m| m.params.channels[5].interval, |m, v| m.params.channels[5].interval = v).min(1e-6),
+            "Sampling interval of the east position (default: 002 DGPS, 2 m at 1 s) (samples at t0 + k interval, held)";
+        input real "east" ["m"] (input[5]),
+            "True east position (default: 002 DGPS, 2 m at 1 s)";
+        output real "east_measured" ["m"] (|m| m.sensors.measured(5)),
+            "Measured east position (default: 002 DGPS, 2 m at 1 s): sampled true value plus noise, zero-order hold";
+        tunable real "cross_track_sigma" ["m"] (|m| m.params.channels[6].sigma, |m, v| m.params.channels[6].sigma = v).min(0.0),
+            "Per-sample standard deviation of the cross-track offset eta (default: 004 Table 3 DECCA, 9.549e-3 L at 0.2349 s) noise";
+        fixed real "cross_track_interval" ["s"] (|m| m.params.channels[6].interval, |m, v| m.params.channels[6].interval = v).min(1e-6),
+            "Sampling interval of the cross-track offset eta (default: 004 Table 3 DECCA, 9.549e-3 L at 0.2349 s) (samples at t0 + k interval, held)";
+        input real "cross_track" ["m"] (input[6]),
+            "True cross-track offset eta (default: 004 Table 3 DECCA, 9.549e-3 L at 0.2349 s)";
+        output real "cross_track_measured" ["m"] (|m| m.sensors.measured(6)),
+            "Measured cross-track offset eta (default: 004 Table 3 DECCA, 9.549e-3 L at 0.2349 s): sampled true value plus noise, zero-order hold";
+        tunable real "speed_sigma" ["m/s"] (|m| m.params.channels[7].sigma, |m, v| m.params.channels[7].sigma = v).min(0.0),
+            "Per-sample standard deviation of the speed (no level in the sources: 0) noise";
+        fixed real "speed_interval" ["s"] (|m| m.params.channels[7].interval, |m, v| m.params.channels[7].interval = v).min(1e-6),
+            "Sampling interval of the speed (no level in the sources: 0) (samples at t0 + k interval, held)";
+        input real "speed" ["m/s"] (input[7]),
+            "True speed (no level in the sources: 0)";
+        output real "speed_measured" ["m/s"] (|m| m.sensors.measured(7)),
+            "Measured speed (no level in the sources: 0): sampled true value plus noise, zero-order hold";
+        tunable real "sway_velocity_sigma" ["m/s"] (|m| m.params.channels[8].sigma, |m, v| m.params.channels[8].sigma = v).min(0.0),
+            "Per-sample standard deviation of the sway velocity v = -U beta (default: 004 Table 3 Doppler, 1.495e-3 U at 0.2349 s) noise";
+        fixed real "sway_velocity_interval" ["s"] (|m| m.params.channels[8].interval, |m, v| m.params.channels[8].interval = v).min(1e-6),
+            "Sampling interval of the sway velocity v = -U beta (default: 004 Table 3 Doppler, 1.495e-3 U at 0.2349 s) (samples at t0 + k interval, held)";
+        input real "sway_velocity" ["m/s"] (input[8]),
+            "True sway velocity v = -U beta (default: 004 Table 3 Doppler, 1.495e-3 U at 0.2349 s)";
+        output real "sway_velocity_measured" ["m/s"] (|m| m.sensors.measured(8)),
+            "Measured sway velocity v = -U beta (default: 004 Table 3 Doppler, 1.495e-3 U at 0.2349 s): sampled true value plus noise, zero-order hold";
+    }
 }
 
-static VARIABLES: [V; 2 + 4 * CHANNELS] = table! {
-    0, "heading", "rad", "heading psi (default: 004 Table 3 compass, sigma' = 1.611e-3 at 0.2349 s)";
-    1, "yaw_rate", "rad/s", "yaw rate r (default: 004 Table 3 rate gyro, 7.563e-3 U/L at 0.2349 s)";
-    2, "roll", "rad", "roll angle phi (no level in the sources: 0)";
-    3, "roll_rate", "rad/s", "roll rate p (no level in the sources: 0)";
-    4, "north", "m", "north position (default: 002 DGPS, 2 m at 1 s)";
-    5, "east", "m", "east position (default: 002 DGPS, 2 m at 1 s)";
-    6, "cross_track", "m", "cross-track offset eta (default: 004 Table 3 DECCA, 9.549e-3 L at 0.2349 s)";
-    7, "speed", "m/s", "speed (no level in the sources: 0)";
-    8, "sway_velocity", "m/s", "sway velocity v = -U beta (default: 004 Table 3 Doppler, 1.495e-3 U at 0.2349 s)";
-};
-
 impl FmuModel for SensorsFmu {
-    const MODEL_IDENTIFIER: &'static str = "Sensors";
-    const DESCRIPTION: &'static str = "Seeded sensor block: sample-and-hold plus Gaussian white \
-        noise for heading, yaw rate, roll, roll rate, position, cross-track, speed and sway \
-        velocity (Parsons & Cuong 1980 Tables 3/9, Artyszuk DGPS 2 m at 1 s)";
-    const DEFAULT_EXPERIMENT: DefaultExperiment = DefaultExperiment {
-        start_time: 0.0,
-        stop_time: 100.0,
-        step_size: 0.1,
-    };
-
-    fn variables() -> &'static [Variable<Self>] {
-        &VARIABLES
-    }
-
-    fn documentation_html() -> &'static str {
-        include_str!("documentation.html")
-    }
-
     fn initialize(&mut self, start_time: f64) -> Result<(), String> {
         self.sensors = Sensors::new(self.params.clone(), start_time, self.input)?;
         Ok(())
@@ -141,5 +139,3 @@ impl FmuModel for SensorsFmu {
         Ok(())
     }
 }
-
-export_fmu!(SensorsFmu);
