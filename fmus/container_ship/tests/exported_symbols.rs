@@ -1,23 +1,23 @@
-//! Calls the `fmi2*` symbols that `export_fmu!` emitted for ContainerShip (linked from this
-//! crate's rlib), as a C importer would, and checks them against the model bit for bit.
+//! ContainerShip through the `fmi2*` symbols its crate exports, as a C importer calls them: the
+//! checks every FMU runs, and the FMU against `models::hull::container_ship` bit for bit, by
+//! variable name.
 
-use container_ship_fmu::ContainerShipFmu as Fmu;
-use fmi2::*;
-use fmi2_export::FmuModel;
+use container_ship_fmu::ContainerShipFmu;
+use fmi2_export::fmi2::{fmi2Error, fmi2OK};
+use fmi2_export::testing::Harness;
 use models::hull::container_ship::{
     ContainerShip, ContainerShipInputs, ContainerShipOutputs, LinearContainerShip,
     LinearContainerShipInputs,
 };
-use std::ffi::CString;
-use std::ptr::null;
 
-fmi2::declare_fmi2_functions!();
+fmi2_export::fmu_tests!(ContainerShipFmu);
 
-fn vr(name: &str) -> u32 {
-    Fmu::variables()
-        .iter()
-        .position(|v| v.name == name)
-        .unwrap_or_else(|| panic!("no variable {name}")) as u32
+/// An instance in Initialization Mode at t = 0.
+fn initializing() -> Harness<ContainerShipFmu> {
+    let mut fmu = fmu();
+    assert_eq!(fmu.setup(0.0, None), fmi2OK);
+    assert_eq!(fmu.enter_initialization(), fmi2OK);
+    fmu
 }
 
 const OUTPUTS: [&str; 16] = [
@@ -39,8 +39,8 @@ const OUTPUTS: [&str; 16] = [
     "roll_rate_prime",
 ];
 
-fn expected(o: &ContainerShipOutputs) -> [f64; 16] {
-    [
+fn expected(o: &ContainerShipOutputs) -> Vec<f64> {
+    vec![
         o.u,
         o.v,
         o.r,
@@ -60,121 +60,54 @@ fn expected(o: &ContainerShipOutputs) -> [f64; 16] {
     ]
 }
 
-unsafe fn instantiate() -> fmi2Component {
-    let guid = CString::new(fmi2_export::xml::guid::<Fmu>()).unwrap();
-    let name = CString::new("ship").unwrap();
-    let cb = fmi2CallbackFunctions {
-        logger: None,
-        allocateMemory: None,
-        freeMemory: None,
-        stepFinished: None,
-        componentEnvironment: std::ptr::null_mut(),
-    };
-    let c = fmi2Instantiate(
-        name.as_ptr(),
-        fmi2CoSimulation,
-        guid.as_ptr(),
-        null(),
-        &cb,
-        0,
-        0,
-    );
-    assert!(!c.is_null());
-    assert_eq!(fmi2SetupExperiment(c, 0, 0.0, 0.0, 0, 0.0), fmi2OK);
-    assert_eq!(fmi2EnterInitializationMode(c), fmi2OK);
-    c
-}
-
 #[test]
 fn exported_api_reproduces_the_nonlinear_model() {
-    unsafe {
-        let c = instantiate();
-        assert_eq!(fmi2ExitInitializationMode(c), fmi2OK);
-        let mut model = ContainerShip::at_equilibrium(80.0).unwrap();
-        let ins = [
-            vr("rudder_command"),
-            vr("shaft_speed_command"),
-            vr("sway_force"),
-            vr("roll_moment"),
-            vr("yaw_moment"),
-        ];
-        let outs: Vec<u32> = OUTPUTS.iter().map(|n| vr(n)).collect();
-        let h = 0.1;
-        for k in 0..1000 {
-            let t = k as f64 * h;
-            let u = [
-                0.3 * (0.05 * t).sin(),
-                80.0 - 10.0 * (0.01 * t).sin(),
-                1e5 * (0.1 * t).sin(),
-                2e6 * (0.5 * t).sin(),
-                -1e6 * (0.02 * t).cos(),
-            ];
-            assert_eq!(fmi2SetReal(c, ins.as_ptr(), 5, u.as_ptr()), fmi2OK);
-            assert_eq!(fmi2DoStep(c, t, h, 1), fmi2OK);
-            model.step(
-                &ContainerShipInputs {
-                    rudder_command: u[0],
-                    shaft_command_rpm: u[1],
-                    sway_force_ext: u[2],
-                    roll_moment_ext: u[3],
-                    yaw_moment_ext: u[4],
-                },
-                h,
-            );
-            let mut v = [0.0; 16];
-            assert_eq!(fmi2GetReal(c, outs.as_ptr(), 16, v.as_mut_ptr()), fmi2OK);
-            assert_eq!(v, expected(&model.outputs()), "step {k}");
-        }
-        assert!(model.outputs().heading.abs() > 0.1);
-        assert_eq!(fmi2Terminate(c), fmi2OK);
-        fmi2FreeInstance(c);
+    let mut fmu = fmu();
+    fmu.initialize(0.0);
+    let mut model = ContainerShip::at_equilibrium(80.0).unwrap();
+    let h = 0.1;
+    for k in 0..1000 {
+        let t = k as f64 * h;
+        let inputs = ContainerShipInputs {
+            rudder_command: 0.3 * (0.05 * t).sin(),
+            shaft_command_rpm: 80.0 - 10.0 * (0.01 * t).sin(),
+            sway_force_ext: 1e5 * (0.1 * t).sin(),
+            roll_moment_ext: 2e6 * (0.5 * t).sin(),
+            yaw_moment_ext: -1e6 * (0.02 * t).cos(),
+        };
+        fmu.set("rudder_command", inputs.rudder_command)
+            .set("shaft_speed_command", inputs.shaft_command_rpm)
+            .set("sway_force", inputs.sway_force_ext)
+            .set("roll_moment", inputs.roll_moment_ext)
+            .set("yaw_moment", inputs.yaw_moment_ext)
+            .step(t, h);
+        model.step(&inputs, h);
+        assert_eq!(fmu.reals(&OUTPUTS), expected(&model.outputs()), "step {k}");
     }
+    assert!(model.outputs().heading.abs() > 0.1);
+    assert_eq!(fmu.terminate(), fmi2OK);
 }
 
 #[test]
 fn exported_api_reproduces_the_linear_model() {
-    unsafe {
-        let c = instantiate();
-        let two = 2;
-        assert_eq!(fmi2SetInteger(c, &vr("variant"), 1, &two), fmi2OK);
-        assert_eq!(fmi2ExitInitializationMode(c), fmi2OK);
-        let mut model = LinearContainerShip::mss_default();
-        let outs: Vec<u32> = OUTPUTS.iter().map(|n| vr(n)).collect();
-        let h = 0.25;
-        for k in 0..400 {
-            let t = k as f64 * h;
-            let cmd = 0.2 * (0.03 * t).sin();
-            assert_eq!(fmi2SetReal(c, &vr("rudder_command"), 1, &cmd), fmi2OK);
-            assert_eq!(fmi2DoStep(c, t, h, 1), fmi2OK);
-            model.step(
-                &LinearContainerShipInputs {
-                    rudder_command: cmd,
-                },
-                h,
-            );
-            let mut v = [0.0; 16];
-            assert_eq!(fmi2GetReal(c, outs.as_ptr(), 16, v.as_mut_ptr()), fmi2OK);
-            assert_eq!(v, expected(&model.outputs()), "step {k}");
-        }
-        assert_eq!(fmi2Terminate(c), fmi2OK);
-        fmi2FreeInstance(c);
+    let mut fmu = initializing();
+    fmu.set("variant", 2);
+    assert_eq!(fmu.exit_initialization(), fmi2OK);
+    let mut model = LinearContainerShip::mss_default();
+    let h = 0.25;
+    for k in 0..400 {
+        let t = k as f64 * h;
+        let rudder_command = 0.2 * (0.03 * t).sin();
+        fmu.set("rudder_command", rudder_command).step(t, h);
+        model.step(&LinearContainerShipInputs { rudder_command }, h);
+        assert_eq!(fmu.reals(&OUTPUTS), expected(&model.outputs()), "step {k}");
     }
+    assert_eq!(fmu.terminate(), fmi2OK);
 }
 
 #[test]
 fn bad_parameter_is_refused() {
-    unsafe {
-        let c = instantiate();
-        let bad = -1.0;
-        assert_eq!(fmi2SetReal(c, &vr("initial_shaft_speed"), 1, &bad), fmi2OK);
-        assert_eq!(fmi2ExitInitializationMode(c), fmi2Error);
-        fmi2FreeInstance(c);
-    }
-}
-
-#[test]
-fn variable_table_passes_the_layer_checks() {
-    fmi2_export::variables::check_table(Fmu::variables()).unwrap();
-    let xml = fmi2_export::xml::model_description::<Fmu>();
-    assert!(xml.contains(r#"name="rudder_command""#));
+    let mut fmu = initializing();
+    fmu.set("initial_shaft_speed", -1.0);
+    assert_eq!(fmu.exit_initialization(), fmi2Error);
 }
