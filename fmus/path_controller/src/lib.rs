@@ -3,7 +3,7 @@
 //! scheduling over depth, partial adaptation from a parameter estimator, dither) as an FMI 2.0
 //! co-simulation FMU. No physics here: the variable table maps the model onto FMI variables.
 
-use fmi2_export::{export_fmu, DefaultExperiment, FmuModel, Variable};
+use fmi2_export::FmuModel;
 use models::controllers::path::{
     Adaptation, DisturbanceModel, PathController, PathControllerParams, PathInputs, EPSILON,
 };
@@ -61,455 +61,115 @@ impl Default for PathControllerFmu {
     }
 }
 
-type V = Variable<PathControllerFmu>;
-
-fn adaptation_code(a: Adaptation) -> i32 {
-    match a {
-        Adaptation::Fixed => 0,
-        Adaptation::Scheduled => 1,
-        Adaptation::Estimated => 2,
+fmi2_export::fmu! {
+    PathControllerFmu => "PathController",
+    description: "LQ path controller of the Tokyo Maru in restricted water \
+        (Parsons & Cuong 1980): steady-state LQ gains from the design depth and disturbance \
+        model, gain scheduling over depth, partial adaptation of f23/f25, open-loop dither",
+    experiment: (0.0, 940.0, 0.2349),
+    documentation: "documentation.html",
+    variables: {
+        // ---- design (0..13)
+        tunable real "design_depth_ratio" (params.design_depth_ratio).min(1.0),
+            "Depth ratio H/T of the initial design (Table 2 interpolated; 1.89 in the report; 1e300 for deep water)";
+        tunable int(1, 2) "disturbance_model" (disturbance_model),
+            "Design model of N', Y': 1 first-order shaping filter (eqs. 39-41, Table 4), 2 random walk (eqs. 56-59, Tables 5/6/8)";
+        tunable real "epsilon" (epsilon).min(0.0),
+            "Random-walk regulariser epsilon on F_e(6,6), F_e(7,7) (line 768: 1e-4)";
+        tunable real "shaping_time_constant" (shaping_time_constant).min(0.0),
+            "Shaping-filter time constant T_N = T_Y in ship lengths (eqs. 39-40: 1)";
+        tunable real "steering_time_constant" ["s"] (steering_time_constant).min(0.0),
+            "Steering-gear time constant of the design model (eq. 10; not printed in 004, 10 s derived from Table 4)";
+        tunable real "a44" (params.design.a44).min(0.0),
+            "Weight on eta'^2 = (eta'_0)^-2 (eq. 31: 772.463, eta_0 = 10.43 m)";
+        tunable real "a55" (params.design.a55).min(0.0),
+            "Weight on delta'^2 = (delta'_0)^-2 (eq. 32: 131.332, 5 deg)";
+        tunable real "b11" (params.design.b11).min(0.0),
+            "Weight on delta'_c^2 (eq. 33: 131.332, 5 deg)";
+        tunable real "q_n" (params.design.q[0]).min(0.0),
+            "Process-noise PSD of N' (random walk eq. 67: 2e-8; shaping filter eq. 53: 1.548e-8)";
+        tunable real "q_y" (params.design.q[1]).min(0.0),
+            "Process-noise PSD of Y' (random walk eq. 68: 1.25e-7; shaping filter eq. 54: 8.970e-8)";
+        tunable real "r_heading" (params.design.r[0]).min(0.0),
+            "Measurement-noise PSD r_jj of psi' for the Kalman gain output (Table 3: 1.298e-8)";
+        tunable real "r_yaw_rate" (params.design.r[1]).min(0.0),
+            "Measurement-noise PSD r_jj of r' (Table 3: 2.860e-7)";
+        tunable real "r_cross_track" (params.design.r[2]).min(0.0),
+            "Measurement-noise PSD r_jj of eta' (Table 3: 4.559e-7)";
+        fixed real "ship_length" ["m"] (params.length).min(0.0),
+            "Ship length L of the prime system (Tokyo Maru 290 m)";
+        // ---- adaptation and dither (14..23)
+        fixed real "ship_speed" ["m/s"] (params.speed).min(0.0),
+            "Ship speed U of the prime system (12 kn = 6.1733 m/s)";
+        fixed int "adaptation" (params.adaptation => { 0: Adaptation::Fixed, 1: Adaptation::Scheduled, 2: Adaptation::Estimated }),
+            "0 fixed design; 1 gain scheduling on the measured depth_ratio input; 2 partial adaptation from the estimator inputs at the end of each dither window (Table 10 rule)";
+        tunable real "update_interval" (params.update_interval).min(0.0),
+            "Gain-scheduling clock in ship lengths (t' = tU/L)";
+        tunable real "schedule_tolerance" (params.schedule_tolerance).min(0.0),
+            "Re-design when the measured T/H moved by more than this since the current design";
+        fixed bool "dither_enabled" (params.dither.enabled),
+            "Open-loop dither windows with the control loop off (section 4-5 of 004)";
+        fixed real "dither_amplitude" ["rad"] (params.dither.amplitude),
+            "Square-wave rudder command amplitude (0.5 rad)";
+        fixed real "dither_period" (params.dither.period).min(0.0),
+            "Square-wave period in ship lengths (0.5; 1.0, 2.5, 5.0 also used)";
+        fixed real "dither_window" (params.dither.window).min(0.0),
+            "Dither window length LW in ship lengths (2.5)";
+        fixed real "dither_cycle" (params.dither.cycle).min(0.0),
+            "Cycle length in ship lengths: a window at the start of each cycle (MVE schedule 6.25)";
+        fixed real "dither_start" (params.dither.start),
+            "Start of the first window in ship lengths after the start time";
+        // ---- inputs (24..38)
+        input real "heading" ["rad"] (inputs.heading),
+            "Estimated heading psi relative to the track direction";
+        input real "yaw_rate" ["rad/s"] (inputs.yaw_rate), "Estimated yaw rate r";
+        input real "drift_angle" ["rad"] (inputs.drift_angle),
+            "Estimated drift angle beta (v = -U beta)";
+        input real "cross_track" ["m"] (inputs.cross_track),
+            "Estimated lateral offset eta from the track";
+        input real "rudder_angle" ["rad"] (inputs.rudder),
+            "Actual rudder angle delta (known exactly in 004)";
+        input real "yaw_moment_prime" (inputs.yaw_moment_prime),
+            "Estimated external yaw moment N' = 2N/(rho L^3 U^2)";
+        input real "sway_force_prime" (inputs.sway_force_prime),
+            "Estimated external sway force Y' = 2Y/(rho L^2 U^2)";
+        input real "depth_ratio" (inputs.depth_ratio),
+            "Measured depth ratio H/T for gain scheduling (adaptation = 1)";
+        input real "f22_estimate" (inputs.estimates[0]), "Estimator output f22 (adaptation = 2)";
+        input real "f23_estimate" (inputs.estimates[1]),
+            "Estimator output f23 (adaptation = 2; no update unless in [2.10, 12.00], Table 10)";
+        input real "f25_estimate" (inputs.estimates[2]),
+            "Estimator output f25 (adaptation = 2; no update unless in [-1.30, -0.30], Table 10)";
+        input real "f32_estimate" (inputs.estimates[3]), "Estimator output f32 (adaptation = 2)";
+        input real "f33_estimate" (inputs.estimates[4]), "Estimator output f33 (adaptation = 2)";
+        input real "f35_estimate" (inputs.estimates[5]), "Estimator output f35 (adaptation = 2)";
+        // ---- outputs (38..49)
+        output real "rudder_command" ["rad"] (|m| m.ctl.command(&m.inputs)),
+            "Rudder command delta_c = C x' (control loop) or the dither square wave";
+        output bool "dithering" (|m| m.ctl.dithering()),
+            "Inside a dither window (control loop off)";
+        output real "gain_heading" (|m| m.ctl.gains().c[0]), "c11: gain on psi' [rad/rad]";
+        output real "gain_yaw_rate" (|m| m.ctl.gains().c[1]), "c12: gain on r' = rL/U";
+        output real "gain_drift_angle" (|m| m.ctl.gains().c[2]), "c13: gain on beta'";
+        output real "gain_cross_track" (|m| m.ctl.gains().c[3]),
+            "c14: gain on eta' = eta/L (sqrt(a44/b11) = 2.4252)";
+        output real "gain_rudder" (|m| m.ctl.gains().c[4]), "c15: gain on delta'";
+        output real "gain_yaw_moment" (|m| m.ctl.gains().c[5]), "c16: feedforward gain on N'";
+        output real "gain_sway_force" (|m| m.ctl.gains().c[6]), "c17: feedforward gain on Y'";
+        output real "design_f23" (|m| m.ctl.coefficients().f23), "f23 of the current design";
+        output real "design_f25" (|m| m.ctl.coefficients().f25), "f25 of the current design";
+        output real "gain_updates" (|m| m.ctl.updates() as f64),
+            "Number of gain re-designs since the start";
+        // ---- the rest of the current design (appended: earlier value references unchanged), for
+        // the PathKalmanFilter's f*_design inputs (004 Fig. 1: C, K and the filter model together)
+        output real "design_f22" (|m| m.ctl.coefficients().f22), "f22 of the current design";
+        output real "design_f32" (|m| m.ctl.coefficients().f32), "f32 of the current design";
+        output real "design_f33" (|m| m.ctl.coefficients().f33), "f33 of the current design";
+        output real "design_f35" (|m| m.ctl.coefficients().f35), "f35 of the current design";
     }
 }
 
-static VARIABLES: [V; 54] = [
-    // ---- design (0..13)
-    V::real_parameter(
-        "design_depth_ratio",
-        None,
-        true,
-        "Depth ratio H/T of the initial design (Table 2 interpolated; 1.89 in the report; 1e300 for deep water)",
-        |m| m.params.design_depth_ratio,
-        |m, v| m.params.design_depth_ratio = v,
-    )
-    .with_range(Some(1.0), None),
-    V::integer_parameter(
-        "disturbance_model",
-        true,
-        "Design model of N', Y': 1 first-order shaping filter (eqs. 39-41, Table 4), 2 random walk (eqs. 56-59, Tables 5/6/8)",
-        1,
-        2,
-        |m| m.disturbance_model,
-        |m, v| m.disturbance_model = v,
-    ),
-    V::real_parameter(
-        "epsilon",
-        None,
-        true,
-        "Random-walk regulariser epsilon on F_e(6,6), F_e(7,7) (line 768: 1e-4)",
-        |m| m.epsilon,
-        |m, v| m.epsilon = v,
-    )
-    .with_range(Some(0.0), None),
-    V::real_parameter(
-        "shaping_time_constant",
-        None,
-        true,
-        "Shaping-filter time constant T_N = T_Y in ship lengths (eqs. 39-40: 1)",
-        |m| m.shaping_time_constant,
-        |m, v| m.shaping_time_constant = v,
-    )
-    .with_range(Some(0.0), None),
-    V::real_parameter(
-        "steering_time_constant",
-        Some("s"),
-        true,
-        "Steering-gear time constant of the design model (eq. 10; not printed in 004, 10 s derived from Table 4)",
-        |m| m.steering_time_constant,
-        |m, v| m.steering_time_constant = v,
-    )
-    .with_range(Some(0.0), None),
-    V::real_parameter(
-        "a44",
-        None,
-        true,
-        "Weight on eta'^2 = (eta'_0)^-2 (eq. 31: 772.463, eta_0 = 10.43 m)",
-        |m| m.params.design.a44,
-        |m, v| m.params.design.a44 = v,
-    )
-    .with_range(Some(0.0), None),
-    V::real_parameter(
-        "a55",
-        None,
-        true,
-        "Weight on delta'^2 = (delta'_0)^-2 (eq. 32: 131.332, 5 deg)",
-        |m| m.params.design.a55,
-        |m, v| m.params.design.a55 = v,
-    )
-    .with_range(Some(0.0), None),
-    V::real_parameter(
-        "b11",
-        None,
-        true,
-        "Weight on delta'_c^2 (eq. 33: 131.332, 5 deg)",
-        |m| m.params.design.b11,
-        |m, v| m.params.design.b11 = v,
-    )
-    .with_range(Some(0.0), None),
-    V::real_parameter(
-        "q_n",
-        None,
-        true,
-        "Process-noise PSD of N' (random walk eq. 67: 2e-8; shaping filter eq. 53: 1.548e-8)",
-        |m| m.params.design.q[0],
-        |m, v| m.params.design.q[0] = v,
-    )
-    .with_range(Some(0.0), None),
-    V::real_parameter(
-        "q_y",
-        None,
-        true,
-        "Process-noise PSD of Y' (random walk eq. 68: 1.25e-7; shaping filter eq. 54: 8.970e-8)",
-        |m| m.params.design.q[1],
-        |m, v| m.params.design.q[1] = v,
-    )
-    .with_range(Some(0.0), None),
-    V::real_parameter(
-        "r_heading",
-        None,
-        true,
-        "Measurement-noise PSD r_jj of psi' for the Kalman gain output (Table 3: 1.298e-8)",
-        |m| m.params.design.r[0],
-        |m, v| m.params.design.r[0] = v,
-    )
-    .with_range(Some(0.0), None),
-    V::real_parameter(
-        "r_yaw_rate",
-        None,
-        true,
-        "Measurement-noise PSD r_jj of r' (Table 3: 2.860e-7)",
-        |m| m.params.design.r[1],
-        |m, v| m.params.design.r[1] = v,
-    )
-    .with_range(Some(0.0), None),
-    V::real_parameter(
-        "r_cross_track",
-        None,
-        true,
-        "Measurement-noise PSD r_jj of eta' (Table 3: 4.559e-7)",
-        |m| m.params.design.r[2],
-        |m, v| m.params.design.r[2] = v,
-    )
-    .with_range(Some(0.0), None),
-    V::real_parameter(
-        "ship_length",
-        Some("m"),
-        false,
-        "Ship length L of the prime system (Tokyo Maru 290 m)",
-        |m| m.params.length,
-        |m, v| m.params.length = v,
-    )
-    .with_range(Some(0.0), None),
-    // ---- adaptation and dither (14..23)
-    V::real_parameter(
-        "ship_speed",
-        Some("m/s"),
-        false,
-        "Ship speed U of the prime system (12 kn = 6.1733 m/s)",
-        |m| m.params.speed,
-        |m, v| m.params.speed = v,
-    )
-    .with_range(Some(0.0), None),
-    V::integer_parameter(
-        "adaptation",
-        false,
-        "0 fixed design; 1 gain scheduling on the measured depth_ratio input; 2 partial adaptation from the estimator inputs at the end of each dither window (Table 10 rule)",
-        0,
-        2,
-        |m| adaptation_code(m.params.adaptation),
-        |m, v| {
-            m.params.adaptation = match v {
-                1 => Adaptation::Scheduled,
-                2 => Adaptation::Estimated,
-                _ => Adaptation::Fixed,
-            }
-        },
-    ),
-    V::real_parameter(
-        "update_interval",
-        None,
-        true,
-        "Gain-scheduling clock in ship lengths (t' = tU/L)",
-        |m| m.params.update_interval,
-        |m, v| m.params.update_interval = v,
-    )
-    .with_range(Some(0.0), None),
-    V::real_parameter(
-        "schedule_tolerance",
-        None,
-        true,
-        "Re-design when the measured T/H moved by more than this since the current design",
-        |m| m.params.schedule_tolerance,
-        |m, v| m.params.schedule_tolerance = v,
-    )
-    .with_range(Some(0.0), None),
-    V::boolean_parameter(
-        "dither_enabled",
-        false,
-        "Open-loop dither windows with the control loop off (section 4-5 of 004)",
-        |m| m.params.dither.enabled,
-        |m, v| m.params.dither.enabled = v,
-    ),
-    V::real_parameter(
-        "dither_amplitude",
-        Some("rad"),
-        false,
-        "Square-wave rudder command amplitude (0.5 rad)",
-        |m| m.params.dither.amplitude,
-        |m, v| m.params.dither.amplitude = v,
-    ),
-    V::real_parameter(
-        "dither_period",
-        None,
-        false,
-        "Square-wave period in ship lengths (0.5; 1.0, 2.5, 5.0 also used)",
-        |m| m.params.dither.period,
-        |m, v| m.params.dither.period = v,
-    )
-    .with_range(Some(0.0), None),
-    V::real_parameter(
-        "dither_window",
-        None,
-        false,
-        "Dither window length LW in ship lengths (2.5)",
-        |m| m.params.dither.window,
-        |m, v| m.params.dither.window = v,
-    )
-    .with_range(Some(0.0), None),
-    V::real_parameter(
-        "dither_cycle",
-        None,
-        false,
-        "Cycle length in ship lengths: a window at the start of each cycle (MVE schedule 6.25)",
-        |m| m.params.dither.cycle,
-        |m, v| m.params.dither.cycle = v,
-    )
-    .with_range(Some(0.0), None),
-    V::real_parameter(
-        "dither_start",
-        None,
-        false,
-        "Start of the first window in ship lengths after the start time",
-        |m| m.params.dither.start,
-        |m, v| m.params.dither.start = v,
-    ),
-    // ---- inputs (24..38)
-    V::real_input(
-        "heading",
-        Some("rad"),
-        "Estimated heading psi relative to the track direction",
-        |m| m.inputs.heading,
-        |m, v| m.inputs.heading = v,
-    ),
-    V::real_input(
-        "yaw_rate",
-        Some("rad/s"),
-        "Estimated yaw rate r",
-        |m| m.inputs.yaw_rate,
-        |m, v| m.inputs.yaw_rate = v,
-    ),
-    V::real_input(
-        "drift_angle",
-        Some("rad"),
-        "Estimated drift angle beta (v = -U beta)",
-        |m| m.inputs.drift_angle,
-        |m, v| m.inputs.drift_angle = v,
-    ),
-    V::real_input(
-        "cross_track",
-        Some("m"),
-        "Estimated lateral offset eta from the track",
-        |m| m.inputs.cross_track,
-        |m, v| m.inputs.cross_track = v,
-    ),
-    V::real_input(
-        "rudder_angle",
-        Some("rad"),
-        "Actual rudder angle delta (known exactly in 004)",
-        |m| m.inputs.rudder,
-        |m, v| m.inputs.rudder = v,
-    ),
-    V::real_input(
-        "yaw_moment_prime",
-        None,
-        "Estimated external yaw moment N' = 2N/(rho L^3 U^2)",
-        |m| m.inputs.yaw_moment_prime,
-        |m, v| m.inputs.yaw_moment_prime = v,
-    ),
-    V::real_input(
-        "sway_force_prime",
-        None,
-        "Estimated external sway force Y' = 2Y/(rho L^2 U^2)",
-        |m| m.inputs.sway_force_prime,
-        |m, v| m.inputs.sway_force_prime = v,
-    ),
-    V::real_input(
-        "depth_ratio",
-        None,
-        "Measured depth ratio H/T for gain scheduling (adaptation = 1)",
-        |m| m.inputs.depth_ratio,
-        |m, v| m.inputs.depth_ratio = v,
-    ),
-    V::real_input(
-        "f22_estimate",
-        None,
-        "Estimator output f22 (adaptation = 2)",
-        |m| m.inputs.estimates[0],
-        |m, v| m.inputs.estimates[0] = v,
-    ),
-    V::real_input(
-        "f23_estimate",
-        None,
-        "Estimator output f23 (adaptation = 2; no update unless in [2.10, 12.00], Table 10)",
-        |m| m.inputs.estimates[1],
-        |m, v| m.inputs.estimates[1] = v,
-    ),
-    V::real_input(
-        "f25_estimate",
-        None,
-        "Estimator output f25 (adaptation = 2; no update unless in [-1.30, -0.30], Table 10)",
-        |m| m.inputs.estimates[2],
-        |m, v| m.inputs.estimates[2] = v,
-    ),
-    V::real_input(
-        "f32_estimate",
-        None,
-        "Estimator output f32 (adaptation = 2)",
-        |m| m.inputs.estimates[3],
-        |m, v| m.inputs.estimates[3] = v,
-    ),
-    V::real_input(
-        "f33_estimate",
-        None,
-        "Estimator output f33 (adaptation = 2)",
-        |m| m.inputs.estimates[4],
-        |m, v| m.inputs.estimates[4] = v,
-    ),
-    V::real_input(
-        "f35_estimate",
-        None,
-        "Estimator output f35 (adaptation = 2)",
-        |m| m.inputs.estimates[5],
-        |m, v| m.inputs.estimates[5] = v,
-    ),
-    // ---- outputs (38..49)
-    V::real_output(
-        "rudder_command",
-        Some("rad"),
-        "Rudder command delta_c = C x' (control loop) or the dither square wave",
-        |m| m.ctl.command(&m.inputs),
-    ),
-    V::boolean_output(
-        "dithering",
-        "Inside a dither window (control loop off)",
-        |m| m.ctl.dithering(),
-    ),
-    V::real_output(
-        "gain_heading",
-        None,
-        "c11: gain on psi' [rad/rad]",
-        |m| m.ctl.gains().c[0],
-    ),
-    V::real_output(
-        "gain_yaw_rate",
-        None,
-        "c12: gain on r' = rL/U",
-        |m| m.ctl.gains().c[1],
-    ),
-    V::real_output(
-        "gain_drift_angle",
-        None,
-        "c13: gain on beta'",
-        |m| m.ctl.gains().c[2],
-    ),
-    V::real_output(
-        "gain_cross_track",
-        None,
-        "c14: gain on eta' = eta/L (sqrt(a44/b11) = 2.4252)",
-        |m| m.ctl.gains().c[3],
-    ),
-    V::real_output(
-        "gain_rudder",
-        None,
-        "c15: gain on delta'",
-        |m| m.ctl.gains().c[4],
-    ),
-    V::real_output(
-        "gain_yaw_moment",
-        None,
-        "c16: feedforward gain on N'",
-        |m| m.ctl.gains().c[5],
-    ),
-    V::real_output(
-        "gain_sway_force",
-        None,
-        "c17: feedforward gain on Y'",
-        |m| m.ctl.gains().c[6],
-    ),
-    V::real_output(
-        "design_f23",
-        None,
-        "f23 of the current design",
-        |m| m.ctl.coefficients().f23,
-    ),
-    V::real_output(
-        "design_f25",
-        None,
-        "f25 of the current design",
-        |m| m.ctl.coefficients().f25,
-    ),
-    V::real_output(
-        "gain_updates",
-        None,
-        "Number of gain re-designs since the start",
-        |m| m.ctl.updates() as f64,
-    ),
-    // ---- the rest of the current design (appended: earlier value references unchanged), for
-    // the PathKalmanFilter's f*_design inputs (004 Fig. 1: C, K and the filter model together)
-    V::real_output(
-        "design_f22",
-        None,
-        "f22 of the current design",
-        |m| m.ctl.coefficients().f22,
-    ),
-    V::real_output(
-        "design_f32",
-        None,
-        "f32 of the current design",
-        |m| m.ctl.coefficients().f32,
-    ),
-    V::real_output(
-        "design_f33",
-        None,
-        "f33 of the current design",
-        |m| m.ctl.coefficients().f33,
-    ),
-    V::real_output(
-        "design_f35",
-        None,
-        "f35 of the current design",
-        |m| m.ctl.coefficients().f35,
-    ),
-];
-
 impl FmuModel for PathControllerFmu {
-    const MODEL_IDENTIFIER: &'static str = "PathController";
-    const DESCRIPTION: &'static str = "LQ path controller of the Tokyo Maru in restricted water \
-        (Parsons & Cuong 1980): steady-state LQ gains from the design depth and disturbance \
-        model, gain scheduling over depth, partial adaptation of f23/f25, open-loop dither";
-    const DEFAULT_EXPERIMENT: DefaultExperiment = DefaultExperiment {
-        start_time: 0.0,
-        stop_time: 940.0,
-        step_size: 0.2349,
-    };
-
-    fn variables() -> &'static [Variable<Self>] {
-        &VARIABLES
-    }
-
-    fn documentation_html() -> &'static str {
-        include_str!("documentation.html")
-    }
-
     fn initialize(&mut self, _start_time: f64) -> Result<(), String> {
         self.ctl = PathController::new(self.model_params()).map_err(|e| e.to_string())?;
         self.ctl.start(&self.inputs);
@@ -526,5 +186,3 @@ impl FmuModel for PathControllerFmu {
         self.ctl.step(&self.inputs, h).map_err(|e| e.to_string())
     }
 }
-
-export_fmu!(PathControllerFmu);
