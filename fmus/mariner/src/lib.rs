@@ -2,11 +2,12 @@
 //! `models::hull::mariner` as an FMI 2.0 co-simulation FMU. No physics here: the variable table
 //! maps the model onto FMI variables.
 
-use fmi2_export::{export_fmu, DefaultExperiment, FmuModel, Variable};
+use fmi2_export::FmuModel;
 use models::hull::mariner::{Mariner, MarinerInputs, MarinerOutputs, MarinerParams, U0_DEFAULT};
 use models::hull::DEG;
 use models::steering_gear::ParamError;
 use serde::{Deserialize, Serialize};
+use std::f64::consts::PI;
 
 /// Parameters, input and state of one Mariner instance.
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -51,164 +52,51 @@ impl MarinerFmu {
     }
 }
 
-type V = Variable<MarinerFmu>;
-
-static VARIABLES: &[V] = &[
-    V::real_parameter(
-        "nominal_speed",
-        Some("m/s"),
-        false,
-        "Nominal speed U0 of the model (section 3.1: 7.7175 m/s = 15 kn); surge u = U0 + delta_u",
-        |m| m.params.u0,
-        |m, v| m.params.u0 = v,
-    )
-    .with_range(Some(0.0), None),
-    V::real_parameter(
-        "rudder_max",
-        Some("rad"),
-        true,
-        "Rudder command saturation (section 3.1: 40 deg)",
-        |m| m.params.rudder_max,
-        |m, v| m.params.rudder_max = v,
-    )
-    .with_range(Some(0.0), Some(std::f64::consts::PI)),
-    V::real_parameter(
-        "rudder_rate_max",
-        Some("rad/s"),
-        true,
-        "Rudder rate limit of the built-in servo (section 3.1: 5 deg/s)",
-        |m| m.params.rudder_rate_max,
-        |m, v| m.params.rudder_rate_max = v,
-    )
-    .with_range(Some(0.0), None),
-    V::real_parameter(
-        "max_substep",
-        Some("s"),
-        false,
-        "Largest RK4 sub-step (default 0.05 s)",
-        |m| m.params.max_substep,
-        |m, v| m.params.max_substep = v,
-    )
-    .with_range(Some(0.0), None),
-    V::boolean_parameter(
-        "trimmed",
-        false,
-        "true: start on the trimmed straight course at nominal_speed (X' = Y' = N' = 0 with r = 0, \
-         solved for delta_u, v, delta); false: MSS's start, all states 0 (not an equilibrium, section 3.3)",
-        |m| m.trimmed,
-        |m, v| m.trimmed = v,
-    ),
-    V::real_calculated_parameter(
-        "trim_rudder_command",
-        Some("rad"),
-        "The rudder_command that holds the trimmed straight course at nominal_speed \
-         (about -1.108 deg at 15 kn; the Y'0, N'0 bias terms of section 3.3)",
-        |m| m.trim,
-    ),
-    V::real_input(
-        "rudder_command",
-        Some("rad"),
-        "Rudder input u_i (positive: starboard turn), through the built-in servo (saturation \
-         rudder_max, rate rudder_rate_max, time constant 1 s); start value 5 deg",
-        |m| m.inputs.rudder_command,
-        |m, v| m.inputs.rudder_command = v,
-    ),
-    V::real_output(
-        "surge_velocity",
-        Some("m/s"),
-        "Surge velocity u = U0 + delta_u",
-        |m| m.out().u,
-    ),
-    V::real_output(
-        "surge_perturbation",
-        Some("m/s"),
-        "Surge perturbation delta_u (the model's state)",
-        |m| m.out().delta_u,
-    ),
-    V::real_output(
-        "sway_velocity",
-        Some("m/s"),
-        "Sway velocity v",
-        |m| m.out().v,
-    ),
-    V::real_output(
-        "yaw_rate",
-        Some("rad/s"),
-        "Yaw rate r",
-        |m| m.out().r,
-    ),
-    V::real_output(
-        "heading",
-        Some("rad"),
-        "Heading psi from north, clockwise, continuous (not wrapped)",
-        |m| m.out().heading,
-    ),
-    V::real_output(
-        "heading_wrapped",
-        Some("rad"),
-        "Heading wrapped to (-pi, pi]",
-        |m| m.out().heading_wrapped,
-    ),
-    V::real_output("x", Some("m"), "North position", |m| m.out().x),
-    V::real_output("y", Some("m"), "East position", |m| m.out().y),
-    V::real_output(
-        "rudder_angle",
-        Some("rad"),
-        "Physical rudder angle -delta (same sign as rudder_command; positive: starboard turn)",
-        |m| m.out().rudder,
-    ),
-    V::real_output(
-        "speed",
-        Some("m/s"),
-        "Total speed U = sqrt(u^2 + v^2)",
-        |m| m.out().speed,
-    ),
-    V::real_output(
-        "drift_angle",
-        Some("rad"),
-        "Drift angle beta = atan2(v, u)",
-        |m| m.out().drift_angle,
-    ),
-    V::real_output(
-        "surge_perturbation_prime",
-        None,
-        "Prime-system surge perturbation u' = delta_u/U",
-        |m| m.out().u_prime,
-    ),
-    V::real_output(
-        "sway_velocity_prime",
-        None,
-        "Prime-system sway v' = v/U",
-        |m| m.out().v_prime,
-    ),
-    V::real_output(
-        "yaw_rate_prime",
-        None,
-        "Prime-system yaw rate r' = r L/U (L = 160.93 m)",
-        |m| m.out().r_prime,
-    ),
-];
+fmi2_export::fmu! {
+    MarinerFmu => "Mariner",
+    description: "Mariner-class cargo ship: nonlinear 3-DOF surge-sway-yaw \
+        manoeuvring model with rudder servo (Chislett & Strom-Tejsen 1965; MSS mariner.m)",
+    experiment: (0.0, 600.0, 0.1),
+    // Every output is a function of the state: no direct feedthrough from the inputs.
+    direct_feedthrough: false,
+    documentation: "documentation.html",
+    variables: {
+        fixed real "nominal_speed" ["m/s"] (params.u0).min(0.0),
+            "Nominal speed U0 of the model (section 3.1: 7.7175 m/s = 15 kn); surge u = U0 + delta_u";
+        tunable real "rudder_max" ["rad"] (params.rudder_max).range(0.0, PI),
+            "Rudder command saturation (section 3.1: 40 deg)";
+        tunable real "rudder_rate_max" ["rad/s"] (params.rudder_rate_max).min(0.0),
+            "Rudder rate limit of the built-in servo (section 3.1: 5 deg/s)";
+        fixed real "max_substep" ["s"] (params.max_substep).min(0.0),
+            "Largest RK4 sub-step (default 0.05 s)";
+        fixed bool "trimmed" (trimmed),
+            "true: start on the trimmed straight course at nominal_speed (X' = Y' = N' = 0 with r = 0, \
+             solved for delta_u, v, delta); false: MSS's start, all states 0 (not an equilibrium, section 3.3)";
+        calculated real "trim_rudder_command" ["rad"] (trim),
+            "The rudder_command that holds the trimmed straight course at nominal_speed \
+             (about -1.108 deg at 15 kn; the Y'0, N'0 bias terms of section 3.3)";
+        input real "rudder_command" ["rad"] (inputs.rudder_command),
+            "Rudder input u_i (positive: starboard turn), through the built-in servo (saturation \
+             rudder_max, rate rudder_rate_max, time constant 1 s); start value 5 deg";
+        output real "surge_velocity" ["m/s"] (|m| m.out().u), "Surge velocity u = U0 + delta_u";
+        output real "surge_perturbation" ["m/s"] (|m| m.out().delta_u),
+            "Surge perturbation delta_u (the model's state)";
+        output real "sway_velocity" ["m/s"] (|m| m.out().v), "Sway velocity v";
+        output real "yaw_rate" ["rad/s"] (|m| m.out().r), "Yaw rate r";
+        pose!(out());
+        output real "rudder_angle" ["rad"] (|m| m.out().rudder),
+            "Physical rudder angle -delta (same sign as rudder_command; positive: starboard turn)";
+        output real "speed" ["m/s"] (|m| m.out().speed), "Total speed U = sqrt(u^2 + v^2)";
+        output real "drift_angle" ["rad"] (|m| m.out().drift_angle), "Drift angle beta = atan2(v, u)";
+        output real "surge_perturbation_prime" (|m| m.out().u_prime),
+            "Prime-system surge perturbation u' = delta_u/U";
+        output real "sway_velocity_prime" (|m| m.out().v_prime), "Prime-system sway v' = v/U";
+        output real "yaw_rate_prime" (|m| m.out().r_prime),
+            "Prime-system yaw rate r' = r L/U (L = 160.93 m)";
+    }
+}
 
 impl FmuModel for MarinerFmu {
-    const MODEL_IDENTIFIER: &'static str = "Mariner";
-    /// Every output is a function of the state: no direct feedthrough from the inputs.
-    const DIRECT_FEEDTHROUGH: bool = false;
-    const DESCRIPTION: &'static str = "Mariner-class cargo ship: nonlinear 3-DOF surge-sway-yaw \
-        manoeuvring model with rudder servo (Chislett & Strom-Tejsen 1965; MSS mariner.m)";
-    const DEFAULT_EXPERIMENT: DefaultExperiment = DefaultExperiment {
-        start_time: 0.0,
-        stop_time: 600.0,
-        step_size: 0.1,
-    };
-
-    fn variables() -> &'static [Variable<Self>] {
-        VARIABLES
-    }
-
-    fn documentation_html() -> &'static str {
-        include_str!("documentation.html")
-    }
-
     fn initialize(&mut self, _start_time: f64) -> Result<(), String> {
         self.params.validate().map_err(param_error)?;
         let mut ship = if self.trimmed {
@@ -233,8 +121,6 @@ impl FmuModel for MarinerFmu {
         Ok(())
     }
 }
-
-export_fmu!(MarinerFmu);
 
 #[cfg(test)]
 mod tests {
