@@ -1,45 +1,20 @@
-//! Calls the `fmi2*` symbols that `export_fmu!` emitted for NomotoShip (linked from this crate's
-//! rlib), as a C importer would, and checks them against the model bit for bit.
+//! NomotoShip through the `fmi2*` symbols its crate exports, as a C importer calls them: the
+//! checks every FMU runs, and the FMU against `models::hull::nomoto` bit for bit, by variable
+//! name.
 
-use fmi2::*;
-use fmi2_export::FmuModel;
+use fmi2_export::fmi2::{fmi2Error, fmi2OK};
+use fmi2_export::testing::Harness;
 use models::hull::nomoto::{NomotoInputs, NomotoOutputs, NomotoShip};
-use nomoto_ship_fmu::NomotoShipFmu as Fmu;
-use std::ffi::CString;
-use std::ptr::null;
+use nomoto_ship_fmu::NomotoShipFmu;
 
-fmi2::declare_fmi2_functions!();
+fmi2_export::fmu_tests!(NomotoShipFmu);
 
-fn vr(name: &str) -> u32 {
-    Fmu::variables()
-        .iter()
-        .position(|v| v.name == name)
-        .unwrap_or_else(|| panic!("no variable {name}")) as u32
-}
-
-unsafe fn instantiate() -> fmi2Component {
-    let guid = CString::new(fmi2_export::xml::guid::<Fmu>()).unwrap();
-    let name = CString::new("ship").unwrap();
-    let cb = fmi2CallbackFunctions {
-        logger: None,
-        allocateMemory: None,
-        freeMemory: None,
-        stepFinished: None,
-        componentEnvironment: std::ptr::null_mut(),
-    };
-    let c = fmi2Instantiate(
-        name.as_ptr(),
-        fmi2CoSimulation,
-        guid.as_ptr(),
-        null(),
-        &cb,
-        0,
-        0,
-    );
-    assert!(!c.is_null());
-    assert_eq!(fmi2SetupExperiment(c, 0, 0.0, 0.0, 0, 0.0), fmi2OK);
-    assert_eq!(fmi2EnterInitializationMode(c), fmi2OK);
-    c
+/// An instance in Initialization Mode at t = 0.
+fn initializing() -> Harness<NomotoShipFmu> {
+    let mut fmu = fmu();
+    assert_eq!(fmu.setup(0.0, None), fmi2OK);
+    assert_eq!(fmu.enter_initialization(), fmi2OK);
+    fmu
 }
 
 const OUTPUTS: [&str; 10] = [
@@ -55,8 +30,8 @@ const OUTPUTS: [&str; 10] = [
     "time_prime",
 ];
 
-fn expected(o: &NomotoOutputs) -> [f64; 10] {
-    [
+fn expected(o: &NomotoOutputs) -> Vec<f64> {
+    vec![
         o.sway_velocity,
         o.v_prime,
         o.yaw_rate,
@@ -70,72 +45,43 @@ fn expected(o: &NomotoOutputs) -> [f64; 10] {
     ]
 }
 
-unsafe fn check(model_preset: i32, mut model: NomotoShip, h: f64) {
-    let c = instantiate();
-    assert_eq!(fmi2SetInteger(c, &vr("model"), 1, &model_preset), fmi2OK);
-    assert_eq!(fmi2ExitInitializationMode(c), fmi2OK);
-    let ins: Vec<u32> = [
-        "rudder_angle",
-        "current_speed",
-        "current_direction",
-        "yaw_disturbance",
-    ]
-    .iter()
-    .map(|n| vr(n))
-    .collect();
-    let outs: Vec<u32> = OUTPUTS.iter().map(|n| vr(n)).collect();
+fn check(model_preset: i32, mut model: NomotoShip, h: f64) {
+    let mut fmu = initializing();
+    fmu.set("model", model_preset);
+    assert_eq!(fmu.exit_initialization(), fmi2OK);
     for k in 0..1000 {
         let t = k as f64 * h;
-        let u = [
-            0.1 * (0.05 * t).sin(),
-            0.5,
-            1.0 + 0.001 * t,
-            0.02 * (0.4 * t).cos(),
-        ];
-        assert_eq!(fmi2SetReal(c, ins.as_ptr(), 4, u.as_ptr()), fmi2OK);
-        assert_eq!(fmi2DoStep(c, t, h, 1), fmi2OK);
-        model.step(
-            &NomotoInputs {
-                rudder: u[0],
-                current_speed: u[1],
-                current_direction: u[2],
-                yaw_disturbance: u[3],
-            },
-            h,
-        );
-        let mut v = [0.0; 10];
-        assert_eq!(fmi2GetReal(c, outs.as_ptr(), 10, v.as_mut_ptr()), fmi2OK);
+        let inputs = NomotoInputs {
+            rudder: 0.1 * (0.05 * t).sin(),
+            current_speed: 0.5,
+            current_direction: 1.0 + 0.001 * t,
+            yaw_disturbance: 0.02 * (0.4 * t).cos(),
+        };
+        fmu.set("rudder_angle", inputs.rudder)
+            .set("current_speed", inputs.current_speed)
+            .set("current_direction", inputs.current_direction)
+            .set("yaw_disturbance", inputs.yaw_disturbance)
+            .step(t, h);
+        model.step(&inputs, h);
         assert_eq!(
-            v,
+            fmu.reals(&OUTPUTS),
             expected(&model.outputs()),
             "model {model_preset} step {k}"
         );
     }
     assert!(model.outputs().heading.abs() > 1e-3);
-    assert_eq!(fmi2Terminate(c), fmi2OK);
-    fmi2FreeInstance(c);
+    assert_eq!(fmu.terminate(), fmi2OK);
 }
 
 #[test]
 fn exported_api_reproduces_both_models() {
-    unsafe {
-        check(1, NomotoShip::ddg51(), 0.1);
-        check(2, NomotoShip::esso_osaka(), 0.5);
-    }
+    check(1, NomotoShip::ddg51(), 0.1);
+    check(2, NomotoShip::esso_osaka(), 0.5);
 }
 
 #[test]
 fn bad_parameter_is_refused() {
-    unsafe {
-        let c = instantiate();
-        let zero = 0.0;
-        assert_eq!(fmi2SetReal(c, &vr("t_prime"), 1, &zero), fmi2OK);
-        assert_eq!(fmi2ExitInitializationMode(c), fmi2Error);
-        fmi2FreeInstance(c);
-    }
-}
-
-#[test]
-fn variable_table_passes_the_layer_checks() {
-    fmi2_export::variables::check_table(Fmu::variables()).unwrap();
+    let mut fmu = initializing();
+    fmu.set("t_prime", 0.0);
+    assert_eq!(fmu.exit_initialization(), fmi2Error);
 }
