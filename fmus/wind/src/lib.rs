@@ -1,7 +1,7 @@
 //! `Wind` FMU: mean wind plus gusts and the roll/yaw moments of 003 eqs. 2.19-2.20
 //! (`models::disturbances::wind`). No physics here.
 
-use fmi2_export::{export_fmu, DefaultExperiment, FmuModel, Variable};
+use fmi2_export::FmuModel;
 use models::disturbances::wind::{Wind, WindParams};
 use serde::{Deserialize, Serialize};
 
@@ -26,167 +26,51 @@ impl Default for WindFmu {
     }
 }
 
-type V = Variable<WindFmu>;
-
-static VARIABLES: [V; 18] = [
-    V::integer_parameter(
-        "seed",
-        false,
-        "Seed of this instance's ChaCha8 streams",
-        0,
-        i32::MAX,
-        |m| m.params.seed as i32,
-        |m, v| m.params.seed = v as u64,
-    ),
-    V::real_parameter(
-        "mean_wind_speed",
-        Some("m/s"),
-        true,
-        "Mean true wind speed (the constant component of 003 section 2.4.2)",
-        |m| m.params.mean_speed,
-        |m, v| m.params.mean_speed = v,
-    )
-    .with_range(Some(0.0), None),
-    V::real_parameter(
-        "wind_direction",
-        Some("rad"),
-        true,
-        "Mean direction the wind blows towards, earth frame of the heading",
-        |m| m.params.direction,
-        |m, v| m.params.direction = v,
-    ),
-    V::real_parameter(
-        "gust_std",
-        Some("m/s"),
-        false,
-        "Std of the first-order Gauss-Markov gust speed (spectrum 2 s^2 T/pi/(1 + w^2 T^2))",
-        |m| m.params.gust_std,
-        |m, v| m.params.gust_std = v,
-    )
-    .with_range(Some(0.0), None),
-    V::real_parameter(
-        "gust_time_constant",
-        Some("s"),
-        false,
-        "Correlation time of the gust speed",
-        |m| m.params.gust_time_constant,
-        |m, v| m.params.gust_time_constant = v,
-    )
-    .with_range(Some(1e-6), None),
-    V::real_parameter(
-        "direction_std",
-        Some("rad"),
-        false,
-        "Std of the first-order Gauss-Markov wind-direction variation",
-        |m| m.params.direction_std,
-        |m, v| m.params.direction_std = v,
-    )
-    .with_range(Some(0.0), None),
-    V::real_parameter(
-        "direction_time_constant",
-        Some("s"),
-        false,
-        "Correlation time of the direction variation",
-        |m| m.params.direction_time_constant,
-        |m, v| m.params.direction_time_constant = v,
-    )
-    .with_range(Some(1e-6), None),
-    V::real_parameter(
-        "roll_coefficient",
-        None,
-        true,
-        "c_w_phi of 003 eq. 2.19 [N.m/(m/s)^2]; not given in 003",
-        |m| m.params.roll_coefficient,
-        |m, v| m.params.roll_coefficient = v,
-    ),
-    V::real_parameter(
-        "yaw_coefficient",
-        None,
-        true,
-        "c_wR of 003 eq. 2.20 [N.m/(m/s)^2]; not given in 003",
-        |m| m.params.yaw_coefficient,
-        |m, v| m.params.yaw_coefficient = v,
-    ),
-    V::real_parameter(
-        "internal_step",
-        Some("s"),
-        false,
-        "Fixed grid of the gust processes (linear interpolation in between)",
-        |m| m.params.internal_step,
-        |m, v| m.params.internal_step = v,
-    )
-    .with_range(Some(1e-6), None),
-    V::real_input(
-        "ship_speed",
-        Some("m/s"),
-        "Ship speed along the heading",
-        |m| m.speed,
-        |m, v| m.speed = v,
-    ),
-    V::real_input(
-        "heading",
-        Some("rad"),
-        "Ship heading",
-        |m| m.heading,
-        |m, v| m.heading = v,
-    ),
-    V::real_output(
-        "true_wind_speed",
-        Some("m/s"),
-        "Mean plus gust wind speed",
-        |m| m.model.true_speed(),
-    ),
-    V::real_output(
-        "true_wind_direction",
-        Some("rad"),
-        "Mean plus varying direction (towards)",
-        |m| m.model.true_direction(),
-    ),
-    V::real_output(
-        "relative_wind_speed",
-        Some("m/s"),
-        "V_w: relative wind speed as measured on board",
-        |m| m.model.relative().0,
-    ),
-    V::real_output(
-        "relative_wind_angle",
-        Some("rad"),
-        "gamma in (-pi, pi]: 0 wind from astern, +pi/2 blowing towards starboard, pi head wind",
-        |m| m.model.relative().1,
-    ),
-    V::real_output(
-        "roll_moment",
-        Some("N.m"),
-        "K = c_w_phi V_w^2 sin(gamma) (003 eq. 2.19)",
-        |m| m.model.roll_moment(),
-    ),
-    V::real_output(
-        "yaw_moment",
-        Some("N.m"),
-        "N = c_wR V_w^2 sin(2 gamma) (003 eq. 2.20)",
-        |m| m.model.yaw_moment(),
-    ),
-];
+fmi2_export::fmu! {
+    WindFmu => "Wind",
+    description: "Seeded wind: mean wind with Gauss-Markov gusts in speed and \
+        direction, relative wind, roll and yaw moments of van der Klugt (1987) eqs. 2.19-2.20",
+    experiment: (0.0, 600.0, 0.1),
+    documentation: "documentation.html",
+    variables: {
+        fixed int(0, i32::MAX) "seed" (params.seed as u64),
+            "Seed of this instance's ChaCha8 streams";
+        tunable real "mean_wind_speed" ["m/s"] (params.mean_speed).min(0.0),
+            "Mean true wind speed (the constant component of 003 section 2.4.2)";
+        tunable real "wind_direction" ["rad"] (params.direction),
+            "Mean direction the wind blows towards, earth frame of the heading";
+        fixed real "gust_std" ["m/s"] (params.gust_std).min(0.0),
+            "Std of the first-order Gauss-Markov gust speed (spectrum 2 s^2 T/pi/(1 + w^2 T^2))";
+        fixed real "gust_time_constant" ["s"] (params.gust_time_constant).min(1e-6),
+            "Correlation time of the gust speed";
+        fixed real "direction_std" ["rad"] (params.direction_std).min(0.0),
+            "Std of the first-order Gauss-Markov wind-direction variation";
+        fixed real "direction_time_constant" ["s"] (params.direction_time_constant).min(1e-6),
+            "Correlation time of the direction variation";
+        tunable real "roll_coefficient" (params.roll_coefficient),
+            "c_w_phi of 003 eq. 2.19 [N.m/(m/s)^2]; not given in 003";
+        tunable real "yaw_coefficient" (params.yaw_coefficient),
+            "c_wR of 003 eq. 2.20 [N.m/(m/s)^2]; not given in 003";
+        fixed real "internal_step" ["s"] (params.internal_step).min(1e-6),
+            "Fixed grid of the gust processes (linear interpolation in between)";
+        input real "ship_speed" ["m/s"] (speed), "Ship speed along the heading";
+        input real "heading" ["rad"] (heading), "Ship heading";
+        output real "true_wind_speed" ["m/s"] (|m| m.model.true_speed()),
+            "Mean plus gust wind speed";
+        output real "true_wind_direction" ["rad"] (|m| m.model.true_direction()),
+            "Mean plus varying direction (towards)";
+        output real "relative_wind_speed" ["m/s"] (|m| m.model.relative().0),
+            "V_w: relative wind speed as measured on board";
+        output real "relative_wind_angle" ["rad"] (|m| m.model.relative().1),
+            "gamma in (-pi, pi]: 0 wind from astern, +pi/2 blowing towards starboard, pi head wind";
+        output real "roll_moment" ["N.m"] (|m| m.model.roll_moment()),
+            "K = c_w_phi V_w^2 sin(gamma) (003 eq. 2.19)";
+        output real "yaw_moment" ["N.m"] (|m| m.model.yaw_moment()),
+            "N = c_wR V_w^2 sin(2 gamma) (003 eq. 2.20)";
+    }
+}
 
 impl FmuModel for WindFmu {
-    const MODEL_IDENTIFIER: &'static str = "Wind";
-    const DESCRIPTION: &'static str =
-        "Seeded wind: mean wind with Gauss-Markov gusts in speed and \
-        direction, relative wind, roll and yaw moments of van der Klugt (1987) eqs. 2.19-2.20";
-    const DEFAULT_EXPERIMENT: DefaultExperiment = DefaultExperiment {
-        start_time: 0.0,
-        stop_time: 600.0,
-        step_size: 0.1,
-    };
-
-    fn variables() -> &'static [Variable<Self>] {
-        &VARIABLES
-    }
-
-    fn documentation_html() -> &'static str {
-        include_str!("documentation.html")
-    }
-
     fn initialize(&mut self, start_time: f64) -> Result<(), String> {
         self.model = Wind::new(self.params.clone(), start_time)?;
         self.model.set_inputs(self.speed, self.heading);
@@ -217,5 +101,3 @@ impl FmuModel for WindFmu {
         Ok(())
     }
 }
-
-export_fmu!(WindFmu);

@@ -1,112 +1,69 @@
-//! Calls the `fmi2*` symbols that `export_fmu!` emitted for Wind (linked from this crate's
-//! rlib), as a C importer would, and checks them against the model; state snapshot restore.
+//! Wind through the `fmi2*` symbols its crate exports, as a C importer calls them: the checks
+//! every FMU runs, and the FMU against `models::disturbances::wind` by variable name, with a
+//! state snapshot restored.
 
-use fmi2::*;
+use fmi2_export::fmi2::fmi2OK;
 use models::disturbances::wind::{Wind, WindParams};
-use std::ffi::CString;
-use std::ptr::null;
 
-fmi2::declare_fmi2_functions!();
+fmi2_export::fmu_tests!(wind_fmu::WindFmu);
 
-fn vr(name: &str) -> u32 {
-    use fmi2_export::FmuModel;
-    wind_fmu::WindFmu::variables()
-        .iter()
-        .position(|v| v.name == name)
-        .unwrap_or_else(|| panic!("no variable {name}")) as u32
+const OUTPUTS: [&str; 3] = [
+    "true_wind_speed",
+    "relative_wind_speed",
+    "relative_wind_angle",
+];
+
+/// Ship speed and heading at `t`.
+fn inputs(t: f64) -> [f64; 2] {
+    std::array::from_fn(|i| (i as f64 + 1.0) * (0.01 * t).sin())
 }
 
 #[test]
 fn exported_api_reproduces_the_model_and_restores_states() {
-    let guid = CString::new(fmi2_export::xml::guid::<wind_fmu::WindFmu>()).unwrap();
-    let name = CString::new("instance").unwrap();
-    let cb = fmi2CallbackFunctions {
-        logger: None,
-        allocateMemory: None,
-        freeMemory: None,
-        stepFinished: None,
-        componentEnvironment: std::ptr::null_mut(),
+    let mut fmu = fmu();
+    assert_eq!(fmu.setup(0.0, None), fmi2OK);
+    assert_eq!(fmu.enter_initialization(), fmi2OK);
+    fmu.set("seed", 77i32);
+    assert_eq!(fmu.exit_initialization(), fmi2OK);
+    let params = WindParams {
+        seed: 77,
+        ..WindParams::default()
     };
-    let ins = [vr("ship_speed"), vr("heading")];
-    let outs = [
-        vr("true_wind_speed"),
-        vr("relative_wind_speed"),
-        vr("relative_wind_angle"),
-    ];
-    unsafe {
-        assert_eq!(lossy_str(fmi2GetVersion()), "2.0");
-        let c = fmi2Instantiate(
-            name.as_ptr(),
-            fmi2CoSimulation,
-            guid.as_ptr(),
-            null(),
-            &cb,
-            0,
-            0,
-        );
-        assert!(!c.is_null());
-        assert_eq!(fmi2SetupExperiment(c, 0, 0.0, 0.0, 0, 0.0), fmi2OK);
-        assert_eq!(fmi2EnterInitializationMode(c), fmi2OK);
-        let seed = 77i32;
-        assert_eq!(fmi2SetInteger(c, &vr("seed"), 1, &seed), fmi2OK);
-        assert_eq!(fmi2ExitInitializationMode(c), fmi2OK);
-        let mut model = Wind::new(
-            WindParams {
-                seed: 77,
-                ..WindParams::default()
-            },
-            0.0,
-        )
-        .unwrap();
-        let h = 0.3;
-        let mut snapshot: fmi2FMUstate = std::ptr::null_mut();
-        let mut after = Vec::new();
-        for k in 0..400 {
-            let t = k as f64 * h;
-            let u: [f64; 2] = std::array::from_fn(|i| (i as f64 + 1.0) * (0.01 * t).sin());
-            assert_eq!(fmi2SetReal(c, ins.as_ptr(), ins.len(), u.as_ptr()), fmi2OK);
-            if k == 200 {
-                assert_eq!(fmi2GetFMUstate(c, &mut snapshot), fmi2OK);
-            }
-            assert_eq!(fmi2DoStep(c, t, h, 1), fmi2OK);
-            model.set_inputs(u[0], u[1]);
-            model.advance_to(t + h);
-            let mut v = [0.0; 3];
-            assert_eq!(
-                fmi2GetReal(c, outs.as_ptr(), outs.len(), v.as_mut_ptr()),
-                fmi2OK
-            );
-            assert_eq!(
-                v,
-                [model.true_speed(), model.relative().0, model.relative().1]
-            );
-            if k >= 200 {
-                after.push(v);
-            }
+    let mut model = Wind::new(params, 0.0).unwrap();
+    let h = 0.3;
+    let mut snapshot = None;
+    let mut after = Vec::new();
+    for k in 0..400 {
+        let t = k as f64 * h;
+        let u = inputs(t);
+        fmu.set("ship_speed", u[0]).set("heading", u[1]);
+        if k == 200 {
+            snapshot = Some(fmu.get_state());
         }
-        assert_eq!(fmi2SetFMUstate(c, snapshot), fmi2OK);
-        for k in 200..400 {
-            let t = k as f64 * h;
-            let u: [f64; 2] = std::array::from_fn(|i| (i as f64 + 1.0) * (0.01 * t).sin());
-            assert_eq!(fmi2SetReal(c, ins.as_ptr(), ins.len(), u.as_ptr()), fmi2OK);
-            assert_eq!(fmi2DoStep(c, t, h, 1), fmi2OK);
-            let mut v = [0.0; 3];
-            assert_eq!(
-                fmi2GetReal(c, outs.as_ptr(), outs.len(), v.as_mut_ptr()),
-                fmi2OK
-            );
-            assert_eq!(v, after[k - 200]);
+        fmu.step(t, h);
+        model.set_inputs(u[0], u[1]);
+        model.advance_to(t + h);
+        let v = fmu.reals(&OUTPUTS);
+        let expected = [model.true_speed(), model.relative().0, model.relative().1];
+        assert_eq!(v, expected);
+        if k >= 200 {
+            after.push(v);
         }
-        assert_eq!(fmi2FreeFMUstate(c, &mut snapshot), fmi2OK);
-        assert_eq!(fmi2Terminate(c), fmi2OK);
-        fmi2FreeInstance(c);
     }
+    let snapshot = snapshot.unwrap();
+    assert_eq!(fmu.set_state(snapshot), fmi2OK);
+    for k in 200..400 {
+        let t = k as f64 * h;
+        let u = inputs(t);
+        fmu.set("ship_speed", u[0]).set("heading", u[1]).step(t, h);
+        assert_eq!(fmu.reals(&OUTPUTS), after[k - 200]);
+    }
+    fmu.free_state(snapshot);
+    assert_eq!(fmu.terminate(), fmi2OK);
 }
 
 #[test]
-fn variable_table_passes_the_layer_checks() {
-    use fmi2_export::FmuModel;
-    fmi2_export::variables::check_table(wind_fmu::WindFmu::variables()).unwrap();
+fn model_identifier_is_declared() {
     let xml = fmi2_export::xml::model_description::<wind_fmu::WindFmu>();
     assert!(xml.contains(r#"modelIdentifier="Wind""#));
 }
