@@ -1,30 +1,21 @@
-//! Calls the `fmi2*` symbols emitted for ParameterEkf (linked from this crate's rlib), as a C
-//! importer would, and checks them against the model.
+//! ParameterEkf through the `fmi2*` symbols its crate exports, as a C importer calls them: the
+//! checks every FMU runs, and the FMU against `models::observers::parameter_ekf` by variable
+//! name.
 
-use fmi2::*;
+use fmi2_export::fmi2::fmi2OK;
+use fmi2_export::testing::Harness;
 use models::observers::parameter_ekf::ParameterEkf;
-use std::ffi::CString;
-use std::ptr::null;
+use parameter_ekf_fmu::ParameterEkfFmu;
 
-fmi2::declare_fmi2_functions!();
+fmi2_export::fmu_tests!(ParameterEkfFmu);
 
-fn callbacks() -> fmi2CallbackFunctions {
-    fmi2CallbackFunctions {
-        logger: None,
-        allocateMemory: None,
-        freeMemory: None,
-        stepFinished: None,
-        componentEnvironment: std::ptr::null_mut(),
-    }
-}
-
-fn vr(name: &str) -> u32 {
-    use fmi2_export::FmuModel;
-    parameter_ekf_fmu::ParameterEkfFmu::variables()
-        .iter()
-        .position(|v| v.name == name)
-        .unwrap_or_else(|| panic!("{name}")) as u32
-}
+const INPUTS: [&str; 5] = [
+    "surge_velocity_measured",
+    "sway_velocity_measured",
+    "yaw_rate_measured",
+    "shaft_speed_measured",
+    "rudder_angle",
+];
 
 fn inputs(t: f64) -> [f64; 5] {
     let s = (0.02 * t).sin();
@@ -37,92 +28,55 @@ fn inputs(t: f64) -> [f64; 5] {
     ]
 }
 
-#[test]
-fn exported_api_reproduces_the_model() {
-    let guid =
-        CString::new(fmi2_export::xml::guid::<parameter_ekf_fmu::ParameterEkfFmu>()).unwrap();
-    let name = CString::new("ekf").unwrap();
-    let cb = callbacks();
-    unsafe {
-        assert_eq!(lossy_str(fmi2GetVersion()), "2.0");
-        let c = fmi2Instantiate(
-            name.as_ptr(),
-            fmi2CoSimulation,
-            guid.as_ptr(),
-            null(),
-            &cb,
-            0,
-            0,
-        );
-        assert!(!c.is_null());
-        assert_eq!(fmi2SetupExperiment(c, 0, 0.0, 0.0, 0, 0.0), fmi2OK);
-        assert_eq!(fmi2EnterInitializationMode(c), fmi2OK);
-        assert_eq!(fmi2ExitInitializationMode(c), fmi2OK);
-        let mut model = ParameterEkf::new(parameter_ekf_fmu::default_params(), 0.0).unwrap();
-        let ins = [
-            vr("surge_velocity_measured"),
-            vr("sway_velocity_measured"),
-            vr("yaw_rate_measured"),
-            vr("shaft_speed_measured"),
-            vr("rudder_angle"),
-        ];
-        let outs = [
-            vr("sway_velocity_estimate"),
-            vr("neg_y_v_estimate"),
-            vr("mxg_minus_n_r_mean"),
-            vr("nomoto_gain_prime"),
-        ];
-        let check = |model: &ParameterEkf, c: fmi2Component| {
-            let mut v = [0.0; 4];
-            assert_eq!(fmi2GetReal(c, outs.as_ptr(), 4, v.as_mut_ptr()), fmi2OK);
-            assert_eq!(
-                v,
-                [
-                    model.dimensional_states()[1],
-                    model.coefficients()[0],
-                    model.averaged_coefficients()[3],
-                    model.identified_nomoto().1
-                ]
-            );
-        };
-        let mut snapshot: fmi2FMUstate = std::ptr::null_mut();
-        let mut model_at_snapshot = None;
-        for k in 0..400 {
-            let t = k as f64 * 0.5;
-            let u = inputs(t);
-            assert_eq!(fmi2SetReal(c, ins.as_ptr(), 5, u.as_ptr()), fmi2OK);
-            assert_eq!(fmi2DoStep(c, t, 0.5, 1), fmi2OK);
-            model.step(t, 0.5, [u[0], u[1], u[2], u[3]], u[4]);
-            check(&model, c);
-            if k == 199 {
-                assert_eq!(fmi2GetFMUstate(c, &mut snapshot), fmi2OK);
-                model_at_snapshot = Some(model.clone());
-            }
-        }
-        assert_eq!(model.updates(), 200);
-        // Restore the FMU state and replay: bit-identical.
-        assert_eq!(fmi2SetFMUstate(c, snapshot), fmi2OK);
-        let mut model = model_at_snapshot.unwrap();
-        for k in 200..400 {
-            let t = k as f64 * 0.5;
-            let u = inputs(t);
-            assert_eq!(fmi2SetReal(c, ins.as_ptr(), 5, u.as_ptr()), fmi2OK);
-            assert_eq!(fmi2DoStep(c, t, 0.5, 1), fmi2OK);
-            model.step(t, 0.5, [u[0], u[1], u[2], u[3]], u[4]);
-            check(&model, c);
-        }
-        assert_eq!(fmi2FreeFMUstate(c, &mut snapshot), fmi2OK);
-        assert_eq!(fmi2Terminate(c), fmi2OK);
-        fmi2FreeInstance(c);
+/// One step of the FMU and the model from `t` over 0.5 s with `inputs(t)`, then the outputs
+/// compared.
+fn step_both(fmu: &mut Harness<ParameterEkfFmu>, model: &mut ParameterEkf, t: f64) {
+    let u = inputs(t);
+    for (name, value) in INPUTS.iter().zip(u) {
+        fmu.set(name, value);
     }
+    fmu.step(t, 0.5);
+    model.step(t, 0.5, [u[0], u[1], u[2], u[3]], u[4]);
+    let outputs = [
+        "sway_velocity_estimate",
+        "neg_y_v_estimate",
+        "mxg_minus_n_r_mean",
+        "nomoto_gain_prime",
+    ];
+    let expected = [
+        model.dimensional_states()[1],
+        model.coefficients()[0],
+        model.averaged_coefficients()[3],
+        model.identified_nomoto().1,
+    ];
+    assert_eq!(fmu.reals(&outputs), expected);
 }
 
 #[test]
-fn variable_table_passes_the_layer_checks() {
-    use fmi2_export::FmuModel;
-    fmi2_export::variables::check_table(parameter_ekf_fmu::ParameterEkfFmu::variables()).unwrap();
-    let xml = fmi2_export::xml::model_description::<parameter_ekf_fmu::ParameterEkfFmu>();
-    assert!(xml.contains(r#"name="neg_y_v_mean""#));
-    // outputs depend on the state only
+fn exported_api_reproduces_the_model() {
+    let mut fmu = fmu();
+    fmu.initialize(0.0);
+    let mut model = ParameterEkf::new(parameter_ekf_fmu::default_params(), 0.0).unwrap();
+    let mut snapshot = None;
+    for k in 0..400 {
+        step_both(&mut fmu, &mut model, k as f64 * 0.5);
+        if k == 199 {
+            snapshot = Some((fmu.get_state(), model.clone()));
+        }
+    }
+    assert_eq!(model.updates(), 200);
+    // Restore the FMU state and replay: bit-identical.
+    let (state, mut model) = snapshot.unwrap();
+    assert_eq!(fmu.set_state(state), fmi2OK);
+    for k in 200..400 {
+        step_both(&mut fmu, &mut model, k as f64 * 0.5);
+    }
+    fmu.free_state(state);
+    assert_eq!(fmu.terminate(), fmi2OK);
+}
+
+#[test]
+fn outputs_depend_on_the_state_only() {
+    let xml = fmi2_export::xml::model_description::<ParameterEkfFmu>();
     assert!(xml.contains(r#"dependencies="""#));
 }
