@@ -33,3 +33,31 @@ macro_rules! heading {
         )
     };
 }
+
+/// The design frame shared by source 000's loop-shaped DDG-51 controllers (HeadingAutopilot,
+/// TrackController): Nomoto plant K' and T', steering-gear pole, Tustin sample step, rudder
+/// command limit and the ship length and speed of the time base t' = tU/L, in that order, from
+/// a value with the fields of `models::controllers::loop_shaped::LoopShapingCommon` (e.g.
+/// `loop_shaping_common!(d.common);` reads and writes `m.d.common.nomoto_k`, ...).
+#[macro_export]
+macro_rules! loop_shaping_common {
+    (@fragment [$model:ty] [$($done:tt)*] ($($path:tt)*) $($rest:tt)*) => {
+        $crate::__variables!(@[$model] [$($done)*]
+            tunable real "nomoto_k" ($($path)*.nomoto_k).min(0.0),
+                "Nomoto K' of the design plant in t' = tU/L (eq. 5.26: 2.04)";
+            tunable real "nomoto_t" ($($path)*.nomoto_t).min(0.0),
+                "Nomoto T' in ship lengths (eq. 5.25: 1.9287)";
+            tunable real "gear_pole" ($($path)*.gear_pole).min(0.0),
+                "Steering-gear pole a of a/(s+a) in t' (eq. 5.28: 6)";
+            tunable real "sample_step" ($($path)*.sample_step).min(0.0),
+                "Largest internal Tustin step in ship lengths (t'); each communication step is split into equal samples not longer than this";
+            tunable real "command_limit" ["rad"] ($($path)*.limit).min(0.0),
+                "Rudder command limit (L2192-2199: 30 deg)";
+            fixed real "ship_length" ["m"] ($($path)*.length).min(0.0),
+                "Ship length L of the time base (DDG-51: 466 ft)";
+            fixed real "ship_speed" ["m/s"] ($($path)*.speed).min(0.0),
+                "Ship speed U of the time base (22 kn)";
+            $($rest)*
+        )
+    };
+}
