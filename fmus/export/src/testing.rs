@@ -144,6 +144,10 @@ impl Value for bool {
     }
 }
 
+/// An FMU state of a [`Harness`] instance (`fmi2FMUstate`), valid until freed.
+#[derive(Clone, Copy, Debug)]
+pub struct FmuState(pub fmi2FMUstate);
+
 /// One instance of the FMU `M`, driven through `functions` by variable name. Dropping it frees
 /// the instance.
 pub struct Harness<M: FmuModel> {
@@ -341,27 +345,28 @@ impl<M: FmuModel> Harness<M> {
     }
 
     /// `fmi2GetFMUstate` into a new state, checked.
-    pub fn get_state(&mut self) -> fmi2FMUstate {
+    pub fn get_state(&mut self) -> FmuState {
         let mut s: fmi2FMUstate = null_mut();
         let st = unsafe { (self.f.fmi2GetFMUstate)(self.c, &mut s) };
         self.check("fmi2GetFMUstate", st);
-        s
+        FmuState(s)
     }
 
     /// `fmi2SetFMUstate`.
-    pub fn set_state(&mut self, state: fmi2FMUstate) -> fmi2Status {
-        unsafe { (self.f.fmi2SetFMUstate)(self.c, state) }
+    pub fn set_state(&mut self, state: FmuState) -> fmi2Status {
+        unsafe { (self.f.fmi2SetFMUstate)(self.c, state.0) }
     }
 
     /// `fmi2FreeFMUstate`, checked.
-    pub fn free_state(&mut self, mut state: fmi2FMUstate) {
+    pub fn free_state(&mut self, state: FmuState) {
+        let mut state = state.0;
         let st = unsafe { (self.f.fmi2FreeFMUstate)(self.c, &mut state) };
         self.check("fmi2FreeFMUstate", st);
     }
 
     /// `fmi2SerializedFMUstateSize` and `fmi2SerializeFMUstate`, checked.
-    pub fn serialize(&mut self, state: fmi2FMUstate) -> Vec<u8> {
-        let mut size = 0usize;
+    pub fn serialize(&mut self, state: FmuState) -> Vec<u8> {
+        let (state, mut size) = (state.0, 0usize);
         let st = unsafe { (self.f.fmi2SerializedFMUstateSize)(self.c, state, &mut size) };
         self.check("fmi2SerializedFMUstateSize", st);
         let mut bytes = vec![0 as c_char; size];
@@ -371,11 +376,11 @@ impl<M: FmuModel> Harness<M> {
     }
 
     /// `fmi2DeSerializeFMUstate` into a new state, with the status.
-    pub fn deserialize(&mut self, bytes: &[u8]) -> (fmi2Status, fmi2FMUstate) {
+    pub fn deserialize(&mut self, bytes: &[u8]) -> (fmi2Status, FmuState) {
         let mut s: fmi2FMUstate = null_mut();
         let p = bytes.as_ptr() as *const c_char;
         let st = unsafe { (self.f.fmi2DeSerializeFMUstate)(self.c, p, bytes.len(), &mut s) };
-        (st, s)
+        (st, FmuState(s))
     }
 }
 

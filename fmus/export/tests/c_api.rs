@@ -399,7 +399,10 @@ fn variable_table_and_model_description_are_consistent() {
 #[test]
 fn types_platform_and_version() {
     unsafe {
-        assert_eq!(lossy_str(api::get_types_platform::<Integrator>()), "default");
+        assert_eq!(
+            lossy_str(api::get_types_platform::<Integrator>()),
+            "default"
+        );
         assert_eq!(lossy_str(api::get_version::<Integrator>()), "2.0");
     }
 }
@@ -931,8 +934,19 @@ struct Table {
 
 impl Default for Table {
     fn default() -> Self {
-        let pose = Pose { heading: 4.0, heading_wrapped: 4.0 - 2.0 * std::f64::consts::PI, x: 1.0, y: 2.0 };
-        Table { order: Order::Second, seed: 7, gains: [0.5, 1.5], flag: true, pose }
+        let pose = Pose {
+            heading: 4.0,
+            heading_wrapped: 4.0 - 2.0 * std::f64::consts::PI,
+            x: 1.0,
+            y: 2.0,
+        };
+        Table {
+            order: Order::Second,
+            seed: 7,
+            gains: [0.5, 1.5],
+            flag: true,
+            pose,
+        }
     }
 }
 
@@ -969,14 +983,27 @@ fn the_table_language_declares_enumerations_casts_paths_and_fragments() {
     let xml = xml::model_description::<Table>();
     // an enumeration's range is that of its codes; the start is the default's code
     assert!(xml.contains(r#"name="order" valueReference="0""#));
-    assert!(xml.contains(r#"<Integer min="1" max="2" start="2"/>"#), "{xml}");
+    assert!(
+        xml.contains(r#"<Integer min="1" max="2" start="2"/>"#),
+        "{xml}"
+    );
     assert!(xml.contains(r#"<Integer min="0" max="2147483647" start="7"/>"#));
     assert!(xml.contains(r#"<Real min="0.0" max="2.0" start="1.5"/>"#));
     // the fragment splices its four entries in at its position
     let names: Vec<&str> = Table::variables().iter().map(|v| v.name).collect();
     assert_eq!(
         names,
-        ["order", "seed", "gain_b", "flag_code", "heading", "heading_wrapped", "x", "y", "sum"]
+        [
+            "order",
+            "seed",
+            "gain_b",
+            "flag_code",
+            "heading",
+            "heading_wrapped",
+            "x",
+            "y",
+            "sum"
+        ]
     );
     assert!(xml.contains(r#"<Unknown index="7" dependencies=""/>"#));
 
@@ -984,7 +1011,10 @@ fn the_table_language_declares_enumerations_casts_paths_and_fragments() {
     assert_eq!(fmu.setup(0.0, None), fmi2OK);
     assert_eq!(fmu.enter_initialization(), fmi2OK);
     assert_eq!(fmu.get::<i32>("order"), 2);
-    fmu.set("order", 1).set("seed", 12).set("gain_b", 2.0).set("flag_code", 0);
+    fmu.set("order", 1)
+        .set("seed", 12)
+        .set("gain_b", 2.0)
+        .set("flag_code", 0);
     assert_eq!(fmu.get::<i32>("order"), 1);
     assert_eq!(fmu.get::<i32>("seed"), 12);
     assert_eq!(fmu.get::<i32>("flag_code"), 0);
@@ -995,7 +1025,10 @@ fn the_table_language_declares_enumerations_casts_paths_and_fragments() {
     assert_eq!(fmu.try_set("gain_b", 2.5), fmi2Error);
     assert_eq!(fmu.exit_initialization(), fmi2OK);
     fmu.step(0.0, 0.5);
-    assert_eq!(fmu.reals(&["x", "y", "sum", "heading"]), [2.0, 2.0, 2.5, 4.0]);
+    assert_eq!(
+        fmu.reals(&["x", "y", "sum", "heading"]),
+        [2.0, 2.0, 2.5, 4.0]
+    );
     check_every_variable::<Table>(functions::<Table>());
     check_state_rollback::<Table>(functions::<Table>());
     check_every_variable::<Integrator>(functions::<Integrator>());
