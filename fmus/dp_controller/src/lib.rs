@@ -1,7 +1,7 @@
 //! `DpController` FMU: the dynamic-positioning PID of `models::controllers::dp` as an FMI 2.0
 //! co-simulation FMU. No physics here: the variable table maps the model onto FMI variables.
 
-use fmi2_export::{export_fmu, DefaultExperiment, FmuModel, Variable};
+use fmi2_export::FmuModel;
 use models::controllers::dp::{body_error, DpController, DpInputs, DpParams};
 use models::disturbances::shaping::quantise_time;
 use serde::{Deserialize, Serialize};
@@ -34,8 +34,7 @@ impl DpControllerFmu {
     }
 }
 
-type V = Variable<DpControllerFmu>;
-
+/// The inputs the commanded forces depend on directly.
 const TAU_DEPS: &[&str] = &[
     "north_estimate",
     "east_estimate",
@@ -47,6 +46,7 @@ const TAU_DEPS: &[&str] = &[
     "east_setpoint",
     "heading_setpoint",
 ];
+/// The inputs the position errors depend on directly.
 const ERR_DEPS: &[&str] = &[
     "north_estimate",
     "east_estimate",
@@ -56,300 +56,85 @@ const ERR_DEPS: &[&str] = &[
     "heading_setpoint",
 ];
 
-macro_rules! fixed {
-    ($name:literal, $unit:expr, $desc:literal, $field:ident, $i:literal) => {
-        V::real_parameter(
-            $name,
-            $unit,
-            false,
-            $desc,
-            |m| m.params.$field[$i],
-            |m, v| m.params.$field[$i] = v,
-        )
-        .with_range(Some(0.0), None)
-    };
+fmi2_export::fmu! {
+    DpControllerFmu => "DpController",
+    description: "Dynamic-positioning PID on the observer's LF estimates in the \
+        body frame, gains from the desired bandwidth, with the open-loop test input of Fossen & \
+        Strand (1999) Eq. 61",
+    experiment: (0.0, 1000.0, 1.0),
+    documentation: "documentation.html",
+    variables: {
+        fixed real "mass_surge" ["kg"] (params.mass[0]).min(0.0),
+            "m11 = m - X_udot used for the surge gains (001 Eq. 56: 5.3122e6)";
+        fixed real "mass_sway" ["kg"] (params.mass[1]).min(0.0),
+            "m22 = m - Y_vdot used for the sway gains (001 Eq. 56: 8.2831e6)";
+        fixed real "inertia_yaw" (params.mass[2]).min(0.0),
+            "m33 = I_z - N_rdot [kg m2] used for the yaw gains (001 Eq. 56: 3.7454e9)";
+        fixed real "damping_surge" (params.damping[0]).min(0.0),
+            "d11 = -X_u [N s/m] used for the surge gains (001 Eq. 57: 5.0242e4)";
+        fixed real "damping_sway" (params.damping[1]).min(0.0),
+            "d22 = -Y_v [N s/m] used for the sway gains (001 Eq. 57: 2.7229e5)";
+        fixed real "damping_yaw" (params.damping[2]).min(0.0),
+            "d33 = -N_r [N m s] used for the yaw gains (001 Eq. 57: 4.1894e8)";
+        fixed real "bandwidth_surge" ["rad/s"] (params.bandwidth[0]).min(0.0),
+            "Desired closed-loop bandwidth omega_b in surge; 0: no feedback";
+        fixed real "bandwidth_sway" ["rad/s"] (params.bandwidth[1]).min(0.0),
+            "Desired closed-loop bandwidth omega_b in sway; 0: no feedback";
+        fixed real "bandwidth_yaw" ["rad/s"] (params.bandwidth[2]).min(0.0),
+            "Desired closed-loop bandwidth omega_b in yaw; 0: no feedback";
+        fixed real "relative_damping" (params.relative_damping).min(0.0),
+            "Relative damping zeta of the closed loop (gains: Kp = m wn^2, Kd = 2 zeta wn m - d)";
+        fixed real "integral_ratio" (params.integral_ratio).min(0.0),
+            "r in Ki = Kp wn / r (Fossen's rule r = 10); 0: no integral action";
+        tunable real "test_amplitude_surge" ["N"] (params.test_amplitude[0]),
+            "Amplitude A of the feed-forward test input A sin(w t) in surge (001 Eq. 61: 1000)";
+        tunable real "test_amplitude_sway" ["N"] (params.test_amplitude[1]),
+            "Amplitude of the feed-forward test input in sway (001 Eq. 61: 1000)";
+        tunable real "test_amplitude_yaw" ["N.m"] (params.test_amplitude[2]),
+            "Amplitude of the feed-forward test input in yaw (001 Eq. 61: 1000)";
+        tunable real "test_frequency_surge" ["rad/s"] (params.test_frequency[0]),
+            "Frequency w of the surge test input (001 Eq. 61: 0.05)";
+        tunable real "test_frequency_sway" ["rad/s"] (params.test_frequency[1]),
+            "Frequency of the sway test input (001 Eq. 61: 0.1)";
+        tunable real "test_frequency_yaw" ["rad/s"] (params.test_frequency[2]),
+            "Frequency of the yaw test input (001 Eq. 61: 0.07)";
+        input real "north_estimate" ["m"] (inputs.eta[0]),
+            "LF north position estimate (observer eta_hat, not the measurement)";
+        input real "east_estimate" ["m"] (inputs.eta[1]), "LF east position estimate";
+        input real "heading_estimate" ["rad"] (inputs.eta[2]),
+            "LF heading estimate (rotation J(psi_hat) of the error)";
+        input real "surge_velocity_estimate" ["m/s"] (inputs.nu[0]),
+            "LF surge velocity estimate (body)";
+        input real "sway_velocity_estimate" ["m/s"] (inputs.nu[1]),
+            "LF sway velocity estimate (body)";
+        input real "yaw_rate_estimate" ["rad/s"] (inputs.nu[2]), "LF yaw-rate estimate";
+        input real "north_setpoint" ["m"] (inputs.setpoint[0]), "Desired north position";
+        input real "east_setpoint" ["m"] (inputs.setpoint[1]), "Desired east position";
+        input real "heading_setpoint" ["rad"] (inputs.setpoint[2]), "Desired heading";
+        output real "tau_surge" ["N"] (|m| m.tau(0)).depends_on(TAU_DEPS),
+            "Commanded surge force (body)";
+        output real "tau_sway" ["N"] (|m| m.tau(1)).depends_on(TAU_DEPS),
+            "Commanded sway force (body)";
+        output real "tau_yaw" ["N.m"] (|m| m.tau(2)).depends_on(TAU_DEPS), "Commanded yaw moment";
+        output real "error_surge" ["m"] (|m| m.error(0)).depends_on(ERR_DEPS),
+            "Body-frame position error J^T(psi_hat)(eta_hat - eta_d), surge";
+        output real "error_sway" ["m"] (|m| m.error(1)).depends_on(ERR_DEPS),
+            "Body-frame position error, sway";
+        output real "error_yaw" ["rad"] (|m| m.error(2)).depends_on(ERR_DEPS),
+            "Heading error, wrapped to (-pi, pi]";
+        calculated real "kp_surge" (|m| m.ctrl.gains().0[0]), "Kp surge [N/m]";
+        calculated real "kp_sway" (|m| m.ctrl.gains().0[1]), "Kp sway [N/m]";
+        calculated real "kp_yaw" (|m| m.ctrl.gains().0[2]), "Kp yaw [N m/rad]";
+        calculated real "kd_surge" (|m| m.ctrl.gains().1[0]), "Kd surge [N s/m]";
+        calculated real "kd_sway" (|m| m.ctrl.gains().1[1]), "Kd sway [N s/m]";
+        calculated real "kd_yaw" (|m| m.ctrl.gains().1[2]), "Kd yaw [N m s/rad]";
+        calculated real "ki_surge" (|m| m.ctrl.gains().2[0]), "Ki surge [N/(m s)]";
+        calculated real "ki_sway" (|m| m.ctrl.gains().2[1]), "Ki sway [N/(m s)]";
+        calculated real "ki_yaw" (|m| m.ctrl.gains().2[2]), "Ki yaw [N m/(rad s)]";
+    }
 }
-
-macro_rules! input {
-    ($name:literal, $unit:expr, $desc:literal, $field:ident, $i:literal) => {
-        V::real_input(
-            $name,
-            $unit,
-            $desc,
-            |m| m.inputs.$field[$i],
-            |m, v| m.inputs.$field[$i] = v,
-        )
-    };
-}
-
-static VARIABLES: [V; 41] = [
-    fixed!(
-        "mass_surge",
-        Some("kg"),
-        "m11 = m - X_udot used for the surge gains (001 Eq. 56: 5.3122e6)",
-        mass,
-        0
-    ),
-    fixed!(
-        "mass_sway",
-        Some("kg"),
-        "m22 = m - Y_vdot used for the sway gains (001 Eq. 56: 8.2831e6)",
-        mass,
-        1
-    ),
-    fixed!(
-        "inertia_yaw",
-        None,
-        "m33 = I_z - N_rdot [kg m2] used for the yaw gains (001 Eq. 56: 3.7454e9)",
-        mass,
-        2
-    ),
-    fixed!(
-        "damping_surge",
-        None,
-        "d11 = -X_u [N s/m] used for the surge gains (001 Eq. 57: 5.0242e4)",
-        damping,
-        0
-    ),
-    fixed!(
-        "damping_sway",
-        None,
-        "d22 = -Y_v [N s/m] used for the sway gains (001 Eq. 57: 2.7229e5)",
-        damping,
-        1
-    ),
-    fixed!(
-        "damping_yaw",
-        None,
-        "d33 = -N_r [N m s] used for the yaw gains (001 Eq. 57: 4.1894e8)",
-        damping,
-        2
-    ),
-    fixed!(
-        "bandwidth_surge",
-        Some("rad/s"),
-        "Desired closed-loop bandwidth omega_b in surge; 0: no feedback",
-        bandwidth,
-        0
-    ),
-    fixed!(
-        "bandwidth_sway",
-        Some("rad/s"),
-        "Desired closed-loop bandwidth omega_b in sway; 0: no feedback",
-        bandwidth,
-        1
-    ),
-    fixed!(
-        "bandwidth_yaw",
-        Some("rad/s"),
-        "Desired closed-loop bandwidth omega_b in yaw; 0: no feedback",
-        bandwidth,
-        2
-    ),
-    V::real_parameter(
-        "relative_damping",
-        None,
-        false,
-        "Relative damping zeta of the closed loop (gains: Kp = m wn^2, Kd = 2 zeta wn m - d)",
-        |m| m.params.relative_damping,
-        |m, v| m.params.relative_damping = v,
-    )
-    .with_range(Some(0.0), None),
-    V::real_parameter(
-        "integral_ratio",
-        None,
-        false,
-        "r in Ki = Kp wn / r (Fossen's rule r = 10); 0: no integral action",
-        |m| m.params.integral_ratio,
-        |m, v| m.params.integral_ratio = v,
-    )
-    .with_range(Some(0.0), None),
-    V::real_parameter(
-        "test_amplitude_surge",
-        Some("N"),
-        true,
-        "Amplitude A of the feed-forward test input A sin(w t) in surge (001 Eq. 61: 1000)",
-        |m| m.params.test_amplitude[0],
-        |m, v| m.params.test_amplitude[0] = v,
-    ),
-    V::real_parameter(
-        "test_amplitude_sway",
-        Some("N"),
-        true,
-        "Amplitude of the feed-forward test input in sway (001 Eq. 61: 1000)",
-        |m| m.params.test_amplitude[1],
-        |m, v| m.params.test_amplitude[1] = v,
-    ),
-    V::real_parameter(
-        "test_amplitude_yaw",
-        Some("N.m"),
-        true,
-        "Amplitude of the feed-forward test input in yaw (001 Eq. 61: 1000)",
-        |m| m.params.test_amplitude[2],
-        |m, v| m.params.test_amplitude[2] = v,
-    ),
-    V::real_parameter(
-        "test_frequency_surge",
-        Some("rad/s"),
-        true,
-        "Frequency w of the surge test input (001 Eq. 61: 0.05)",
-        |m| m.params.test_frequency[0],
-        |m, v| m.params.test_frequency[0] = v,
-    ),
-    V::real_parameter(
-        "test_frequency_sway",
-        Some("rad/s"),
-        true,
-        "Frequency of the sway test input (001 Eq. 61: 0.1)",
-        |m| m.params.test_frequency[1],
-        |m, v| m.params.test_frequency[1] = v,
-    ),
-    V::real_parameter(
-        "test_frequency_yaw",
-        Some("rad/s"),
-        true,
-        "Frequency of the yaw test input (001 Eq. 61: 0.07)",
-        |m| m.params.test_frequency[2],
-        |m, v| m.params.test_frequency[2] = v,
-    ),
-    input!(
-        "north_estimate",
-        Some("m"),
-        "LF north position estimate (observer eta_hat, not the measurement)",
-        eta,
-        0
-    ),
-    input!(
-        "east_estimate",
-        Some("m"),
-        "LF east position estimate",
-        eta,
-        1
-    ),
-    input!(
-        "heading_estimate",
-        Some("rad"),
-        "LF heading estimate (rotation J(psi_hat) of the error)",
-        eta,
-        2
-    ),
-    input!(
-        "surge_velocity_estimate",
-        Some("m/s"),
-        "LF surge velocity estimate (body)",
-        nu,
-        0
-    ),
-    input!(
-        "sway_velocity_estimate",
-        Some("m/s"),
-        "LF sway velocity estimate (body)",
-        nu,
-        1
-    ),
-    input!(
-        "yaw_rate_estimate",
-        Some("rad/s"),
-        "LF yaw-rate estimate",
-        nu,
-        2
-    ),
-    input!(
-        "north_setpoint",
-        Some("m"),
-        "Desired north position",
-        setpoint,
-        0
-    ),
-    input!(
-        "east_setpoint",
-        Some("m"),
-        "Desired east position",
-        setpoint,
-        1
-    ),
-    input!(
-        "heading_setpoint",
-        Some("rad"),
-        "Desired heading",
-        setpoint,
-        2
-    ),
-    V::real_output(
-        "tau_surge",
-        Some("N"),
-        "Commanded surge force (body)",
-        |m| m.tau(0),
-    )
-    .depends_on(TAU_DEPS),
-    V::real_output("tau_sway", Some("N"), "Commanded sway force (body)", |m| {
-        m.tau(1)
-    })
-    .depends_on(TAU_DEPS),
-    V::real_output("tau_yaw", Some("N.m"), "Commanded yaw moment", |m| m.tau(2))
-        .depends_on(TAU_DEPS),
-    V::real_output(
-        "error_surge",
-        Some("m"),
-        "Body-frame position error J^T(psi_hat)(eta_hat - eta_d), surge",
-        |m| m.error(0),
-    )
-    .depends_on(ERR_DEPS),
-    V::real_output(
-        "error_sway",
-        Some("m"),
-        "Body-frame position error, sway",
-        |m| m.error(1),
-    )
-    .depends_on(ERR_DEPS),
-    V::real_output(
-        "error_yaw",
-        Some("rad"),
-        "Heading error, wrapped to (-pi, pi]",
-        |m| m.error(2),
-    )
-    .depends_on(ERR_DEPS),
-    V::real_calculated_parameter("kp_surge", None, "Kp surge [N/m]", |m| m.ctrl.gains().0[0]),
-    V::real_calculated_parameter("kp_sway", None, "Kp sway [N/m]", |m| m.ctrl.gains().0[1]),
-    V::real_calculated_parameter("kp_yaw", None, "Kp yaw [N m/rad]", |m| m.ctrl.gains().0[2]),
-    V::real_calculated_parameter("kd_surge", None, "Kd surge [N s/m]", |m| {
-        m.ctrl.gains().1[0]
-    }),
-    V::real_calculated_parameter("kd_sway", None, "Kd sway [N s/m]", |m| m.ctrl.gains().1[1]),
-    V::real_calculated_parameter("kd_yaw", None, "Kd yaw [N m s/rad]", |m| {
-        m.ctrl.gains().1[2]
-    }),
-    V::real_calculated_parameter("ki_surge", None, "Ki surge [N/(m s)]", |m| {
-        m.ctrl.gains().2[0]
-    }),
-    V::real_calculated_parameter("ki_sway", None, "Ki sway [N/(m s)]", |m| {
-        m.ctrl.gains().2[1]
-    }),
-    V::real_calculated_parameter("ki_yaw", None, "Ki yaw [N m/(rad s)]", |m| {
-        m.ctrl.gains().2[2]
-    }),
-];
 
 impl FmuModel for DpControllerFmu {
-    const MODEL_IDENTIFIER: &'static str = "DpController";
-    const DESCRIPTION: &'static str =
-        "Dynamic-positioning PID on the observer's LF estimates in the \
-        body frame, gains from the desired bandwidth, with the open-loop test input of Fossen & \
-        Strand (1999) Eq. 61";
-    const DEFAULT_EXPERIMENT: DefaultExperiment = DefaultExperiment {
-        start_time: 0.0,
-        stop_time: 1000.0,
-        step_size: 1.0,
-    };
-
-    fn variables() -> &'static [Variable<Self>] {
-        &VARIABLES
-    }
-
-    fn documentation_html() -> &'static str {
-        include_str!("documentation.html")
-    }
-
     fn initialize(&mut self, start_time: f64) -> Result<(), String> {
         self.ctrl = DpController::new(self.params.clone(), quantise_time(start_time))
             .map_err(|e| e.to_string())?;
@@ -368,5 +153,3 @@ impl FmuModel for DpControllerFmu {
         Ok(())
     }
 }
-
-export_fmu!(DpControllerFmu);

@@ -1,91 +1,69 @@
-//! Calls the `fmi2*` symbols that `export_fmu!` emitted for DpController (linked from this
-//! crate's rlib), as a C importer would, and checks them against the model.
+//! DpController through the `fmi2*` symbols its crate exports, as a C importer calls them: the
+//! checks every FMU runs, and the FMU against `models::controllers::dp` by variable name.
 
-use fmi2::*;
+use fmi2_export::fmi2::fmi2OK;
 use models::controllers::dp::{DpController, DpInputs, DpParams};
-use std::ffi::CString;
-use std::ptr::null;
 
-fmi2::declare_fmi2_functions!();
+fmi2_export::fmu_tests!(dp_controller_fmu::DpControllerFmu);
 
-fn callbacks() -> fmi2CallbackFunctions {
-    fmi2CallbackFunctions {
-        logger: None,
-        allocateMemory: None,
-        freeMemory: None,
-        stepFinished: None,
-        componentEnvironment: std::ptr::null_mut(),
-    }
-}
+/// The inputs in the order eta, nu, setpoint.
+const INPUTS: [&str; 9] = [
+    "north_estimate",
+    "east_estimate",
+    "heading_estimate",
+    "surge_velocity_estimate",
+    "sway_velocity_estimate",
+    "yaw_rate_estimate",
+    "north_setpoint",
+    "east_setpoint",
+    "heading_setpoint",
+];
+const OUTPUTS: [&str; 3] = ["tau_surge", "tau_sway", "tau_yaw"];
 
 #[test]
 fn exported_api_reproduces_the_model() {
-    let guid =
-        CString::new(fmi2_export::xml::guid::<dp_controller_fmu::DpControllerFmu>()).unwrap();
-    let name = CString::new("dp").unwrap();
-    let cb = callbacks();
-    unsafe {
-        let c = fmi2Instantiate(
-            name.as_ptr(),
-            fmi2CoSimulation,
-            guid.as_ptr(),
-            null(),
-            &cb,
-            0,
-            0,
-        );
-        assert!(!c.is_null());
-        assert_eq!(fmi2SetupExperiment(c, 0, 0.0, 0.0, 0, 0.0), fmi2OK);
-        assert_eq!(fmi2EnterInitializationMode(c), fmi2OK);
-        let (vr_amp, amp) = (11u32, 1000.0);
-        assert_eq!(fmi2SetReal(c, &vr_amp, 1, &amp), fmi2OK);
-        assert_eq!(fmi2ExitInitializationMode(c), fmi2OK);
-        let mut params = DpParams::northern_clipper();
-        params.test_amplitude[0] = amp;
-        let mut model = DpController::new(params, 0.0).unwrap();
-        let ins: Vec<u32> = (17..26).collect();
-        let outs = [26u32, 27, 28];
-        for k in 0..300 {
-            let t = k as f64 * 0.5;
-            let u = DpInputs {
-                eta: [
-                    3.0 * (0.02 * t).sin(),
-                    -2.0 + 0.01 * t,
-                    0.3 * (0.01 * t).cos(),
-                ],
-                nu: [0.1 * (0.03 * t).cos(), 0.02, 1e-3 * (0.05 * t).sin()],
-                setpoint: [1.0, -1.0, 0.2],
-            };
-            let v: Vec<f64> = u
-                .eta
-                .iter()
-                .chain(&u.nu)
-                .chain(&u.setpoint)
-                .copied()
-                .collect();
-            assert_eq!(fmi2SetReal(c, ins.as_ptr(), 9, v.as_ptr()), fmi2OK);
-            let mut y = [0.0; 3];
-            assert_eq!(fmi2GetReal(c, outs.as_ptr(), 3, y.as_mut_ptr()), fmi2OK);
-            assert_eq!(y, model.tau(&u), "feedthrough at t = {t}");
-            assert_eq!(fmi2DoStep(c, t, 0.5, 1), fmi2OK);
-            model.step(&u, 0.5);
-            model.set_time((k + 1) as f64 * 0.5);
-            assert_eq!(fmi2GetReal(c, outs.as_ptr(), 3, y.as_mut_ptr()), fmi2OK);
-            assert_eq!(y, model.tau(&u), "after the step from t = {t}");
+    let mut fmu = fmu();
+    assert_eq!(fmu.setup(0.0, None), fmi2OK);
+    assert_eq!(fmu.enter_initialization(), fmi2OK);
+    let amp = 1000.0;
+    fmu.set("test_amplitude_surge", amp);
+    assert_eq!(fmu.exit_initialization(), fmi2OK);
+    let mut params = DpParams::northern_clipper();
+    params.test_amplitude[0] = amp;
+    let mut model = DpController::new(params, 0.0).unwrap();
+    for k in 0..300 {
+        let t = k as f64 * 0.5;
+        let u = DpInputs {
+            eta: [
+                3.0 * (0.02 * t).sin(),
+                -2.0 + 0.01 * t,
+                0.3 * (0.01 * t).cos(),
+            ],
+            nu: [0.1 * (0.03 * t).cos(), 0.02, 1e-3 * (0.05 * t).sin()],
+            setpoint: [1.0, -1.0, 0.2],
+        };
+        let values = u.eta.iter().chain(&u.nu).chain(&u.setpoint);
+        for (name, &x) in INPUTS.iter().zip(values) {
+            fmu.set(name, x);
         }
-        assert_eq!(fmi2Terminate(c), fmi2OK);
-        fmi2FreeInstance(c);
+        assert_eq!(fmu.reals(&OUTPUTS), model.tau(&u), "feedthrough at t = {t}");
+        fmu.step(t, 0.5);
+        model.step(&u, 0.5);
+        model.set_time((k + 1) as f64 * 0.5);
+        assert_eq!(
+            fmu.reals(&OUTPUTS),
+            model.tau(&u),
+            "after the step from t = {t}"
+        );
     }
+    assert_eq!(fmu.terminate(), fmi2OK);
 }
 
 #[test]
-fn variable_table_passes_the_layer_checks() {
-    use fmi2_export::FmuModel;
-    fmi2_export::variables::check_table(dp_controller_fmu::DpControllerFmu::variables()).unwrap();
-    let xml = fmi2_export::xml::model_description::<dp_controller_fmu::DpControllerFmu>();
-    // value references used above
-    assert!(xml.contains(r#"name="test_amplitude_surge" valueReference="11""#));
-    assert!(xml.contains(r#"name="north_estimate" valueReference="17""#));
-    assert!(xml.contains(r#"name="heading_setpoint" valueReference="25""#));
-    assert!(xml.contains(r#"name="tau_surge" valueReference="26""#));
+fn value_references_are_pinned() {
+    let fmu = fmu();
+    assert_eq!(fmu.vr("test_amplitude_surge"), 11);
+    assert_eq!(fmu.vr("north_estimate"), 17);
+    assert_eq!(fmu.vr("heading_setpoint"), 25);
+    assert_eq!(fmu.vr("tau_surge"), 26);
 }
