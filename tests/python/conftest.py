@@ -38,14 +38,20 @@ def fmu_path():
 
 @pytest.fixture(scope="session")
 def reference():
-    """Runs the Rust-model reference generator for a case and returns the rows as dicts of floats."""
+    """Runs the Rust-model reference generator for a case and returns the rows as dicts of floats.
+
+    Each case runs once per session (several tests use the same case); every call gets its own copy
+    of the rows."""
+    cache = {}
 
     def run(case: str):
-        exe = os.environ.get("SHIPSIM_REFERENCE_BIN", str(ROOT / "target" / "release" / "model-reference"))
-        if not pathlib.Path(exe).exists():
-            raise RuntimeError(f"{exe} is missing: run `cargo xtask test`")
-        out = subprocess.run([exe, case], check=True, capture_output=True, text=True).stdout
-        rows = list(csv.DictReader(out.splitlines()))
-        return [{k: float(v) for k, v in r.items()} for r in rows]
+        if case not in cache:
+            exe = os.environ.get("SHIPSIM_REFERENCE_BIN", str(ROOT / "target" / "release" / "model-reference"))
+            if not pathlib.Path(exe).exists():
+                raise RuntimeError(f"{exe} is missing: run `cargo xtask test`")
+            out = subprocess.run([exe, case], check=True, capture_output=True, text=True).stdout
+            rows = list(csv.DictReader(out.splitlines()))
+            cache[case] = [{k: float(v) for k, v in r.items()} for r in rows]
+        return [dict(r) for r in cache[case]]
 
     return run

@@ -1,6 +1,6 @@
 """Small helpers around FMPy and libcosimpy used by several test files."""
 import numpy as np
-from fmpy import read_model_description
+from fmpy import read_model_description, simulate_fmu
 from libcosimpy.CosimExecution import CosimExecution
 from libcosimpy.CosimManipulator import CosimManipulator
 from libcosimpy.CosimObserver import CosimObserver
@@ -54,3 +54,40 @@ def run_libcosim(fmu, step, n_steps, outputs, inputs=None, initial=None):
         assert execution.step(1), f"libcosim step {k} failed for {fmu}"
         rows.append(observer.last_real_values(index, refs))
     return {n: np.array([r[i] for r in rows]) for i, n in enumerate(outputs)}
+
+
+# --- runs on the rows of a model-reference case (see tests/src/reference/mod.rs for the CSV) ---
+
+
+def column(ref, name):
+    """One column of reference rows as an array."""
+    return np.array([r[name] for r in ref])
+
+
+def reference_step(ref):
+    """The communication step of a reference case: t_1 - t_0."""
+    return ref[1]["time"] - ref[0]["time"]
+
+
+def input_signal(ref, inputs):
+    """FMPy's input signal for `inputs` from reference rows: value k is set at t_k."""
+    return np.array([tuple([r["time"]] + [r[n] for n in inputs]) for r in ref],
+                    dtype=[("time", np.float64)] + [(n, np.float64) for n in inputs])
+
+
+def fmpy_on_reference(fmu, ref, inputs, outputs, start_values=None):
+    """Runs the FMU in FMPy over the reference's time grid with its inputs: result row k holds the
+    outputs at t_k (row 0 after initialization), as the reference rows do."""
+    t = column(ref, "time")
+    h = t[1] - t[0]
+    return simulate_fmu(str(fmu), start_time=0.0, stop_time=t[-1], step_size=h, output_interval=h,
+                        input=input_signal(ref, inputs), output=list(outputs),
+                        start_values=dict(start_values or {}))
+
+
+def libcosim_on_reference(fmu, ref, inputs, outputs, initial=None):
+    """Runs the FMU in libcosim with the reference's step and inputs for len(ref) - 1 steps: sample k
+    holds the outputs at t_(k+1), i.e. compares with ref[1:]."""
+    return run_libcosim(fmu, reference_step(ref), len(ref) - 1, list(outputs),
+                        inputs={name: [r[name] for r in ref] for name in inputs},
+                        initial=dict(initial or {}))
