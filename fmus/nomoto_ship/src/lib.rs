@@ -135,21 +135,21 @@ fmi2_export::fmu! {
         fixed real "t_prime" (t_prime),
             "Model 1: nondimensional Nomoto time constant T' (eq. 5.25: 1.9287)";
         fixed real "k_prime" (k_prime), "Model 1: nondimensional Nomoto gain K' (eq. 5.26: 2.04)";
-        fixed real "m11" (|m| m.m[0][0], |m, v| m.m[0][0] = v),
+        fixed real "m11" (m[0][0]),
             "Model 2: mass matrix M, entry m11 = m' - Y'_vdot (prime system)";
-        fixed real "m12" (|m| m.m[0][1], |m, v| m.m[0][1] = v),
+        fixed real "m12" (m[0][1]),
             "Model 2: mass matrix M, entry m12 = m'x'_G - Y'_rdot (prime system)";
-        fixed real "m21" (|m| m.m[1][0], |m, v| m.m[1][0] = v),
+        fixed real "m21" (m[1][0]),
             "Model 2: mass matrix M, entry m21 = m'x'_G - N'_vdot (prime system)";
-        fixed real "m22" (|m| m.m[1][1], |m, v| m.m[1][1] = v),
+        fixed real "m22" (m[1][1]),
             "Model 2: mass matrix M, entry m22 = I'_z - N'_rdot (prime system)";
-        fixed real "n11" (|m| m.n[0][0], |m, v| m.n[0][0] = v),
+        fixed real "n11" (n[0][0]),
             "Model 2: damping matrix N (one of the four hull coefficients of Table 2.3), entry n11 = -Y'_v (prime system)";
-        fixed real "n12" (|m| m.n[0][1], |m, v| m.n[0][1] = v),
+        fixed real "n12" (n[0][1]),
             "Model 2: damping matrix N (one of the four hull coefficients of Table 2.3), entry n12 = m' - Y'_r (prime system)";
-        fixed real "n21" (|m| m.n[1][0], |m, v| m.n[1][0] = v),
+        fixed real "n21" (n[1][0]),
             "Model 2: damping matrix N (one of the four hull coefficients of Table 2.3), entry n21 = -N'_v (prime system)";
-        fixed real "n22" (|m| m.n[1][1], |m, v| m.n[1][1] = v),
+        fixed real "n22" (n[1][1]),
             "Model 2: damping matrix N (one of the four hull coefficients of Table 2.3), entry n22 = m'x'_G - N'_r (prime system)";
         fixed real "b1" (b[0]), "Model 2: rudder vector entry b1 = Y'_delta (prime system, per rad)";
         fixed real "b2" (b[1]), "Model 2: rudder vector entry b2 = N'_delta (prime system, per rad)";
