@@ -54,41 +54,41 @@ fmi2_export::fmu! {
     direct_feedthrough: false,
     documentation: "documentation.html",
     variables: {
-        fixed real "m11" (|m| m.m[0][0], |m, v| m.m[0][0] = v),
+        fixed real "m11" (m[0][0]),
             "Inertia matrix M (eq. 56), entry (1, 1), SI (kg, kg.m, kg.m2 by row/column)";
-        fixed real "m12" (|m| m.m[0][1], |m, v| m.m[0][1] = v),
+        fixed real "m12" (m[0][1]),
             "Inertia matrix M (eq. 56), entry (1, 2), SI (kg, kg.m, kg.m2 by row/column)";
-        fixed real "m13" (|m| m.m[0][2], |m, v| m.m[0][2] = v),
+        fixed real "m13" (m[0][2]),
             "Inertia matrix M (eq. 56), entry (1, 3), SI (kg, kg.m, kg.m2 by row/column)";
-        fixed real "m21" (|m| m.m[1][0], |m, v| m.m[1][0] = v),
+        fixed real "m21" (m[1][0]),
             "Inertia matrix M (eq. 56), entry (2, 1), SI (kg, kg.m, kg.m2 by row/column)";
-        fixed real "m22" (|m| m.m[1][1], |m, v| m.m[1][1] = v),
+        fixed real "m22" (m[1][1]),
             "Inertia matrix M (eq. 56), entry (2, 2), SI (kg, kg.m, kg.m2 by row/column)";
-        fixed real "m23" (|m| m.m[1][2], |m, v| m.m[1][2] = v),
+        fixed real "m23" (m[1][2]),
             "Inertia matrix M (eq. 56), entry (2, 3), SI (kg, kg.m, kg.m2 by row/column)";
-        fixed real "m31" (|m| m.m[2][0], |m, v| m.m[2][0] = v),
+        fixed real "m31" (m[2][0]),
             "Inertia matrix M (eq. 56), entry (3, 1), SI (kg, kg.m, kg.m2 by row/column)";
-        fixed real "m32" (|m| m.m[2][1], |m, v| m.m[2][1] = v),
+        fixed real "m32" (m[2][1]),
             "Inertia matrix M (eq. 56), entry (3, 2), SI (kg, kg.m, kg.m2 by row/column)";
-        fixed real "m33" (|m| m.m[2][2], |m, v| m.m[2][2] = v),
+        fixed real "m33" (m[2][2]),
             "Inertia matrix M (eq. 56), entry (3, 3), SI (kg, kg.m, kg.m2 by row/column)";
-        fixed real "d11" (|m| m.d[0][0], |m, v| m.d[0][0] = v),
+        fixed real "d11" (d[0][0]),
             "Damping matrix D (eq. 57), entry (1, 1), SI (N.s/m, N.s, N.m.s by row/column)";
-        fixed real "d12" (|m| m.d[0][1], |m, v| m.d[0][1] = v),
+        fixed real "d12" (d[0][1]),
             "Damping matrix D (eq. 57), entry (1, 2), SI (N.s/m, N.s, N.m.s by row/column)";
-        fixed real "d13" (|m| m.d[0][2], |m, v| m.d[0][2] = v),
+        fixed real "d13" (d[0][2]),
             "Damping matrix D (eq. 57), entry (1, 3), SI (N.s/m, N.s, N.m.s by row/column)";
-        fixed real "d21" (|m| m.d[1][0], |m, v| m.d[1][0] = v),
+        fixed real "d21" (d[1][0]),
             "Damping matrix D (eq. 57), entry (2, 1), SI (N.s/m, N.s, N.m.s by row/column)";
-        fixed real "d22" (|m| m.d[1][1], |m, v| m.d[1][1] = v),
+        fixed real "d22" (d[1][1]),
             "Damping matrix D (eq. 57), entry (2, 2), SI (N.s/m, N.s, N.m.s by row/column)";
-        fixed real "d23" (|m| m.d[1][2], |m, v| m.d[1][2] = v),
+        fixed real "d23" (d[1][2]),
             "Damping matrix D (eq. 57), entry (2, 3), SI (N.s/m, N.s, N.m.s by row/column)";
-        fixed real "d31" (|m| m.d[2][0], |m, v| m.d[2][0] = v),
+        fixed real "d31" (d[2][0]),
             "Damping matrix D (eq. 57), entry (3, 1), SI (N.s/m, N.s, N.m.s by row/column)";
-        fixed real "d32" (|m| m.d[2][1], |m, v| m.d[2][1] = v),
+        fixed real "d32" (d[2][1]),
             "Damping matrix D (eq. 57), entry (3, 2), SI (N.s/m, N.s, N.m.s by row/column)";
-        fixed real "d33" (|m| m.d[2][2], |m, v| m.d[2][2] = v),
+        fixed real "d33" (d[2][2]),
             "Damping matrix D (eq. 57), entry (3, 3), SI (N.s/m, N.s, N.m.s by row/column)";
         fixed real "max_substep" ["s"] (max_substep).min(0.0),
             "Largest RK4 sub-step (default 0.1 s; the fastest open-loop time constant is 8.40 s)";
