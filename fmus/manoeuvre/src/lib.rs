@@ -9,7 +9,7 @@
 //! t and the inputs (getting it twice, or after setting new inputs, never changes the FMU state).
 //! `fmi2DoStep(t, h)` commits the generator's decision at t with the inputs held over the step.
 
-use fmi2_export::{export_fmu, DefaultExperiment, FmuModel, Variable};
+use fmi2_export::FmuModel;
 use models::hull::DEG;
 use models::manoeuvre::{ManoeuvreGenerator, ManoeuvreKind};
 use serde::{Deserialize, Serialize};
@@ -66,8 +66,9 @@ impl Default for ManoeuvreFmu {
 impl ManoeuvreFmu {
     /// The generator the parameters describe; the error names the parameter and its value.
     pub fn build(&self) -> Result<ManoeuvreGenerator, String> {
+        let (rudder, check, hold) = (self.rudder_angle, self.check_angle, self.hold_time);
         for (name, v) in [
-            ("rudder_angle", self.rudder_angle),
+            ("rudder_angle", rudder),
             ("execute_time", self.execute_time),
             ("initial_command", self.initial_command),
         ] {
@@ -76,40 +77,19 @@ impl ManoeuvreFmu {
             }
         }
         let kind = match self.kind {
-            1 => ManoeuvreKind::TurningCircle {
-                rudder: self.rudder_angle,
-            },
-            2 => {
-                if !(self.check_angle.is_finite() && self.check_angle > 0.0) {
-                    return Err(format!(
-                        "parameter check_angle = {} must be finite and > 0",
-                        self.check_angle
-                    ));
-                }
-                ManoeuvreKind::ZigZag {
-                    rudder: self.rudder_angle,
-                    check: self.check_angle,
-                }
-            }
-            3 => {
-                if !(self.hold_time.is_finite() && self.hold_time >= 0.0) {
-                    return Err(format!(
-                        "parameter hold_time = {} must be finite and >= 0",
-                        self.hold_time
-                    ));
-                }
-                ManoeuvreKind::PullOut {
-                    rudder: self.rudder_angle,
-                    hold: self.hold_time,
-                }
-            }
-            v => return Err(format!("parameter kind = {v} must be 1, 2 or 3")),
+            1 => ManoeuvreKind::TurningCircle { rudder },
+            2 if check.is_finite() && check > 0.0 => ManoeuvreKind::ZigZag { rudder, check },
+            2 => Err(format!(
+                "parameter check_angle = {check} must be finite and > 0"
+            ))?,
+            3 if hold.is_finite() && hold >= 0.0 => ManoeuvreKind::PullOut { rudder, hold },
+            3 => Err(format!(
+                "parameter hold_time = {hold} must be finite and >= 0"
+            ))?,
+            v => Err(format!("parameter kind = {v} must be 1, 2 or 3"))?,
         };
-        Ok(ManoeuvreGenerator::new(
-            kind,
-            self.execute_time,
-            self.initial_command,
-        ))
+        let (execute, initial) = (self.execute_time, self.initial_command);
+        Ok(ManoeuvreGenerator::new(kind, execute, initial))
     }
 
     /// Outputs at `time` from the committed generator and the current inputs.
@@ -121,116 +101,41 @@ impl ManoeuvreFmu {
     }
 }
 
-type V = Variable<ManoeuvreFmu>;
-
-static VARIABLES: &[V] = &[
-    V::integer_parameter(
-        "kind",
-        false,
-        "1: rudder step / turning circle (rudder_angle from execute_time on); 2: zig-zag a/b \
-         (a = rudder_angle, b = check_angle); 3: pull-out (rudder_angle for hold_time, then 0)",
-        1,
-        3,
-        |m| m.kind,
-        |m, v| m.kind = v,
-    ),
-    V::real_parameter(
-        "rudder_angle",
-        Some("rad"),
-        false,
-        "Rudder angle of the manoeuvre (zig-zag: a; negative for a port-first test); default 35 deg",
-        |m| m.rudder_angle,
-        |m, v| m.rudder_angle = v,
-    ),
-    V::real_parameter(
-        "check_angle",
-        Some("rad"),
-        false,
-        "Zig-zag switching heading b (> 0): the rudder reverses when the heading change from the \
-         execute heading reaches +-b with the yaw rate in the same direction; default 10 deg",
-        |m| m.check_angle,
-        |m, v| m.check_angle = v,
-    )
-    .with_range(Some(0.0), None),
-    V::real_parameter(
-        "hold_time",
-        Some("s"),
-        false,
-        "Pull-out: time the rudder is held after execute before it returns to 0; default 60 s",
-        |m| m.hold_time,
-        |m, v| m.hold_time = v,
-    )
-    .with_range(Some(0.0), None),
-    V::real_parameter(
-        "execute_time",
-        Some("s"),
-        false,
-        "Execute time t_e (the command switches at t >= t_e; the heading at t_e is latched as the \
-         original course); default 10 s",
-        |m| m.execute_time,
-        |m, v| m.execute_time = v,
-    ),
-    V::real_parameter(
-        "initial_command",
-        Some("rad"),
-        false,
-        "Command before execute (e.g. Mariner.trim_rudder_command for a run from the trimmed course)",
-        |m| m.initial_command,
-        |m, v| m.initial_command = v,
-    ),
-    V::real_input(
-        "heading",
-        Some("rad"),
-        "Ship heading psi, continuous (not wrapped)",
-        |m| m.heading,
-        |m, v| m.heading = v,
-    ),
-    V::real_input(
-        "yaw_rate",
-        Some("rad/s"),
-        "Ship yaw rate r",
-        |m| m.yaw_rate,
-        |m, v| m.yaw_rate = v,
-    ),
-    V::real_output(
-        "rudder_command",
-        Some("rad"),
-        "Rudder command for the step starting at the current communication point (direct \
-         feedthrough from heading and yaw_rate)",
-        |m| m.command,
-    ),
-    V::real_output(
-        "heading_change",
-        Some("rad"),
-        "Heading change psi - psi_e from the execute heading (0 before execute)",
-        |m| m.heading_change,
-    ),
-    V::boolean_output(
-        "executed",
-        "The manoeuvre has been executed (t >= execute_time)",
-        |m| m.executed,
-    ),
-];
+fmi2_export::fmu! {
+    ManoeuvreFmu => "Manoeuvre",
+    description: "Rudder-command generator of the standard manoeuvring \
+        tests from the ship's heading: rudder step / turning circle, zig-zag a/b, pull-out \
+        (IMO MSC.137(76), ITTC; MSS turncircle.m / zigzag.m)",
+    experiment: (0.0, 300.0, 0.1),
+    documentation: "documentation.html",
+    variables: {
+        fixed int(1, 3) "kind" (kind),
+            "1: rudder step / turning circle (rudder_angle from execute_time on); 2: zig-zag a/b \
+            (a = rudder_angle, b = check_angle); 3: pull-out (rudder_angle for hold_time, then 0)";
+        fixed real "rudder_angle" ["rad"] (rudder_angle),
+            "Rudder angle of the manoeuvre (zig-zag: a; negative for a port-first test); default 35 deg";
+        fixed real "check_angle" ["rad"] (check_angle).min(0.0),
+            "Zig-zag switching heading b (> 0): the rudder reverses when the heading change from the \
+            execute heading reaches +-b with the yaw rate in the same direction; default 10 deg";
+        fixed real "hold_time" ["s"] (hold_time).min(0.0),
+            "Pull-out: time the rudder is held after execute before it returns to 0; default 60 s";
+        fixed real "execute_time" ["s"] (execute_time),
+            "Execute time t_e (the command switches at t >= t_e; the heading at t_e is latched as the \
+            original course); default 10 s";
+        fixed real "initial_command" ["rad"] (initial_command),
+            "Command before execute (e.g. Mariner.trim_rudder_command for a run from the trimmed course)";
+        input real "heading" ["rad"] (heading), "Ship heading psi, continuous (not wrapped)";
+        input real "yaw_rate" ["rad/s"] (yaw_rate), "Ship yaw rate r";
+        output real "rudder_command" ["rad"] (command),
+            "Rudder command for the step starting at the current communication point (direct \
+            feedthrough from heading and yaw_rate)";
+        output real "heading_change" ["rad"] (heading_change),
+            "Heading change psi - psi_e from the execute heading (0 before execute)";
+        output bool "executed" (executed), "The manoeuvre has been executed (t >= execute_time)";
+    }
+}
 
 impl FmuModel for ManoeuvreFmu {
-    const MODEL_IDENTIFIER: &'static str = "Manoeuvre";
-    const DESCRIPTION: &'static str = "Rudder-command generator of the standard manoeuvring \
-        tests from the ship's heading: rudder step / turning circle, zig-zag a/b, pull-out \
-        (IMO MSC.137(76), ITTC; MSS turncircle.m / zigzag.m)";
-    const DEFAULT_EXPERIMENT: DefaultExperiment = DefaultExperiment {
-        start_time: 0.0,
-        stop_time: 300.0,
-        step_size: 0.1,
-    };
-
-    fn variables() -> &'static [Variable<Self>] {
-        VARIABLES
-    }
-
-    fn documentation_html() -> &'static str {
-        include_str!("documentation.html")
-    }
-
     fn initialize(&mut self, start_time: f64) -> Result<(), String> {
         self.generator = self.build()?;
         self.time = start_time;
@@ -249,8 +154,6 @@ impl FmuModel for ManoeuvreFmu {
         Ok(())
     }
 }
-
-export_fmu!(ManoeuvreFmu);
 
 #[cfg(test)]
 mod tests {
