@@ -30,8 +30,10 @@ fn exported_api_reproduces_the_model_and_restores_states() {
     let x0 = truth(0.0);
     set_inputs(&mut fmu, x0);
     assert_eq!(fmu.exit_initialization(), fmi2OK);
-    let mut p = SensorParams::default();
-    p.seed = 8;
+    let mut p = SensorParams {
+        seed: 8,
+        ..SensorParams::default()
+    };
     p.channels[2].sigma = 0.3;
     let mut model = Sensors::new(p, 0.0, x0).unwrap();
     let h = 0.1;

@@ -31,10 +31,12 @@ fn exported_api_reproduces_the_model_and_restores_states() {
         .set("wave_direction", 0.4);
     assert_eq!(fmu.exit_initialization(), fmi2OK);
 
-    let mut p = WaveParams::default();
-    p.seed = 99;
-    p.roll_gain = 1.0e6;
-    p.yaw_gain = 3.0e5;
+    let p = WaveParams {
+        seed: 99,
+        roll_gain: 1.0e6,
+        yaw_gain: 3.0e5,
+        ..WaveParams::default()
+    };
     let mut model = Waves::new(p, 0.0).unwrap();
     let h = 0.1;
     let mut snapshot = None;
