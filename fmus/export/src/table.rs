@@ -14,8 +14,8 @@
 //! * `TYPE` is `real`, `int` or `bool`. An `int` carries its inclusive range, `int(0, i32::MAX)`,
 //!   unless it is an enumeration (below), whose range is that of its codes.
 //! * `ACCESS` is one of
-//!   - a field path, `(params.angle_max)`, `(params.white_sigma[1])` or `(params.m[0][1])`: the
-//!     getter reads it and,
+//!   - a field path, `(params.angle_max)`, `(params.white_sigma[1])`, `(params.m[0][1])` or
+//!     `(params.channels[2].sigma)`: the getter reads it and,
 //!     for parameters and inputs, the setter writes it;
 //!   - a field path with a cast, `(params.seed as u64)`: the field's type differs from the FMI type;
 //!   - an enumeration, `(params.order => { 1: ServoOrder::First, 2: ServoOrder::Second })`: each
@@ -223,10 +223,10 @@ macro_rules! __access {
         }
     };
     // An enumeration: the range is that of its codes.
-    (@$mode:ident int [] [] ($($f:ident).+ $([$i:expr])* => { $($code:literal : $($variant:ident)::+),+ $(,)? })) => {
+    (@$mode:ident int [] [] ($($f:ident $([$i:expr])*).+ => { $($code:literal : $($variant:ident)::+),+ $(,)? })) => {
         $crate::Access::Integer {
-            get: $crate::__get!(i32 ($($f).+ $([$i])* => { $($code : $($variant)::+),+ })),
-            set: $crate::__access!(@setter $mode i32 ($($f).+ $([$i])* => { $($code : $($variant)::+),+ })),
+            get: $crate::__get!(i32 ($($f $([$i])*).+ => { $($code : $($variant)::+),+ })),
+            set: $crate::__access!(@setter $mode i32 ($($f $([$i])*).+ => { $($code : $($variant)::+),+ })),
             min: Some($crate::table::min_code(&[$($code),+])),
             max: Some($crate::table::max_code(&[$($code),+])),
         }
@@ -255,11 +255,11 @@ macro_rules! __access {
 macro_rules! __get {
     ($t:ident (|$m:pat_param| $get:expr, |$m2:pat_param, $v:pat_param| $set:expr)) => { |$m| $get };
     ($t:ident (|$m:pat_param| $get:expr)) => { |$m| $get };
-    ($t:ident ($($f:ident).+ $([$i:expr])* as $field:ty)) => { |m| m.$($f).+$([$i])* as $t };
-    ($t:ident ($($f:ident).+ $([$i:expr])* => { $($code:literal : $($variant:ident)::+),+ })) => {
-        |m| match m.$($f).+$([$i])* { $($($variant)::+ => $code,)+ }
+    ($t:ident ($($f:ident $([$i:expr])*).+ as $field:ty)) => { |m| m.$($f $([$i])*).+ as $t };
+    ($t:ident ($($f:ident $([$i:expr])*).+ => { $($code:literal : $($variant:ident)::+),+ })) => {
+        |m| match m.$($f $([$i])*).+ { $($($variant)::+ => $code,)+ }
     };
-    ($t:ident ($($f:ident).+ $([$i:expr])*)) => { |m| m.$($f).+$([$i])* };
+    ($t:ident ($($f:ident $([$i:expr])*).+)) => { |m| m.$($f $([$i])*).+ };
 }
 
 /// The setter of an access form, as a closure coerced to `fn(&mut M, $t)`.
@@ -270,15 +270,15 @@ macro_rules! __set {
     ($t:ident (|$m:pat_param| $get:expr)) => {
         compile_error!("a parameter or input needs a setter: write (field.path) or (|m| get, |m, v| set)")
     };
-    ($t:ident ($($f:ident).+ $([$i:expr])* as $field:ty)) => { |m, v| m.$($f).+$([$i])* = v as $field };
-    ($t:ident ($($f:ident).+ $([$i:expr])* => { $($code:literal : $($variant:ident)::+),+ })) => {
+    ($t:ident ($($f:ident $([$i:expr])*).+ as $field:ty)) => { |m, v| m.$($f $([$i])*).+ = v as $field };
+    ($t:ident ($($f:ident $([$i:expr])*).+ => { $($code:literal : $($variant:ident)::+),+ })) => {
         |m, v| {
             if let Some(x) = match v { $($code => Some($($variant)::+),)+ _ => None } {
-                m.$($f).+$([$i])* = x;
+                m.$($f $([$i])*).+ = x;
             }
         }
     };
-    ($t:ident ($($f:ident).+ $([$i:expr])*)) => { |m, v| m.$($f).+$([$i])* = v };
+    ($t:ident ($($f:ident $([$i:expr])*).+)) => { |m, v| m.$($f $([$i])*).+ = v };
 }
 
 #[doc(hidden)]

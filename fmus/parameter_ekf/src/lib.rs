@@ -62,14 +62,11 @@ fmi2_export::fmu! {
             "Nominal speed U: u' = u/U, v' = v/U, r' = r L/U, t' = t U/L (default 10 kn)";
         fixed real "shaft_speed" ["rpm"] (params.shaft_speed).min(0.0),
             "Nominal shaft speed n0: n' = n/n0 (the thesis leaves n' undefined)";
-        fixed real "m11" (|m| m.params.mass[0][0], |m, v| m.params.mass[0][0] = v),
+        fixed real "m11" (params.mass[0][0]),
             "Mass matrix m - Y_vdot (prime; default: assumed Esso Osaka value)";
-        fixed real "m12" (|m| m.params.mass[0][1], |m, v| m.params.mass[0][1] = v),
-            "Mass matrix m x_G - Y_rdot (prime)";
-        fixed real "m21" (|m| m.params.mass[1][0], |m, v| m.params.mass[1][0] = v),
-            "Mass matrix m x_G - N_vdot (prime)";
-        fixed real "m22" (|m| m.params.mass[1][1], |m, v| m.params.mass[1][1] = v),
-            "Mass matrix I_z - N_rdot (prime)";
+        fixed real "m12" (params.mass[0][1]), "Mass matrix m x_G - Y_rdot (prime)";
+        fixed real "m21" (params.mass[1][0]), "Mass matrix m x_G - N_vdot (prime)";
+        fixed real "m22" (params.mass[1][1]), "Mass matrix I_z - N_rdot (prime)";
         fixed real "rudder_sway_coefficient" (params.rudder[0]),
             "Y'_delta per rad (prime; known, not identified)";
         fixed real "rudder_yaw_coefficient" (params.rudder[1]),

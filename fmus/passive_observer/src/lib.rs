@@ -35,22 +35,17 @@ fmi2_export::fmu! {
     experiment: (0.0, 1000.0, 1.0),
     documentation: "documentation.html",
     variables: {
-        fixed real "mass_surge" ["kg"] (|m| m.params.m[0][0], |m, v| m.params.m[0][0] = v).min(0.0),
+        fixed real "mass_surge" ["kg"] (params.m[0][0]).min(0.0),
             "M11 of the observer model (Northern Clipper eq. 56; SI)";
-        fixed real "mass_sway" ["kg"] (|m| m.params.m[1][1], |m, v| m.params.m[1][1] = v).min(0.0),
+        fixed real "mass_sway" ["kg"] (params.m[1][1]).min(0.0),
             "M22 of the observer model (Northern Clipper eq. 56; SI)";
-        fixed real "inertia_yaw" (|m| m.params.m[2][2], |m, v| m.params.m[2][2] = v).min(0.0),
+        fixed real "inertia_yaw" (params.m[2][2]).min(0.0),
             "M33 of the observer model (Northern Clipper eq. 56; SI)";
-        fixed real "damping_surge" (|m| m.params.d[0][0], |m, v| m.params.d[0][0] = v),
-            "D11 of the observer model (eq. 57; SI)";
-        fixed real "damping_sway" (|m| m.params.d[1][1], |m, v| m.params.d[1][1] = v),
-            "D22 of the observer model (eq. 57; SI)";
-        fixed real "damping_sway_yaw" (|m| m.params.d[1][2], |m, v| m.params.d[1][2] = v),
-            "D23 of the observer model (eq. 57; SI)";
-        fixed real "damping_yaw_sway" (|m| m.params.d[2][1], |m, v| m.params.d[2][1] = v),
-            "D32 of the observer model (eq. 57; SI)";
-        fixed real "damping_yaw" (|m| m.params.d[2][2], |m, v| m.params.d[2][2] = v),
-            "D33 of the observer model (eq. 57; SI)";
+        fixed real "damping_surge" (params.d[0][0]), "D11 of the observer model (eq. 57; SI)";
+        fixed real "damping_sway" (params.d[1][1]), "D22 of the observer model (eq. 57; SI)";
+        fixed real "damping_sway_yaw" (params.d[1][2]), "D23 of the observer model (eq. 57; SI)";
+        fixed real "damping_yaw_sway" (params.d[2][1]), "D32 of the observer model (eq. 57; SI)";
+        fixed real "damping_yaw" (params.d[2][2]), "D33 of the observer model (eq. 57; SI)";
         tunable real "bias_time_constant_surge" ["s"] (params.t_bias[0]).min(0.0),
             "Bias time constant T (surge; eq. 58: 1000 s)";
         tunable real "bias_time_constant_sway" ["s"] (params.t_bias[1]).min(0.0),

@@ -38,73 +38,69 @@ fmi2_export::fmu! {
         tunable real "noise_scale" (params.noise_scale).min(0.0),
             "Multiplies every sigma (004 uses 1, 0.001 and 0)";
         // Four entries per channel of models::sensors::CHANNEL_NAMES, in its order.
-        tunable real "heading_sigma" ["rad"] (|m| m.params.channels[0].sigma, |m, v| m.params.channels[0].sigma = v).min(0.0),
+        tunable real "heading_sigma" ["rad"] (params.channels[0].sigma).min(0.0),
             "Per-sample standard deviation of the heading psi (default: 004 Table 3 compass, sigma' = 1.611e-3 at 0.2349 s) noise";
-        fixed real "heading_interval" ["s"] (|m| m.params.channels[0].interval, |m, v| m.params.channels[0].interval = v).min(1e-6),
+        fixed real "heading_interval" ["s"] (params.channels[0].interval).min(1e-6),
             "Sampling interval of the heading psi (default: 004 Table 3 compass, sigma' = 1.611e-3 at 0.2349 s) (samples at t0 + k interval, held)";
         input real "heading" ["rad"] (input[0]),
             "True heading psi (default: 004 Table 3 compass, sigma' = 1.611e-3 at 0.2349 s)";
         output real "heading_measured" ["rad"] (|m| m.sensors.measured(0)),
             "Measured heading psi (default: 004 Table 3 compass, sigma' = 1.611e-3 at 0.2349 s): sampled true value plus noise, zero-order hold";
-        tunable real "yaw_rate_sigma" ["rad/s"] (|m| m.params.channels[1].sigma, |m, v| m.params.channels[1].sigma = v).min(0.0),
+        tunable real "yaw_rate_sigma" ["rad/s"] (params.channels[1].sigma).min(0.0),
             "Per-sample standard deviation of the yaw rate r (default: 004 Table 3 rate gyro, 7.563e-3 U/L at 0.2349 s) noise";
-        fixed real "yaw_rate_interval" ["s"] (|m| m.params.channels[1].interval, |m, v| m.params.channels[1].interval = v).min(1e-6),
+        fixed real "yaw_rate_interval" ["s"] (params.channels[1].interval).min(1e-6),
             "Sampling interval of the yaw rate r (default: 004 Table 3 rate gyro, 7.563e-3 U/L at 0.2349 s) (samples at t0 + k interval, held)";
         input real "yaw_rate" ["rad/s"] (input[1]),
             "True yaw rate r (default: 004 Table 3 rate gyro, 7.563e-3 U/L at 0.2349 s)";
         output real "yaw_rate_measured" ["rad/s"] (|m| m.sensors.measured(1)),
             "Measured yaw rate r (default: 004 Table 3 rate gyro, 7.563e-3 U/L at 0.2349 s): sampled true value plus noise, zero-order hold";
-        tunable real "roll_sigma" ["rad"] (|m| m.params.channels[2].sigma, |m, v| m.params.channels[2].sigma = v).min(0.0),
+        tunable real "roll_sigma" ["rad"] (params.channels[2].sigma).min(0.0),
             "Per-sample standard deviation of the roll angle phi (no level in the sources: 0) noise";
-        fixed real "roll_interval" ["s"] (|m| m.params.channels[2].interval, |m, v| m.params.channels[2].interval = v).min(1e-6),
+        fixed real "roll_interval" ["s"] (params.channels[2].interval).min(1e-6),
             "Sampling interval of the roll angle phi (no level in the sources: 0) (samples at t0 + k interval, held)";
-        input real "roll" ["rad"] (input[2]),
-            "True roll angle phi (no level in the sources: 0)";
+        input real "roll" ["rad"] (input[2]), "True roll angle phi (no level in the sources: 0)";
         output real "roll_measured" ["rad"] (|m| m.sensors.measured(2)),
             "Measured roll angle phi (no level in the sources: 0): sampled true value plus noise, zero-order hold";
-        tunable real "roll_rate_sigma" ["rad/s"] (|m| m.params.channels[3].sigma, |m, v| m.params.channels[3].sigma = v).min(0.0),
+        tunable real "roll_rate_sigma" ["rad/s"] (params.channels[3].sigma).min(0.0),
             "Per-sample standard deviation of the roll rate p (no level in the sources: 0) noise";
-        fixed real "roll_rate_interval" ["s"] (|m| m.params.channels[3].interval, |m, v| m.params.channels[3].interval = v).min(1e-6),
+        fixed real "roll_rate_interval" ["s"] (params.channels[3].interval).min(1e-6),
             "Sampling interval of the roll rate p (no level in the sources: 0) (samples at t0 + k interval, held)";
         input real "roll_rate" ["rad/s"] (input[3]),
             "True roll rate p (no level in the sources: 0)";
         output real "roll_rate_measured" ["rad/s"] (|m| m.sensors.measured(3)),
             "Measured roll rate p (no level in the sources: 0): sampled true value plus noise, zero-order hold";
-        tunable real "north_sigma" ["m"] (|m| m.params.channels[4].sigma, |m, v| m.params.channels[4].sigma = v).min(0.0),
+        tunable real "north_sigma" ["m"] (params.channels[4].sigma).min(0.0),
             "Per-sample standard deviation of the north position (default: 002 DGPS, 2 m at 1 s) noise";
-        fixed real "north_interval" ["s"] (|m| m.params.channels[4].interval, |m, v| m.params.channels[4].interval = v).min(1e-6),
+        fixed real "north_interval" ["s"] (params.channels[4].interval).min(1e-6),
             "Sampling interval of the north position (default: 002 DGPS, 2 m at 1 s) (samples at t0 + k interval, held)";
-        input real "north" ["m"] (input[4]),
-            "True north position (default: 002 DGPS, 2 m at 1 s)";
+        input real "north" ["m"] (input[4]), "True north position (default: 002 DGPS, 2 m at 1 s)";
         output real "north_measured" ["m"] (|m| m.sensors.measured(4)),
             "Measured north position (default: 002 DGPS, 2 m at 1 s): sampled true value plus noise, zero-order hold";
-        tunable real "east_sigma" ["m"] (|m| m.params.channels[5].sigma, |m, v| m.params.channels[5].sigma = v).min(0.0),
+        tunable real "east_sigma" ["m"] (params.channels[5].sigma).min(0.0),
             "Per-sample standard deviation of the east position (default: 002 DGPS, 2 m at 1 s) noise";
-        fixed real "east_interval" ["s"] (|m| m.params.channels[5].interval, |m, v| m.params.channels[5].interval = v).min(1e-6),
+        fixed real "east_interval" ["s"] (params.channels[5].interval).min(1e-6),
             "Sampling interval of the east position (default: 002 DGPS, 2 m at 1 s) (samples at t0 + k interval, held)";
-        input real "east" ["m"] (input[5]),
-            "True east position (default: 002 DGPS, 2 m at 1 s)";
+        input real "east" ["m"] (input[5]), "True east position (default: 002 DGPS, 2 m at 1 s)";
         output real "east_measured" ["m"] (|m| m.sensors.measured(5)),
             "Measured east position (default: 002 DGPS, 2 m at 1 s): sampled true value plus noise, zero-order hold";
-        tunable real "cross_track_sigma" ["m"] (|m| m.params.channels[6].sigma, |m, v| m.params.channels[6].sigma = v).min(0.0),
+        tunable real "cross_track_sigma" ["m"] (params.channels[6].sigma).min(0.0),
             "Per-sample standard deviation of the cross-track offset eta (default: 004 Table 3 DECCA, 9.549e-3 L at 0.2349 s) noise";
-        fixed real "cross_track_interval" ["s"] (|m| m.params.channels[6].interval, |m, v| m.params.channels[6].interval = v).min(1e-6),
+        fixed real "cross_track_interval" ["s"] (params.channels[6].interval).min(1e-6),
             "Sampling interval of the cross-track offset eta (default: 004 Table 3 DECCA, 9.549e-3 L at 0.2349 s) (samples at t0 + k interval, held)";
         input real "cross_track" ["m"] (input[6]),
             "True cross-track offset eta (default: 004 Table 3 DECCA, 9.549e-3 L at 0.2349 s)";
         output real "cross_track_measured" ["m"] (|m| m.sensors.measured(6)),
             "Measured cross-track offset eta (default: 004 Table 3 DECCA, 9.549e-3 L at 0.2349 s): sampled true value plus noise, zero-order hold";
-        tunable real "speed_sigma" ["m/s"] (|m| m.params.channels[7].sigma, |m, v| m.params.channels[7].sigma = v).min(0.0),
+        tunable real "speed_sigma" ["m/s"] (params.channels[7].sigma).min(0.0),
             "Per-sample standard deviation of the speed (no level in the sources: 0) noise";
-        fixed real "speed_interval" ["s"] (|m| m.params.channels[7].interval, |m, v| m.params.channels[7].interval = v).min(1e-6),
+        fixed real "speed_interval" ["s"] (params.channels[7].interval).min(1e-6),
             "Sampling interval of the speed (no level in the sources: 0) (samples at t0 + k interval, held)";
-        input real "speed" ["m/s"] (input[7]),
-            "True speed (no level in the sources: 0)";
+        input real "speed" ["m/s"] (input[7]), "True speed (no level in the sources: 0)";
         output real "speed_measured" ["m/s"] (|m| m.sensors.measured(7)),
             "Measured speed (no level in the sources: 0): sampled true value plus noise, zero-order hold";
-        tunable real "sway_velocity_sigma" ["m/s"] (|m| m.params.channels[8].sigma, |m, v| m.params.channels[8].sigma = v).min(0.0),
+        tunable real "sway_velocity_sigma" ["m/s"] (params.channels[8].sigma).min(0.0),
             "Per-sample standard deviation of the sway velocity v = -U beta (default: 004 Table 3 Doppler, 1.495e-3 U at 0.2349 s) noise";
-        fixed real "sway_velocity_interval" ["s"] (|m| m.params.channels[8].interval, |m, v| m.params.channels[8].interval = v).min(1e-6),
+        fixed real "sway_velocity_interval" ["s"] (params.channels[8].interval).min(1e-6),
             "Sampling interval of the sway velocity v = -U beta (default: 004 Table 3 Doppler, 1.495e-3 U at 0.2349 s) (samples at t0 + k interval, held)";
         input real "sway_velocity" ["m/s"] (input[8]),
             "True sway velocity v = -U beta (default: 004 Table 3 Doppler, 1.495e-3 U at 0.2349 s)";
