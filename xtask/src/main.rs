@@ -7,7 +7,10 @@
 //! * `demo`: the default coupled system (see README).
 //! * `export-osp`: every system file of systems/ as target/osp/<name>/OspSystemStructure.xml
 //!   (+ scenario.json for its events) for libcosim / cosim-cli.
+//! * `artifacts DIR` / `artifacts --compare A B`: captures the model descriptions, documentation,
+//!   system CSVs and report of a commit and compares two captures byte for byte (see artifacts.rs).
 
+mod artifacts;
 mod fmu;
 
 use anyhow::{bail, Context, Result};
@@ -23,6 +26,7 @@ fn main() {
         Some("bench") => bench(&args[1..]),
         Some("report") => report(args.get(1).map(String::as_str)),
         Some("export-osp") => export_osp(),
+        Some("artifacts") => artifacts::main(&args[1..]),
         _ => {
             eprintln!(
                 "usage: cargo xtask <task>\n\n\
@@ -32,7 +36,9 @@ fn main() {
                  demo         run the default coupled system\n  \
                  report [DIR] run every coupled system and write the validation report (target/report)\n  \
                  export-osp   every system of systems/ as target/osp/<name>/OspSystemStructure.xml for libcosim\n  \
-                 bench        master overhead per FMU-step: shipsim vs libcosim vs FMPy (master/bench)"
+                 bench        master overhead per FMU-step: shipsim vs libcosim vs FMPy (master/bench)\n  \
+                 artifacts DIR          FMU model descriptions, system CSVs and report into DIR\n  \
+                 artifacts --compare A B  byte-compare two artifact folders (refactor check)"
             );
             std::process::exit(2);
         }
@@ -137,17 +143,27 @@ fn test(extra: &[String]) -> Result<()> {
 fn report(dir: Option<&str>) -> Result<()> {
     let root = workspace_root();
     let fmu_dir = fmu::build_fmus(&root)?;
-    run(cargo().current_dir(&root).args([
+    build_report(&root)?;
+    write_report(&root, &fmu_dir, &root.join(dir.unwrap_or("target/report")))
+}
+
+/// Builds the release `report` binary of system-tests.
+pub fn build_report(root: &Path) -> Result<()> {
+    run(cargo().current_dir(root).args([
         "build",
         "--release",
         "-p",
         "system-tests",
         "--bin",
         "report",
-    ]))?;
+    ]))
+}
+
+/// Runs the (built) report binary with the FMUs of `fmu_dir`, writing the report into `out`.
+pub fn write_report(root: &Path, fmu_dir: &Path, out: &Path) -> Result<()> {
     run(Command::new(root.join("target/release/report"))
-        .current_dir(&root)
-        .arg(root.join(dir.unwrap_or("target/report")))
+        .current_dir(root)
+        .arg(out)
         .env("SHIPSIM_FMU_DIR", fmu_dir))
 }
 
