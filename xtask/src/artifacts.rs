@@ -56,9 +56,10 @@ fn capture(root: &Path, dir: &Path) -> Result<()> {
     prepare_dir(dir)?;
 
     // Only the FMUs of the current crates: target/fmu may still hold archives of crates that
-    // were renamed or removed, which would hide their absence.
+    // were renamed or removed, which would hide their absence. Example FMUs (examples/, packaged
+    // into target/fmu-examples) are documentation, not product artifacts.
     let crates = fmu::fmu_crates(root)?;
-    for c in &crates {
+    for c in crates.iter().filter(|c| !c.example) {
         let id = &c.model_identifier;
         let archive = fmu_dir.join(format!("{id}.fmu"));
         let file = std::fs::File::open(&archive)
