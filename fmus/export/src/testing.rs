@@ -83,6 +83,48 @@ unsafe extern "C" fn sink(
     }
 }
 
+/// The importer's side of an instance: the callbacks it is given, with a logger (through the C
+/// proxy for the variadic `fmi2CallbackLogger`) that collects every line into a [`Log`]. It must
+/// outlive the instances that use its callbacks.
+pub struct Importer {
+    log: Box<Log>,
+    _target: Box<LogTarget>,
+    callbacks: Box<fmi2CallbackFunctions>,
+}
+
+impl Default for Importer {
+    fn default() -> Self {
+        let log = Box::new(Log::default());
+        let mut target = Box::new(LogTarget {
+            sink: Some(sink),
+            ctx: &*log as *const Log as *mut c_void,
+        });
+        let callbacks = Box::new(fmi2CallbackFunctions {
+            logger: logger_proxy(),
+            allocateMemory: None,
+            freeMemory: None,
+            stepFinished: None,
+            componentEnvironment: &mut *target as *mut LogTarget as *mut c_void,
+        });
+        Importer {
+            log,
+            _target: target,
+            callbacks,
+        }
+    }
+}
+
+impl Importer {
+    /// What the instances logged.
+    pub fn log(&self) -> &Log {
+        &self.log
+    }
+    /// The callbacks to pass to `fmi2Instantiate`.
+    pub fn callbacks(&self) -> &fmi2CallbackFunctions {
+        &self.callbacks
+    }
+}
+
 /// A value of an FMI base type that [`Harness`] can get and set.
 pub trait Value: Copy + std::fmt::Debug {
     const TYPE: BaseType;
@@ -153,27 +195,14 @@ pub struct FmuState(pub fmi2FMUstate);
 pub struct Harness<M: FmuModel> {
     f: Fmi2Functions,
     c: fmi2Component,
-    log: Box<Log>,
-    _target: Box<LogTarget>,
-    _callbacks: Box<fmi2CallbackFunctions>,
+    importer: Importer,
     _model: PhantomData<M>,
 }
 
 impl<M: FmuModel> Harness<M> {
     /// `fmi2Instantiate` with the FMU's GUID, a capturing logger and logging off.
     pub fn instantiate(functions: Fmi2Functions, name: &str) -> Self {
-        let log = Box::new(Log::default());
-        let mut target = Box::new(LogTarget {
-            sink: Some(sink),
-            ctx: &*log as *const Log as *mut c_void,
-        });
-        let callbacks = Box::new(fmi2CallbackFunctions {
-            logger: logger_proxy(),
-            allocateMemory: None,
-            freeMemory: None,
-            stepFinished: None,
-            componentEnvironment: &mut *target as *mut LogTarget as *mut c_void,
-        });
+        let importer = Importer::default();
         let cname = CString::new(name).expect("instance name without NUL");
         let guid = CString::new(crate::xml::guid::<M>()).expect("GUID without NUL");
         let c = unsafe {
@@ -182,7 +211,7 @@ impl<M: FmuModel> Harness<M> {
                 fmi2CoSimulation,
                 guid.as_ptr(),
                 null(),
-                &*callbacks,
+                importer.callbacks(),
                 fmi2False,
                 fmi2False,
             )
@@ -191,14 +220,12 @@ impl<M: FmuModel> Harness<M> {
             !c.is_null(),
             "{}: fmi2Instantiate returned NULL: {}",
             M::MODEL_IDENTIFIER,
-            log.last()
+            importer.log().last()
         );
         Harness {
             f: functions,
             c,
-            log,
-            _target: target,
-            _callbacks: callbacks,
+            importer,
             _model: PhantomData,
         }
     }
@@ -215,7 +242,7 @@ impl<M: FmuModel> Harness<M> {
 
     /// What the instance logged.
     pub fn log(&self) -> &Log {
-        &self.log
+        self.importer.log()
     }
 
     fn check(&self, what: &str, status: fmi2Status) {
@@ -225,7 +252,7 @@ impl<M: FmuModel> Harness<M> {
             "{}: {what} returned {}: {}",
             M::MODEL_IDENTIFIER,
             status_name(status),
-            self.log.last()
+            self.log().last()
         );
     }
 
@@ -332,6 +359,42 @@ impl<M: FmuModel> Harness<M> {
         let s = self.try_step(t, h);
         self.check(&format!("fmi2DoStep({t}, {h})"), s);
         self
+    }
+
+    /// Runs steps `0..n` through `step(self, k, replaying)`, which sets the inputs of step `k`,
+    /// steps, (on the first pass) compares with the model, and returns the outputs it read. The
+    /// FMU state saved before step `replay_from` is then restored and steps `replay_from..n` are
+    /// run again with `replaying = true`: their outputs must repeat bit for bit.
+    pub fn check_replay(
+        &mut self,
+        n: usize,
+        replay_from: usize,
+        mut step: impl FnMut(&mut Self, usize, bool) -> Vec<f64>,
+    ) {
+        let mut saved = None;
+        let mut recorded = Vec::new();
+        for k in 0..n {
+            if k == replay_from {
+                saved = Some(self.get_state());
+            }
+            let outputs = step(self, k, false);
+            if k >= replay_from {
+                recorded.push(outputs);
+            }
+        }
+        let saved = saved.expect("replay_from < n");
+        assert_eq!(self.set_state(saved), fmi2OK);
+        for (k, expected) in (replay_from..n).zip(&recorded) {
+            let again = step(self, k, true);
+            let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            assert_eq!(
+                bits(&again),
+                bits(expected),
+                "{}: replay of step {k}",
+                M::MODEL_IDENTIFIER
+            );
+        }
+        self.free_state(saved);
     }
 
     /// `fmi2Terminate`.

@@ -3,11 +3,11 @@
 //! The `fmi2*` symbols that `export_fmu!` emits forward one-to-one to these functions.
 
 use fmi2::*;
+use fmi2_export::testing::Importer;
 use fmi2_export::{api, xml, FmuDescription, FmuModel, Variable};
 use serde::{Deserialize, Serialize};
-use std::ffi::{c_char, c_int, c_void, CString};
+use std::ffi::{c_char, CString};
 use std::ptr::{null, null_mut};
-use std::sync::Mutex;
 
 // ---------------------------------------------------------------------------------------------
 // Test model: y' = gain * u, with a failure and a panic trigger.
@@ -124,79 +124,15 @@ const VR_UG: u32 = 8;
 const VR_POS: u32 = 9;
 
 // ---------------------------------------------------------------------------------------------
-// Importer side: callbacks and a log collector.
-
-#[derive(Default)]
-struct Log {
-    lines: Mutex<Vec<(c_int, String, String)>>,
-}
-
-impl Log {
-    fn contains(&self, needle: &str) -> bool {
-        self.lines
-            .lock()
-            .unwrap()
-            .iter()
-            .any(|(_, _, m)| m.contains(needle))
-    }
-    fn count(&self, category: &str) -> usize {
-        self.lines
-            .lock()
-            .unwrap()
-            .iter()
-            .filter(|(_, c, _)| c == category)
-            .count()
-    }
-    fn last(&self) -> String {
-        self.lines
-            .lock()
-            .unwrap()
-            .last()
-            .map(|l| l.2.clone())
-            .unwrap_or_default()
-    }
-}
-
-unsafe extern "C" fn sink(
-    ctx: *mut c_void,
-    _inst: *const c_char,
-    status: c_int,
-    cat: *const c_char,
-    msg: *const c_char,
-) {
-    let log = &*(ctx as *const Log);
-    log.lines
-        .lock()
-        .unwrap()
-        .push((status, lossy_str(cat), lossy_str(msg)));
-}
+// Importer side: callbacks and a log collector (fmi2_export::testing::Importer).
 
 /// An importer: owns the log target and callbacks that the instance points to.
-struct Host {
-    log: Box<Log>,
-    target: Box<LogTarget>,
-    callbacks: Box<fmi2CallbackFunctions>,
-}
+#[derive(Default)]
+struct Host(Importer);
 
 impl Host {
     fn new() -> Self {
-        let log = Box::new(Log::default());
-        let mut target = Box::new(LogTarget {
-            sink: Some(sink),
-            ctx: &*log as *const Log as *mut c_void,
-        });
-        let callbacks = Box::new(fmi2CallbackFunctions {
-            logger: logger_proxy(),
-            allocateMemory: None,
-            freeMemory: None,
-            stepFinished: None,
-            componentEnvironment: &mut *target as *mut LogTarget as *mut c_void,
-        });
-        Host {
-            log,
-            target,
-            callbacks,
-        }
+        Host::default()
     }
 
     fn instantiate_with<M: FmuModel>(
@@ -207,7 +143,6 @@ impl Host {
         resources: Option<&str>,
         logging_on: bool,
     ) -> fmi2Component {
-        let _ = &self.target;
         let name = CString::new(name).unwrap();
         let guid = guid.map(|g| CString::new(g).unwrap());
         let res = resources.map(|r| CString::new(r).unwrap());
@@ -217,7 +152,7 @@ impl Host {
                 kind,
                 guid.as_ref().map_or(null(), |g| g.as_ptr()),
                 res.as_ref().map_or(null(), |r| r.as_ptr()),
-                &*self.callbacks,
+                self.0.callbacks(),
                 fmi2False,
                 logging_on as fmi2Boolean,
             )
@@ -232,7 +167,7 @@ impl Host {
             Some("file:///tmp/resources"),
             false,
         );
-        assert!(!c.is_null(), "instantiate failed: {}", self.log.last());
+        assert!(!c.is_null(), "instantiate failed: {}", self.0.log().last());
         Fmu(c)
     }
 }
@@ -415,15 +350,15 @@ fn instantiate_checks_guid_type_name_and_callbacks() {
     let c =
         host.instantiate_with::<Integrator>("a", fmi2CoSimulation, Some("{wrong}"), None, false);
     assert!(c.is_null());
-    assert!(host.log.contains("wrong GUID {wrong}") && host.log.contains(&good));
+    assert!(host.0.log().contains("wrong GUID {wrong}") && host.0.log().contains(&good));
     // missing GUID
     let c = host.instantiate_with::<Integrator>("a", fmi2CoSimulation, None, None, false);
     assert!(c.is_null());
-    assert!(host.log.contains("missing GUID"));
+    assert!(host.0.log().contains("missing GUID"));
     // model exchange is not offered
     let c = host.instantiate_with::<Integrator>("a", fmi2ModelExchange, Some(&good), None, false);
     assert!(c.is_null());
-    assert!(host.log.contains("supports only fmi2CoSimulation"));
+    assert!(host.0.log().contains("supports only fmi2CoSimulation"));
     // empty instance name
     let c = host.instantiate_with::<Integrator>("", fmi2CoSimulation, Some(&good), None, false);
     assert!(c.is_null());
@@ -457,7 +392,7 @@ fn instantiate_checks_guid_type_name_and_callbacks() {
     // a NULL logger is tolerated (no logging)
     let quiet = fmi2CallbackFunctions {
         logger: None,
-        ..*host.callbacks
+        ..*host.0.callbacks()
     };
     let c = unsafe {
         api::instantiate::<Integrator>(
@@ -483,9 +418,9 @@ fn illegal_call_sequences_are_errors() {
     let illegal = |what: &str, s: fmi2Status| {
         assert_eq!(s, fmi2Error, "{what} should be illegal");
         assert!(
-            host.log.last().contains("Illegal call sequence"),
+            host.0.log().last().contains("Illegal call sequence"),
             "{what}: {}",
-            host.log.last()
+            host.0.log().last()
         );
     };
     // Instantiated
@@ -539,7 +474,11 @@ fn unsupported_functions_return_error_with_a_reason() {
         )
     };
     assert_eq!(s, fmi2Error);
-    assert!(host.log.last().contains("fmi2CancelStep is not supported"));
+    assert!(host
+        .0
+        .log()
+        .last()
+        .contains("fmi2CancelStep is not supported"));
     let mut status = 0;
     assert_eq!(
         unsafe { api::get_status::<Integrator>(fmu.0, fmi2DoStepStatus, &mut status) },
@@ -585,13 +524,18 @@ fn do_step_checks_communication_point_step_size_and_stop_time() {
     assert_eq!(fmu.exit(), fmi2OK);
     assert_eq!(fmu.step(0.0, 0.0), fmi2Error);
     assert!(host
-        .log
+        .0
+        .log()
         .last()
         .contains("communicationStepSize = 0 must be > 0"));
     assert_eq!(fmu.step(0.0, -0.1), fmi2Error);
     assert_eq!(fmu.step(0.0, f64::NAN), fmi2Error);
     assert_eq!(fmu.step(0.1, 0.1), fmi2Error);
-    assert!(host.log.last().contains("does not match the FMU's time 0"));
+    assert!(host
+        .0
+        .log()
+        .last()
+        .contains("does not match the FMU's time 0"));
     // a master computing t_k = k*h passes points that differ from t + h by rounding only
     let h = 0.1;
     for k in 0..10 {
@@ -599,12 +543,12 @@ fn do_step_checks_communication_point_step_size_and_stop_time() {
             fmu.step(k as f64 * h, h),
             fmi2OK,
             "k = {k}: {}",
-            host.log.last()
+            host.0.log().last()
         );
     }
     // 10 * 0.1 accumulated differs from 1.0 by rounding: still accepted; past stopTime is not
     assert_eq!(fmu.step(1.0, 0.1), fmi2Error);
-    assert!(host.log.last().contains("passes stopTime"));
+    assert!(host.0.log().last().contains("passes stopTime"));
     // variable step sizes are accepted (canHandleVariableCommunicationStepSize)
     let fmu2 = host.instantiate("v");
     fmu2.init();
@@ -622,30 +566,34 @@ fn values_are_validated_and_errors_name_the_variable() {
     let fmu = host.instantiate("vals");
     assert_eq!(fmu.set(VR_U, f64::NAN), fmi2Error);
     assert!(
-        host.log.last().contains("\"u\" = NaN refused"),
+        host.0.log().last().contains("\"u\" = NaN refused"),
         "{}",
-        host.log.last()
+        host.0.log().last()
     );
     assert_eq!(fmu.set(VR_GAIN, f64::INFINITY), fmi2Error);
-    assert!(host.log.last().contains("\"gain\" = inf refused"));
+    assert!(host.0.log().last().contains("\"gain\" = inf refused"));
     assert_eq!(fmu.set(VR_Y, 1.0), fmi2Error);
     assert!(host
-        .log
+        .0
+        .log()
         .last()
         .contains("\"y\" has causality Output and cannot be set"));
     assert_eq!(fmu.set(99, 1.0), fmi2Error);
     assert!(host
-        .log
+        .0
+        .log()
         .last()
         .contains("no variable with value reference 99"));
     assert_eq!(fmu.set(VR_MODE, 1.0), fmi2Error);
     assert!(host
-        .log
+        .0
+        .log()
         .last()
         .contains("is Integer \"mode\", not a Real variable"));
     assert_eq!(fmu.set_int(VR_MODE, 7), fmi2Error);
     assert!(host
-        .log
+        .0
+        .log()
         .last()
         .contains("\"mode\" = 7 refused: outside [1, 3]"));
     assert_eq!(fmu.set_int(VR_MODE, 3), fmi2OK);
@@ -667,14 +615,15 @@ fn values_are_validated_and_errors_name_the_variable() {
     // fixed parameters are frozen after initialization; tunable ones are not
     assert_eq!(fmu.set(VR_OFFSET, 1.0), fmi2Error);
     assert!(host
-        .log
+        .0
+        .log()
         .last()
         .contains("fixed parameter \"offset\" cannot be changed"));
     assert_eq!(fmu.set_int(VR_MODE, 2), fmi2Error);
     assert_eq!(fmu.set(VR_GAIN, 3.0), fmi2OK);
     // a tunable change the model refuses is reported and rolled back
     assert_eq!(fmu.set(VR_GAIN, 1000.0), fmi2Error);
-    assert!(host.log.last().contains("gain = 1000 must be <= 100"));
+    assert!(host.0.log().last().contains("gain = 1000 must be <= 100"));
     assert_eq!(fmu.get(VR_GAIN), 3.0);
     // direct feedthrough output reflects a new input before the next step
     assert_eq!(fmu.set(VR_U, 5.0), fmi2OK);
@@ -711,7 +660,8 @@ fn invalid_parameters_fail_initialization_with_the_name() {
     assert_eq!(fmu.enter(), fmi2OK);
     assert_eq!(fmu.exit(), fmi2Error);
     assert!(host
-        .log
+        .0
+        .log()
         .last()
         .contains("parameter gain = 500 must be <= 100"));
     assert_eq!(fmu.step(0.0, 0.1), fmi2Error);
@@ -730,11 +680,12 @@ fn a_panic_in_the_model_is_an_error_status_not_an_abort() {
     let before = fmu.get_state();
     assert_eq!(fmu.step(0.4, 0.2), fmi2Error);
     assert!(host
-        .log
+        .0
+        .log()
         .contains("internal error (panic: deliberate panic at t = 0.4)"));
     // the instance is in the Error state: stepping is refused, reading is allowed
     assert_eq!(fmu.step(0.4, 0.2), fmi2Error);
-    assert!(host.log.last().contains("not allowed in state Error"));
+    assert!(host.0.log().last().contains("not allowed in state Error"));
     assert_eq!(fmu.get_reals(&[VR_Y]).0, fmi2OK);
     // rollback to a state before the failure recovers the instance
     assert_eq!(fmu.set_state(before), fmi2OK);
@@ -747,7 +698,8 @@ fn a_panic_in_the_model_is_an_error_status_not_an_abort() {
     fmu.init();
     assert_eq!(fmu.step(0.0, 0.1), fmi2Error);
     assert!(host
-        .log
+        .0
+        .log()
         .last()
         .contains("fmi2DoStep at t = 0, h = 0.1: instance \"failing\": deliberate failure"));
     assert_eq!(fmu.reset(), fmi2OK);
@@ -814,11 +766,12 @@ fn fmu_state_restores_bit_for_bit_and_serializes() {
     bad[0] ^= 0xff;
     assert_eq!(other.deserialize(&bad).0, fmi2Error);
     assert!(host
-        .log
+        .0
+        .log()
         .last()
         .contains("not a serialized state of this Integrator"));
     assert_eq!(other.deserialize(&bytes[..bytes.len() - 3]).0, fmi2Error);
-    assert!(host.log.last().contains("corrupt state"));
+    assert!(host.0.log().last().contains("corrupt state"));
     assert_eq!(other.deserialize(&[]).0, fmi2Error);
     // a state made by another model type is refused
     let other_model = host.instantiate_with::<Other>(
@@ -834,7 +787,11 @@ fn fmu_state_restores_bit_for_bit_and_serializes() {
         fmi2OK
     );
     assert_eq!(fmu.set_state(foreign), fmi2Error);
-    assert!(host.log.last().contains("was not created by Integrator"));
+    assert!(host
+        .0
+        .log()
+        .last()
+        .contains("was not created by Integrator"));
     assert_eq!(
         unsafe { api::free_fmu_state::<Other>(other_model, &mut foreign) },
         fmi2OK
@@ -867,8 +824,8 @@ fn debug_logging_filters_categories_and_escapes_percent() {
     let fmu = host.instantiate("log");
     // loggingOn = false: no call or event logging, errors still reported
     fmu.init();
-    assert_eq!(host.log.count("logCalls"), 0);
-    assert_eq!(host.log.count("logEvents"), 0);
+    assert_eq!(host.0.log().count("logCalls"), 0);
+    assert_eq!(host.0.log().count("logEvents"), 0);
     let cats = [CString::new("logCalls").unwrap()];
     let ptrs: Vec<fmi2String> = cats.iter().map(|c| c.as_ptr()).collect();
     assert_eq!(
@@ -876,23 +833,23 @@ fn debug_logging_filters_categories_and_escapes_percent() {
         fmi2OK
     );
     assert_eq!(fmu.step(0.0, 0.1), fmi2OK);
-    assert!(host.log.count("logCalls") >= 1);
-    assert_eq!(host.log.count("logEvents"), 0);
+    assert!(host.0.log().count("logCalls") >= 1);
+    assert_eq!(host.0.log().count("logEvents"), 0);
     // all categories off: even errors are silent
     assert_eq!(
         unsafe { api::set_debug_logging::<Integrator>(fmu.0, fmi2False, 0, null()) },
         fmi2OK
     );
-    let n = host.log.lines.lock().unwrap().len();
+    let n = host.0.log().lines().len();
     assert_eq!(fmu.set(VR_U, f64::NAN), fmi2Error);
-    assert_eq!(host.log.lines.lock().unwrap().len(), n);
+    assert_eq!(host.0.log().lines().len(), n);
     // all on: events are logged
     assert_eq!(
         unsafe { api::set_debug_logging::<Integrator>(fmu.0, fmi2True, 0, null()) },
         fmi2OK
     );
     assert_eq!(fmu.terminate(), fmi2OK);
-    assert!(host.log.count("logEvents") >= 1);
+    assert!(host.0.log().count("logEvents") >= 1);
     // an unknown category is an error; its name (with printf directives) arrives verbatim
     let cats = [CString::new("log%s%d%n").unwrap()];
     let ptrs: Vec<fmi2String> = cats.iter().map(|c| c.as_ptr()).collect();
@@ -901,7 +858,8 @@ fn debug_logging_filters_categories_and_escapes_percent() {
         fmi2Error
     );
     assert!(host
-        .log
+        .0
+        .log()
         .last()
         .contains("unknown log category \"log%s%d%n\""));
 }
