@@ -61,3 +61,26 @@ macro_rules! loop_shaping_common {
         )
     };
 }
+
+/// The prime-system time base and the four measured path-model states of the Parsons-Cuong
+/// (1980) estimators (PathEstimator, PathWlsEstimator): `ship_length`, `ship_speed` (parameters)
+/// and the inputs `heading`, `yaw_rate`, `drift_angle`, `cross_track` from the fields
+/// `ship_length`, `ship_speed` and `z[0..4]` of the model.
+#[macro_export]
+macro_rules! path_measurements {
+    (@fragment [$model:ty] [$($done:tt)*] () $($rest:tt)*) => {
+        $crate::__variables!(@[$model] [$($done)*]
+            fixed real "ship_length" ["m"] (ship_length).min(0.0),
+                "Ship length L of the prime system (290 m)";
+            fixed real "ship_speed" ["m/s"] (ship_speed).min(0.0),
+                "Ship speed U of the prime system (12 kn)";
+            input real "heading" ["rad"] (z[0]),
+                "Measured heading psi relative to the track direction";
+            input real "yaw_rate" ["rad/s"] (z[1]), "Measured yaw rate r";
+            input real "drift_angle" ["rad"] (z[2]),
+                "Measured drift angle beta (Doppler sonar, v = -U beta)";
+            input real "cross_track" ["m"] (z[3]), "Measured lateral offset eta";
+            $($rest)*
+        )
+    };
+}

@@ -81,15 +81,7 @@ fmi2_export::fmu! {
         fixed real "p0_f25" (p.p0[2]).min(0.0), "Initial variance of f25 (eq. 117: 0.02568)";
         fixed bool "b14_derived" (p.b14_derived),
             "Use B14 = B41 = dt sigma1^2 derived from eq. 88 instead of the printed 0 of eq. 104";
-        fixed real "ship_length" ["m"] (ship_length).min(0.0),
-            "Ship length L of the prime system (290 m)";
-        fixed real "ship_speed" ["m/s"] (ship_speed).min(0.0),
-            "Ship speed U of the prime system (12 kn)";
-        input real "heading" ["rad"] (z[0]), "Measured heading psi relative to the track direction";
-        input real "yaw_rate" ["rad/s"] (z[1]), "Measured yaw rate r";
-        input real "drift_angle" ["rad"] (z[2]),
-            "Measured drift angle beta (Doppler sonar, v = -U beta)";
-        input real "cross_track" ["m"] (z[3]), "Measured lateral offset eta";
+        path_measurements!();
         input real "rudder_angle" ["rad"] (rudder), "Rudder angle delta (known exactly)";
         output real "f22_estimate" (|m| m.mve.estimate()[0]), "Estimate of f22";
         output real "f23_estimate" (|m| m.mve.estimate()[1]), "Estimate of f23";

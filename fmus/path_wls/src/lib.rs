@@ -109,16 +109,8 @@ fmi2_export::fmu! {
         fixed real "r_cross_track" (r[3]).min(0.0), "PSD r_jj of eta' (Table 9: 5.0651e-9)";
         fixed int(10, 1_000_000) "max_evaluations" (max_evaluations),
             "Largest number of cost evaluations per fit (Levenberg-Marquardt with a forward-difference Jacobian)";
-        fixed real "ship_length" ["m"] (ship_length).min(0.0),
-            "Ship length L of the prime system (290 m)";
-        fixed real "ship_speed" ["m/s"] (ship_speed).min(0.0),
-            "Ship speed U of the prime system (12 kn)";
-        // ---- inputs (12..21)
-        input real "heading" ["rad"] (z[0]), "Measured heading psi relative to the track direction";
-        input real "yaw_rate" ["rad/s"] (z[1]), "Measured yaw rate r";
-        input real "drift_angle" ["rad"] (z[2]),
-            "Measured drift angle beta (Doppler sonar, v = -U beta)";
-        input real "cross_track" ["m"] (z[3]), "Measured lateral offset eta";
+        // ship_length, ship_speed, then the inputs (12..21)
+        path_measurements!();
         input real "rudder_angle" ["rad"] (rudder),
             "Rudder angle delta (known exactly), sampled with the states";
         input real "heading_estimate" ["rad"] (xhat[0]),
