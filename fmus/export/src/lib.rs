@@ -1,9 +1,13 @@
 //! FMI 2.0 co-simulation export layer.
 //!
 //! One generic implementation of the whole FMI 2.0 common + co-simulation C API (FMI 2.0.4
-//! sections 2.1 and 4) over the [`FmuModel`] trait. An FMU crate is a model type, its variable
-//! table and one line: `fmi2_export::export_fmu!(MyModel);`, which emits the 34 unprefixed
-//! `fmi2*` symbols (plus two generator symbols used by `cargo xtask build-fmus`).
+//! sections 2.1 and 4) over the [`FmuModel`] trait. An FMU crate is a model type, one
+//! [`fmu!`] definition (identifier, default experiment, documentation and the variable table of
+//! [`table`], from which the get/set dispatch, `modelDescription.xml` and the HTML documentation
+//! all come) and an `impl FmuModel` with its behaviour. [`fmu!`] emits the 34 unprefixed `fmi2*`
+//! symbols of [`fmi2::fmi2_functions!`] (plus two generator symbols used by
+//! `cargo xtask build-fmus`). [`testing`] drives an FMU through those symbols by variable name;
+//! `docs/ADDING_AN_FMU.md` walks through a new FMU.
 //!
 //! What the layer guarantees, for every FMU (spec `fmi_ecosystem.md` §2.4, modelled on the
 //! Modelica Reference FMUs' `fmi2Functions.c`):

@@ -1,5 +1,5 @@
 //! The declarative FMU definition: [`fmu!`](crate::fmu) (header, variable table, C API) and the
-//! variable-table language of [`variables!`](crate::variables).
+//! variable-table language of [`variables!`](macro@crate::variables).
 //!
 //! A variable is one entry, usually two lines:
 //!
