@@ -2,7 +2,7 @@
 //! co-simulation), written out once. Everything else is generated from [`fmi2_functions!`]:
 //! the `fmi2XxxTYPE` function-pointer types, the [`Fmi2Functions`] table the importer fills from
 //! a shared library, [`FUNCTION_NAMES`], the `extern "C"` declarations of
-//! [`declare_fmi2_functions!`] and, in `fmi2-export`, the exported symbols of an FMU.
+//! [`declare_fmi2_functions!`](crate::declare_fmi2_functions) and, in `fmi2-export`, the exported symbols of an FMU.
 
 /// Calls `$callback! { $($extra)* ; <the list> }` with one entry per FMI 2.0 function, in the
 /// order of the standard's header:
@@ -102,7 +102,7 @@ macro_rules! define_abi {
 pub(crate) use define_abi;
 
 /// Declares the 34 FMI 2.0 co-simulation functions as `extern "C"` items and defines
-/// `linked_fmi2_functions()`, which returns them as an [`Fmi2Functions`] table: for tests that call
+/// `linked_fmi2_functions()`, which returns them as an [`Fmi2Functions`](crate::Fmi2Functions) table: for tests that call
 /// the symbols an FMU crate exports (linked from its rlib) exactly as a C importer would.
 /// Use once at module level: `fmi2::declare_fmi2_functions!();`.
 #[macro_export]
