@@ -34,8 +34,9 @@ impl DpControllerFmu {
     }
 }
 
-/// The inputs the commanded forces depend on directly.
-const TAU_DEPS: &[&str] = &[
+/// The inputs the commanded forces depend on directly: every input, in the order eta, nu,
+/// setpoint.
+pub const TAU_DEPS: &[&str] = &[
     "north_estimate",
     "east_estimate",
     "heading_estimate",

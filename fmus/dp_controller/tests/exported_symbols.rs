@@ -7,17 +7,7 @@ use models::controllers::dp::{DpController, DpInputs, DpParams};
 fmi2_export::fmu_tests!(dp_controller_fmu::DpControllerFmu);
 
 /// The inputs in the order eta, nu, setpoint.
-const INPUTS: [&str; 9] = [
-    "north_estimate",
-    "east_estimate",
-    "heading_estimate",
-    "surge_velocity_estimate",
-    "sway_velocity_estimate",
-    "yaw_rate_estimate",
-    "north_setpoint",
-    "east_setpoint",
-    "heading_setpoint",
-];
+const INPUTS: &[&str] = dp_controller_fmu::TAU_DEPS;
 const OUTPUTS: [&str; 3] = ["tau_surge", "tau_sway", "tau_yaw"];
 
 #[test]
