@@ -67,11 +67,10 @@ fn capture(root: &Path, dir: &Path) -> Result<()> {
         let mut zip =
             zip::ZipArchive::new(file).with_context(|| format!("reading {}", archive.display()))?;
         let out = dir.join("fmu").join(id);
+        // Compared as written: the exporter writes no generationDateAndTime, and the tool version
+        // in generationTool is the workspace version (also in the text the GUID hashes).
         let xml = zip_entry(&mut zip, "modelDescription.xml", &archive)?;
-        write(
-            &out.join("modelDescription.xml"),
-            &normalize_model_description(&xml),
-        )?;
+        write(&out.join("modelDescription.xml"), &xml)?;
         let html = zip_entry(&mut zip, "documentation/index.html", &archive)?;
         write(&out.join("documentation/index.html"), &html)?;
     }
@@ -101,26 +100,6 @@ fn capture(root: &Path, dir: &Path) -> Result<()> {
         started.elapsed().as_secs_f64()
     );
     Ok(())
-}
-
-/// The XML as compared. The exporter (fmus/export/src/xml.rs) writes no
-/// `generationDateAndTime`, and the version in `generationTool="ship-control fmi2-export X"` is
-/// the workspace package version, fixed by Cargo.toml rather than by the build (it is also the
-/// `version` attribute and part of the text the GUID hashes, so blanking it alone could not hide a
-/// version bump anyway). So nothing is blanked; a `generationDateAndTime`, should the exporter
-/// ever write one, is blanked since it changes on every build.
-fn normalize_model_description(xml: &[u8]) -> Vec<u8> {
-    const ATTR: &[u8] = b"generationDateAndTime=\"";
-    let Some(start) = xml.windows(ATTR.len()).position(|w| w == ATTR) else {
-        return xml.to_vec();
-    };
-    let value = start + ATTR.len();
-    let Some(len) = xml[value..].iter().position(|&b| b == b'"') else {
-        return xml.to_vec();
-    };
-    let mut out = xml[..value].to_vec();
-    out.extend_from_slice(&xml[value + len..]);
-    out
 }
 
 fn zip_entry(

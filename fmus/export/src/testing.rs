@@ -571,16 +571,20 @@ pub fn check_every_variable<M: FmuModel>(functions: Fmi2Functions) {
                 let x = h.get::<f64>(v.name);
                 assert!(!x.is_nan(), "{}: {} is NaN", M::MODEL_IDENTIFIER, v.name);
             }
-            BaseType::Integer => drop(h.get::<i32>(v.name)),
-            BaseType::Boolean => drop(h.get::<bool>(v.name)),
+            BaseType::Integer => {
+                h.get::<i32>(v.name);
+            }
+            BaseType::Boolean => {
+                h.get::<bool>(v.name);
+            }
         }
     }
     for v in M::variables().iter().filter(step_mode) {
         match &v.access {
-            Access::Real { get, .. } => drop(h.set(v.name, get(&default))),
-            Access::Integer { get, .. } => drop(h.set(v.name, get(&default))),
-            Access::Boolean { get, .. } => drop(h.set(v.name, get(&default))),
-        }
+            Access::Real { get, .. } => h.set(v.name, get(&default)),
+            Access::Integer { get, .. } => h.set(v.name, get(&default)),
+            Access::Boolean { get, .. } => h.set(v.name, get(&default)),
+        };
     }
     let de = M::DEFAULT_EXPERIMENT;
     h.step(de.start_time, de.step_size);

@@ -244,10 +244,37 @@ pub fn base_unit_names() -> &'static [&'static str; 8] {
     &BASE_NAMES
 }
 
+/// Largest Integer range whose every value [`check_table`] writes and reads back.
+const ENUMERABLE: i64 = 64;
+
+/// For a settable Integer with a small declared range (an enumeration or a code): the first value
+/// of the range that, written into a default model, does not read back. `fmi2SetInteger` accepts
+/// every value of the range, so such a value would be accepted and silently lost.
+fn unwritable_code<M: Clone>(default: &M, access: &Access<M>) -> Option<i32> {
+    let Access::Integer {
+        get,
+        set: Some(set),
+        min: Some(lo),
+        max: Some(hi),
+    } = access
+    else {
+        return None;
+    };
+    if i64::from(*hi) - i64::from(*lo) >= ENUMERABLE {
+        return None;
+    }
+    (*lo..=*hi).find(|&code| {
+        let mut m = default.clone();
+        set(&mut m, code);
+        get(&m) != code
+    })
+}
+
 /// Checks a variable table for the rules the XML and the C API rely on: unique legal names,
 /// settable causalities have setters, units are in the registry, legal
-/// causality/variability combinations. Returns every problem found.
-pub fn check_table<M: Default>(vars: &[Variable<M>]) -> Result<(), Vec<String>> {
+/// causality/variability combinations, start values finite and in range, every code of a small
+/// Integer range writable. Returns every problem found.
+pub fn check_table<M: Default + Clone>(vars: &[Variable<M>]) -> Result<(), Vec<String>> {
     let mut problems = Vec::new();
     let default = M::default();
     for (i, v) in vars.iter().enumerate() {
@@ -340,6 +367,13 @@ pub fn check_table<M: Default>(vars: &[Variable<M>]) -> Result<(), Vec<String>> 
                     ));
                 }
             }
+        }
+        if let Some(code) = unwritable_code(&default, &v.access) {
+            problems.push(format!(
+                "variable {}: {code} lies in the declared range but does not read back \
+                 (an enumeration with a gap, or a setter that drops it)",
+                v.name
+            ));
         }
     }
     if problems.is_empty() {

@@ -987,6 +987,15 @@ fn the_table_language_declares_enumerations_casts_paths_and_fragments() {
         fmu.reals(&["x", "y", "sum", "heading"]),
         [2.0, 2.0, 2.5, 4.0]
     );
+    // an enumeration with a gap: code 2 passes the range check but no variant takes it
+    let gap: &[Variable<Table>] = fmi2_export::variables!(Table;
+        fixed int "order" (order => { 1: Order::First, 3: Order::Second }), "gapped";
+    );
+    let problems = fmi2_export::variables::check_table(gap).unwrap_err();
+    assert!(
+        problems[0].contains("order: 2 lies in the declared range"),
+        "{problems:?}"
+    );
     check_every_variable::<Table>(functions::<Table>());
     check_state_rollback::<Table>(functions::<Table>());
     check_every_variable::<Integrator>(functions::<Integrator>());

@@ -29,13 +29,13 @@ use crate::hull::tokyo_maru::{TokyoMaruCoefficients, T_R};
 use nalgebra::{DMatrix, SMatrix};
 use serde::{Deserialize, Serialize};
 
-/// Number of states of the design model: [ψ′, r′, β′, η′, δ′, N′, Y′].
 /// SI measurements [ψ rad, r rad/s, β rad, η m] in the prime system [ψ′, r′ = rL/U, β′, η′ = η/L]
 /// (ship length `length` m, speed `speed` m/s), the state order of the estimators' eq. (75).
 pub fn states_prime(si: &[f64; 4], length: f64, speed: f64) -> [f64; 4] {
     [si[0], si[1] * length / speed, si[2], si[3] / length]
 }
 
+/// Number of states of the design model: [ψ′, r′, β′, η′, δ′, N′, Y′].
 pub const NX: usize = 7;
 /// Number of measurements: [ψ′, r′, η′].
 pub const NZ: usize = 3;
