@@ -85,8 +85,8 @@ pub fn inspect(path: &Path) -> Result<String> {
     let _ = writeln!(s, "variables ({}):", vars.len());
     let _ = writeln!(
         s,
-        "  {:<28} {:>5} {:<11} {:<19} {:<10} {:<10} {:<12} {}",
-        "name", "vr", "type", "causality", "variab.", "initial", "start", "unit"
+        "  {:<28} {:>5} {:<11} {:<19} {:<10} {:<10} {:<12} unit",
+        "name", "vr", "type", "causality", "variab.", "initial", "start"
     );
     for v in vars {
         let unit = md.real_unit(v).unwrap_or("");

@@ -1,29 +1,38 @@
-//! `shipsim`: an FMI 2.0 co-simulation master (see DESIGN.md, "Master").
+//! `shipsim`: an FMI 2.0 co-simulation master for ship-control systems.
 //!
-//! - [`fmu`]: FMU import (unzip, modelDescription, libloading, all symbols resolved once).
-//! - [`instance`]: a safe slave instance whose lifecycle is enforced by types.
-//! - [`model_description`]: typed `modelDescription.xml`.
-//! - [`inspect`]: human-readable FMU summary (`shipsim inspect`).
-//! - [`system`]: the TOML system description, validation into a [`system::Plan`].
-//! - [`osp`]: OSP `OspSystemStructure.xml` read and write (libcosim's format).
-//! - [`plot`]: PNG time-series plots of recorded CSVs (`shipsim plot`).
-//! - [`master`]: Jacobi / Gauss-Seidel fixed-step multi-rate master, events, CSV recorder.
+//! The crate in layers (docs/ARCHITECTURE.md walks a run through them):
 //!
-//! Tests: `master/tests/*.rs` (C test FMU compiled at test time, our FMUs from
+//! - **Importer** (the only FFI): [`fmu`] unzips an FMU, reads its model description and
+//!   resolves every symbol once; [`instance`] is a slave instance whose FMI lifecycle is
+//!   enforced by types; [`model_description`] is the typed `modelDescription.xml`.
+//! - **System**: [`system`] is the format-neutral system and its validation into a
+//!   [`system::Plan`]; [`format`] holds the file formats that read into it (native TOML, OSP
+//!   `OspSystemStructure.xml`) and write out of it (OSP).
+//! - **Master**: [`run`] executes a plan: exchange, recorders, Jacobi and Gauss-Seidel, the
+//!   step loop.
+//! - **Tools**: [`inspect`] (an FMU summary), [`plot`] (PNG plots of recorded CSVs).
+//!
+//! The library holds no process-wide state (no signal handlers, no global logger): it is
+//! loaded into other processes (Python, Dask workers). The `shipsim` binary (`main.rs`) is the
+//! command line and installs those itself.
+//!
+//! Tests: `master/tests/*.rs` (a C test FMU compiled at test time, our FMUs from
 //! `$SHIPSIM_FMU_DIR`), `tests/python/test_master_*.py` (PythonFMU, crane-fmu, libcosim);
 //! benchmark: `master/bench/bench_master.py`.
 
 // `k % m == 0` reads as the time-grid rule; `is_multiple_of` needs a newer Rust than our MSRV.
 #![allow(unknown_lints, clippy::manual_is_multiple_of)]
+// `!(x > 0.0)` is the check that also rejects NaN, which `x <= 0.0` would let through.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod error;
 pub mod fmu;
+pub mod format;
 pub mod inspect;
 pub mod instance;
-pub mod master;
 pub mod model_description;
-pub mod osp;
 pub mod plot;
+pub mod run;
 pub mod system;
 
 pub use error::{Error, Result};

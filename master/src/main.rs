@@ -2,13 +2,14 @@
 use clap::{Parser, Subcommand};
 use shipsim::error::Error;
 use shipsim::fmu::UnpackedFmu;
-use shipsim::master::{run_system, Output, RunOptions};
-use shipsim::system::System;
+use shipsim::run::{prepare, run, Output, RunOptions};
+use shipsim::system::{Algorithm, System};
 use std::io::IsTerminal;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
+use std::time::Instant;
 
 #[derive(Parser)]
 #[command(
@@ -108,73 +109,12 @@ fn dispatch(cmd: Command) -> shipsim::Result<()> {
             scale,
             title,
             output,
-        } => {
-            let table = shipsim::plot::Table::read(&csv)?;
-            let mut out = Vec::new();
-            for spec in &panels {
-                let (label, cols) = spec.split_once('=').ok_or_else(|| {
-                    Error::Other(format!("--panel {spec:?}: expected LABEL=COL[,COL...]"))
-                })?;
-                let mut series = Vec::new();
-                for col in cols.split(',').map(str::trim).filter(|c| !c.is_empty()) {
-                    series.push(shipsim::plot::Series {
-                        label: col.to_string(),
-                        t: table.time().to_vec(),
-                        y: table.column(col)?.iter().map(|v| v * scale).collect(),
-                    });
-                }
-                out.push(shipsim::plot::Panel {
-                    y_label: label.to_string(),
-                    series,
-                });
-            }
-            let title = title.unwrap_or_else(|| csv.display().to_string());
-            shipsim::plot::plot_panels(&output, &title, &out)?;
-            println!("wrote {}", output.display());
-            Ok(())
-        }
+        } => plot(&csv, &panels, scale, title, &output),
         Command::Inspect { fmu } => {
             print!("{}", shipsim::inspect::inspect(&fmu)?);
             Ok(())
         }
-        Command::Check { system, set } => {
-            let mut sys = System::load(&system)?;
-            sys.apply_overrides(&set)?;
-            let mut unpacked = Vec::new();
-            for inst in &sys.instances {
-                if !inst.fmu.exists() {
-                    return Err(Error::system(
-                        &sys.source,
-                        inst.line,
-                        format!(
-                            "instance '{}': FMU file '{}' not found",
-                            inst.name,
-                            inst.fmu.display()
-                        ),
-                    ));
-                }
-                let u = UnpackedFmu::open(&inst.fmu)?;
-                u.binary_path()?;
-                unpacked.push(u);
-            }
-            let mds: Vec<_> = unpacked.iter().map(|u| &u.model_description).collect();
-            let plan = sys.validate(&mds)?;
-            for w in &plan.warnings {
-                eprintln!("warning: {w}");
-            }
-            println!(
-                "{}: OK ({} instances, {} connections, {} events, {} recorded variables, {} steps of {} s, {:?})",
-                system.display(),
-                plan.instances.len(),
-                plan.connections.len(),
-                plan.events.len(),
-                plan.outputs.len(),
-                plan.n_steps,
-                plan.step_size,
-                plan.algorithm
-            );
-            Ok(())
-        }
+        Command::Check { system, set } => check(&system, &set),
         Command::Run {
             system,
             stop_time,
@@ -190,59 +130,138 @@ fn dispatch(cmd: Command) -> shipsim::Result<()> {
                 sys.stop_time = Some(t);
             }
             if let Some(a) = algorithm {
-                sys.algorithm = match a.to_lowercase().as_str() {
-                    "jacobi" => shipsim::system::Algorithm::Jacobi,
-                    "gauss-seidel" | "gauss_seidel" | "gaussseidel" => {
-                        shipsim::system::Algorithm::GaussSeidel
-                    }
-                    _ => {
-                        return Err(Error::Other(format!(
-                            "--algorithm {a}: use jacobi or gauss-seidel"
-                        )))
-                    }
-                };
+                sys.algorithm = parse_algorithm(&a)?;
             }
-            let out_file = output.or_else(|| sys.output.file.clone());
-            let out = match &out_file {
-                Some(p) => Output::File(p.clone()),
-                None => Output::None,
-            };
-            let flag = Arc::new(AtomicBool::new(false));
-            {
-                let f = flag.clone();
-                // A second Ctrl-C while shutting down falls back to the default behaviour.
-                let _ = ctrlc::set_handler(move || {
-                    if f.swap(true, Ordering::SeqCst) {
-                        std::process::exit(130);
-                    }
-                });
-            }
-            let opts = RunOptions {
-                verbose,
-                progress: !quiet && std::io::stderr().is_terminal(),
-                interrupt: Some(flag),
-                log_sink: None,
-            };
-            let (_plan, summary) = run_system(&sys, out, &opts)?;
-            if !quiet {
-                eprintln!("{summary}");
-            }
-            Ok(())
+            run_cli(&sys, output, verbose, quiet)
         }
-        Command::ExportOsp { system, output } => {
-            let sys = System::load(&system)?;
-            let out = output.unwrap_or_else(|| {
-                system
-                    .parent()
-                    .unwrap_or(std::path::Path::new("."))
-                    .join("OspSystemStructure.xml")
-            });
-            let warnings = shipsim::osp::write(&sys, &out)?;
-            for w in warnings {
-                eprintln!("warning: {w}");
-            }
-            eprintln!("wrote {}", out.display());
-            Ok(())
-        }
+        Command::ExportOsp { system, output } => export_osp(&system, output),
     }
+}
+
+/// `shipsim plot`: one panel per --panel, columns against time.
+fn plot(
+    csv: &Path,
+    panels: &[String],
+    scale: f64,
+    title: Option<String>,
+    output: &Path,
+) -> shipsim::Result<()> {
+    let table = shipsim::plot::Table::read(csv)?;
+    let mut out = Vec::new();
+    for spec in panels {
+        let (label, cols) = spec.split_once('=').ok_or_else(|| {
+            Error::Other(format!("--panel {spec:?}: expected LABEL=COL[,COL...]"))
+        })?;
+        let mut series = Vec::new();
+        for col in cols.split(',').map(str::trim).filter(|c| !c.is_empty()) {
+            series.push(shipsim::plot::Series {
+                label: col.to_string(),
+                t: table.time().to_vec(),
+                y: table.column(col)?.iter().map(|v| v * scale).collect(),
+            });
+        }
+        out.push(shipsim::plot::Panel {
+            y_label: label.to_string(),
+            series,
+        });
+    }
+    let title = title.unwrap_or_else(|| csv.display().to_string());
+    shipsim::plot::plot_panels(output, &title, &out)?;
+    println!("wrote {}", output.display());
+    Ok(())
+}
+
+fn print_warnings(warnings: &[String]) {
+    for w in warnings {
+        eprintln!("warning: {w}");
+    }
+}
+
+/// `shipsim check`: the system validated against the FMUs' model descriptions (binaries are
+/// not loaded).
+fn check(system: &Path, set: &[String]) -> shipsim::Result<()> {
+    let mut sys = System::load(system)?;
+    sys.apply_overrides(set)?;
+    let mut unpacked = Vec::new();
+    for inst in &sys.instances {
+        sys.require_fmu(inst)?;
+        let u = UnpackedFmu::open(&inst.fmu)?;
+        u.binary_path()?;
+        unpacked.push(u);
+    }
+    let mds: Vec<_> = unpacked.iter().map(|u| &u.model_description).collect();
+    let plan = sys.validate(&mds)?;
+    print_warnings(&plan.warnings);
+    println!(
+        "{}: OK ({} instances, {} connections, {} events, {} recorded variables, {} steps of {} s, {:?})",
+        system.display(),
+        plan.instances.len(),
+        plan.connections.len(),
+        plan.events.len(),
+        plan.outputs.len(),
+        plan.n_steps,
+        plan.step_size,
+        plan.algorithm
+    );
+    Ok(())
+}
+
+fn parse_algorithm(a: &str) -> shipsim::Result<Algorithm> {
+    match a.to_lowercase().as_str() {
+        "jacobi" => Ok(Algorithm::Jacobi),
+        "gauss-seidel" | "gauss_seidel" | "gaussseidel" => Ok(Algorithm::GaussSeidel),
+        _ => Err(Error::Other(format!(
+            "--algorithm {a}: use jacobi or gauss-seidel"
+        ))),
+    }
+}
+
+/// `shipsim run`: Ctrl-C stops the run cleanly (a second one exits at once); warnings, then
+/// the run, then its summary on stderr.
+fn run_cli(sys: &System, output: Option<PathBuf>, verbose: bool, quiet: bool) -> shipsim::Result<()> {
+    let begin = Instant::now();
+    let out_file = output.or_else(|| sys.output.file.clone());
+    let out = match &out_file {
+        Some(p) => Output::File(p.clone()),
+        None => Output::None,
+    };
+    let flag = Arc::new(AtomicBool::new(false));
+    {
+        let f = flag.clone();
+        // A second Ctrl-C while shutting down falls back to the default behaviour.
+        let _ = ctrlc::set_handler(move || {
+            if f.swap(true, Ordering::SeqCst) {
+                std::process::exit(130);
+            }
+        });
+    }
+    let opts = RunOptions {
+        verbose,
+        progress: !quiet && std::io::stderr().is_terminal(),
+        interrupt: Some(flag),
+        log_sink: None,
+    };
+    let (plan, fmus) = prepare(sys)?;
+    print_warnings(&plan.warnings);
+    let mut summary = run(&plan, &fmus, out, &opts)?;
+    summary.total_wall_time = begin.elapsed();
+    if !quiet {
+        eprintln!("{summary}");
+    }
+    Ok(())
+}
+
+/// `shipsim export-osp`: OspSystemStructure.xml (and scenario.json for events).
+fn export_osp(system: &Path, output: Option<PathBuf>) -> shipsim::Result<()> {
+    let sys = System::load(system)?;
+    let out = output.unwrap_or_else(|| {
+        system
+            .parent()
+            .unwrap_or(Path::new("."))
+            .join("OspSystemStructure.xml")
+    });
+    let warnings = shipsim::format::osp::write(&sys, &out)?;
+    print_warnings(&warnings);
+    eprintln!("wrote {}", out.display());
+    Ok(())
 }

@@ -2,7 +2,7 @@
 //! panic. Test FMUs are compiled from tests/c/testfmu.c at test time.
 mod common;
 use common::*;
-use shipsim::master::{run_system, Output, RunOptions};
+use shipsim::run::{run_system, Output, RunOptions};
 use shipsim::system::System;
 use shipsim::{Error, Fmu};
 use std::process::Command;

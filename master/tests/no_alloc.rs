@@ -1,8 +1,9 @@
 //! The step loop allocates nothing: the number of heap allocations of a run does not depend on
-//! the number of steps (connections, recording into a writer, multi-rate, both algorithms).
+//! the number of steps (connections, recording into a writer or into memory, multi-rate, both
+//! algorithms).
 mod common;
 use common::*;
-use shipsim::master::{load_fmus, run, Output, RunOptions};
+use shipsim::run::{load_fmus, run, run_with, MemoryRecorder, Output, RunOptions};
 use shipsim::system::System;
 use std::alloc::{GlobalAlloc, Layout, System as SysAlloc};
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -61,7 +62,7 @@ value = 2.0
         let mut sys = System::load(&p).unwrap();
         let fmus = load_fmus(&sys).unwrap();
         let mds: Vec<_> = fmus.iter().map(|f| &f.model_description).collect();
-        let mut counts = Vec::new();
+        let (mut counts, mut memory_counts) = (Vec::new(), Vec::new());
         for stop in [1.0, 100.0] {
             sys.stop_time = Some(stop);
             let plan = sys.validate(&mds).unwrap();
@@ -75,10 +76,20 @@ value = 2.0
             .unwrap();
             counts.push(ALLOCS.load(Ordering::SeqCst) - before);
             assert_eq!(s.macro_steps, (stop * 1000.0) as u64);
+            let mut memory = MemoryRecorder::new();
+            let before = ALLOCS.load(Ordering::SeqCst);
+            let s = run_with(&plan, &fmus, Some(&mut memory), &RunOptions::default()).unwrap();
+            memory_counts.push(ALLOCS.load(Ordering::SeqCst) - before);
+            assert_eq!(memory.time.len() as u64, s.rows);
+            assert_eq!(s.rows, s.macro_steps + 1);
         }
         assert_eq!(
             counts[0], counts[1],
             "{algo}: allocations for 1e3 vs 1e5 steps: {counts:?}"
+        );
+        assert_eq!(
+            memory_counts[0], memory_counts[1],
+            "{algo}, in memory: allocations for 1e3 vs 1e5 steps: {memory_counts:?}"
         );
     }
 }

@@ -2,7 +2,7 @@
 //! Fails, never skips, when they have not been built.
 mod common;
 use common::*;
-use shipsim::master::{run_system, Output, RunOptions};
+use shipsim::run::{run_system, Output, RunOptions};
 use shipsim::system::System;
 
 #[test]

@@ -3,12 +3,12 @@
 mod common;
 use common::*;
 use shipsim::instance::LogRecord;
-use shipsim::master::{run_system, Output, RunOptions};
+use shipsim::run::{run_system, Output, RunOptions};
 use shipsim::system::System;
 use std::process::Command;
 use std::sync::{Arc, Mutex};
 
-fn run_file(path: &std::path::Path, out: &std::path::Path) -> shipsim::master::Summary {
+fn run_file(path: &std::path::Path, out: &std::path::Path) -> shipsim::run::Summary {
     let s = System::load(path).unwrap();
     run_system(&s, Output::File(out.to_path_buf()), &RunOptions::default())
         .unwrap()

@@ -11,7 +11,7 @@ Tolerance 0: the runs are bit-identical. (They were not while shipsim handed the
 h itself while libcosim hands its nanosecond clock's t_k and fl(t_k+1) - fl(t_k): the ship's state
 then differed by one ulp from t = 0.3 s, and the closed loop carried it to 2e-10 in the bias
 estimate J M J^T b_hat, a difference of 1e7-sized terms. shipsim now keeps libcosim's clock,
-master/src/master.rs TimeGrid.)
+master/src/run/time_grid.rs, TimeGrid.)
 
 Environment: SHIPSIM_BIN (the master), SHIPSIM_FMU_DIR (our built FMUs).
 """

@@ -68,7 +68,7 @@ MAX_STEPS = 6000
 # Tolerance of assert_same_as_libcosim (|shipsim - libcosim| <= tol * max(1, |libcosim|) at every
 # recorded step): 0, the runs are bit-identical. libcosim keeps time in integer nanoseconds and
 # calls fmi2DoStep with t_k = (t0_ns + k h_ns)/1e9 and the step size fl(t_k+1) - fl(t_k) (its
-# to_double_duration); shipsim uses the same clock (master/src/master.rs, TimeGrid). Before it
+# to_double_duration); shipsim uses the same clock (master/src/run/time_grid.rs, TimeGrid). Before it
 # did (t0 + k*h and h itself) the runs differed by ulps from the third step of h = 0.05 on
 # (0.15 - 0.1 = 0.04999999999999999), which integration and feedback carried up to 4e-12
 # relative (autopilot_track_offset) and 2e-10 (dp_observer). Empty: no system needs an exception.
@@ -216,7 +216,7 @@ def test_system_equals_libcosim(system, tmp_path, monkeypatch):
     toml, spec = localise(system, tmp_path)
     if spec["simulation"].get("algorithm", "jacobi") != "jacobi":
         # Not exportable with the same results: OSP's fixedStep algorithm is Jacobi-type, and
-        # `export-osp` does not carry the Gauss-Seidel order (master/src/osp.rs).
+        # `export-osp` does not carry the Gauss-Seidel order (master/src/format/osp.rs).
         pytest.skip(f"{system}: algorithm {spec['simulation']['algorithm']!r} cannot be expressed in "
                     "OspSystemStructure.xml (libcosim fixedStep is Jacobi)")
     start = time.perf_counter()

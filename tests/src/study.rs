@@ -8,7 +8,7 @@
 //!
 //! A study is `fn(&Env) -> Result<Report, String>`; register it in [`crate::studies::STUDIES`].
 
-use shipsim::master::{run_system, Output, RunOptions};
+use shipsim::run::{run_system, Output, RunOptions};
 use shipsim::plot::{plot_panels, Panel, Series, Table};
 use shipsim::system::System;
 use std::fmt::Write as _;

@@ -116,6 +116,7 @@ fn test(extra: &[String]) -> Result<()> {
         "xtask",
         "--bins",
     ]))?;
+    lint_master(&root)?;
     eprintln!("xtask: Rust tests (release, sharing the FMU build)");
     run(cargo()
         .current_dir(&root)
@@ -136,6 +137,27 @@ fn test(extra: &[String]) -> Result<()> {
         started.elapsed().as_secs_f64()
     );
     Ok(())
+}
+
+/// The master's function-length rule: no function in `master/src` over 100 lines
+/// (`master/clippy.toml`), so that each concern stays readable in one screen.
+fn lint_master(root: &Path) -> Result<()> {
+    let clippy = cargo().arg("clippy").arg("--version").output();
+    if !clippy.map(|o| o.status.success()).unwrap_or(false) {
+        bail!("cargo clippy is not installed; install it with `rustup component add clippy`");
+    }
+    eprintln!("xtask: clippy too_many_lines (100) on master/src");
+    run(cargo().current_dir(root).args([
+        "clippy",
+        "--release",
+        "-p",
+        "shipsim",
+        "--lib",
+        "--bins",
+        "--",
+        "-D",
+        "clippy::too_many_lines",
+    ]))
 }
 
 /// Runs every study of tests/src/studies and writes `<dir>/README.md` with figures (default

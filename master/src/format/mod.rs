@@ -1,0 +1,45 @@
+//! System file formats. Each reader turns a file into the format-neutral
+//! [`System`](crate::system::System); the writer turns one back into a file another tool runs.
+//!
+//! - [`toml`]: shipsim's native system file (read).
+//! - [`osp`]: OSP `OspSystemStructure.xml`, libcosim's format (read and write).
+//!
+//! The readers depend on [`crate::system`]; `system` depends on no reader.
+
+use crate::error::{Error, Result};
+use crate::system::System;
+use std::path::Path;
+
+pub mod osp;
+pub mod toml;
+
+impl System {
+    /// Reads a system file: `.xml` is OSP `OspSystemStructure.xml`, anything else TOML.
+    pub fn load(path: &Path) -> Result<System> {
+        let is_xml = path
+            .extension()
+            .map(|e| e.eq_ignore_ascii_case("xml"))
+            .unwrap_or(false);
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| Error::system(path, None, format!("cannot read: {e}")))?;
+        if is_xml {
+            osp::parse(path, &text)
+        } else {
+            toml::parse(path, &text)
+        }
+    }
+}
+
+/// 1-based line of a byte offset.
+pub fn line_of(text: &str, offset: usize) -> usize {
+    text[..offset.min(text.len())].matches('\n').count() + 1
+}
+
+/// The errors a reader collected, as one error (or `Ok` when there are none).
+pub(crate) fn collected(mut errors: Vec<Error>) -> Result<()> {
+    match errors.len() {
+        0 => Ok(()),
+        1 => Err(errors.pop().unwrap()),
+        _ => Err(Error::Many(errors)),
+    }
+}

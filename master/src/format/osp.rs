@@ -1,0 +1,685 @@
+//! OSP `OspSystemStructure.xml` (the libcosim system format, schema version 0.1 as embedded in
+//! libcosim): read into a [`System`] and write from one, so the same system runs in libcosim.
+//!
+//! Mapping: `StartTime`/`EndTime`/`BaseStepSize` -> simulation times; `Simulator@stepSize` ->
+//! step multiple (stepSize / BaseStepSize, an integer); `InitialValues` -> parameters/start
+//! values; `VariableConnection` -> connection (direction from the variables' causalities);
+//! a `LinearTransformation` function between two `SignalConnection`s -> a connection with gain
+//! (`factor`) and `offset`. Events and outputs have no place in this file; `export-osp` says so.
+
+
+use super::{collected, line_of};
+use crate::error::{Error, Result};
+use crate::model_description::{Causality, ModelDescription};
+use crate::system::{
+    Algorithm, ConnectionSpec, InstanceSpec, OutputSpec, Plan, PlanConnection, System,
+    TypedValue, Value, ValueSpec, VarRef,
+};
+use serde::Deserialize;
+use std::collections::HashMap;
+use std::fmt::Write as _;
+use std::path::{Component, Path, PathBuf};
+
+#[derive(Deserialize)]
+struct Root {
+    #[serde(rename = "StartTime", default)]
+    start_time: Option<f64>,
+    #[serde(rename = "EndTime", default)]
+    end_time: Option<f64>,
+    #[serde(rename = "BaseStepSize", default)]
+    base_step_size: Option<f64>,
+    #[serde(rename = "Algorithm", default)]
+    algorithm: Option<String>,
+    #[serde(rename = "Simulators")]
+    simulators: Simulators,
+    #[serde(rename = "Functions", default)]
+    functions: Option<Functions>,
+    #[serde(rename = "Connections", default)]
+    connections: Option<Connections>,
+}
+
+#[derive(Deserialize, Default)]
+struct Simulators {
+    #[serde(rename = "Simulator", default)]
+    list: Vec<Simulator>,
+}
+
+#[derive(Deserialize)]
+struct Simulator {
+    #[serde(rename = "@name")]
+    name: String,
+    #[serde(rename = "@source")]
+    source: String,
+    #[serde(rename = "@stepSize", default)]
+    step_size: Option<f64>,
+    #[serde(rename = "InitialValues", default)]
+    initial_values: Option<InitialValues>,
+}
+
+#[derive(Deserialize, Default)]
+struct InitialValues {
+    #[serde(rename = "InitialValue", default)]
+    list: Vec<InitialValue>,
+}
+
+#[derive(Deserialize)]
+struct InitialValue {
+    #[serde(rename = "@variable")]
+    variable: String,
+    #[serde(rename = "Real", default)]
+    real: Option<ValueAttr<f64>>,
+    #[serde(rename = "Integer", default)]
+    integer: Option<ValueAttr<i64>>,
+    #[serde(rename = "Boolean", default)]
+    boolean: Option<ValueAttr<bool>>,
+    #[serde(rename = "String", default)]
+    string: Option<ValueAttr<String>>,
+}
+
+#[derive(Deserialize)]
+struct ValueAttr<T> {
+    #[serde(rename = "@value")]
+    value: T,
+}
+
+#[derive(Deserialize, Default)]
+struct Functions {
+    #[serde(rename = "LinearTransformation", default)]
+    linear: Vec<LinearTransformation>,
+    #[serde(rename = "Sum", default)]
+    sum: Vec<Named>,
+    #[serde(rename = "VectorSum", default)]
+    vector_sum: Vec<Named>,
+}
+
+#[derive(Deserialize)]
+struct LinearTransformation {
+    #[serde(rename = "@name")]
+    name: String,
+    #[serde(rename = "@factor", default)]
+    factor: Option<f64>,
+    #[serde(rename = "@offset", default)]
+    offset: Option<f64>,
+}
+
+#[derive(Deserialize)]
+struct Named {
+    #[serde(rename = "@name")]
+    name: String,
+}
+
+#[derive(Deserialize, Default)]
+struct Connections {
+    #[serde(rename = "$value", default)]
+    list: Vec<Connection>,
+}
+
+// The variants are the OSP element names.
+#[allow(clippy::enum_variant_names)]
+#[derive(Deserialize)]
+enum Connection {
+    VariableConnection {
+        #[serde(rename = "Variable", default)]
+        variables: Vec<Endpoint>,
+    },
+    SignalConnection {
+        #[serde(rename = "Variable")]
+        variable: Endpoint,
+        #[serde(rename = "Signal")]
+        signal: SignalEndpoint,
+    },
+    VariableGroupConnection {},
+    SignalGroupConnection {},
+}
+
+#[derive(Deserialize, Clone)]
+struct Endpoint {
+    #[serde(rename = "@simulator")]
+    simulator: String,
+    #[serde(rename = "@name")]
+    name: String,
+}
+
+#[derive(Deserialize)]
+struct SignalEndpoint {
+    #[serde(rename = "@function")]
+    function: String,
+    #[serde(rename = "@name")]
+    name: String,
+}
+
+
+/// Line of the first occurrence of `needle` (OSP errors point at the element when they can).
+fn line_of_needle(text: &str, needle: &str) -> Option<usize> {
+    text.find(needle).map(|p| line_of(text, p))
+}
+
+/// One reading of an `OspSystemStructure.xml`.
+struct Reader<'t> {
+    path: &'t Path,
+    text: &'t str,
+    errors: Vec<Error>,
+}
+
+/// Reads an `OspSystemStructure.xml`.
+pub fn parse(path: &Path, text: &str) -> Result<System> {
+    let root: Root = quick_xml::de::from_str(text).map_err(|e| {
+        Error::system(
+            path,
+            None,
+            format!("not a valid OspSystemStructure.xml: {e}"),
+        )
+    })?;
+    let dir = path.parent().unwrap_or(Path::new("."));
+    let h = root.base_step_size.unwrap_or(0.01);
+    let mut r = Reader {
+        path,
+        text,
+        errors: Vec::new(),
+    };
+    let algorithm = r.algorithm(root.algorithm.as_deref());
+    let instances = root
+        .simulators
+        .list
+        .into_iter()
+        .map(|s| r.simulator(s, dir, h))
+        .collect();
+    let functions = root.functions.unwrap_or_default();
+    let linear = r.linear_transformations(&functions);
+    let connections = r.connections(root.connections.map(|c| c.list), &linear);
+    collected(r.errors)?;
+    Ok(System {
+        source: path.to_path_buf(),
+        start_time: root.start_time.unwrap_or(0.0),
+        stop_time: root.end_time,
+        step_size: h,
+        algorithm,
+        instances,
+        connections,
+        events: Vec::new(),
+        output: OutputSpec {
+            file: None,
+            variables: None,
+            decimation: 1,
+        },
+    })
+}
+
+/// A LinearTransformation's endpoints: its "in" variable and its "out" variables.
+#[derive(Default)]
+struct Signals {
+    input: HashMap<String, Endpoint>,
+    outputs: HashMap<String, Vec<Endpoint>>,
+}
+
+fn var_ref(e: &Endpoint) -> VarRef {
+    VarRef {
+        instance: e.simulator.clone(),
+        variable: e.name.clone(),
+    }
+}
+
+impl Reader<'_> {
+    fn error(&mut self, line: Option<usize>, message: impl Into<String>) {
+        self.errors.push(Error::system(self.path, line, message));
+    }
+
+    fn line_of(&self, needle: &str) -> Option<usize> {
+        line_of_needle(self.text, needle)
+    }
+
+    fn algorithm(&mut self, a: Option<&str>) -> Algorithm {
+        match a.map(str::trim) {
+            None | Some("fixedStep") => Algorithm::Jacobi,
+            Some(other) => {
+                let line = self.line_of("<Algorithm");
+                self.error(
+                    line,
+                    format!(
+                        "Algorithm '{other}' is not supported; shipsim runs 'fixedStep' (Jacobi)"
+                    ),
+                );
+                Algorithm::Jacobi
+            }
+        }
+    }
+
+    /// A Simulator: its step multiple (stepSize / BaseStepSize) and initial values.
+    fn simulator(&mut self, s: Simulator, dir: &Path, h: f64) -> InstanceSpec {
+        let line = self.line_of(&format!("name=\"{}\"", s.name));
+        let m = match s.step_size {
+            None => 1,
+            Some(ss) => {
+                let r = ss / h;
+                let m = r.round();
+                if m < 1.0 || (r - m).abs() > 1e-6 * r.max(1.0) {
+                    self.error(
+                        line,
+                        format!(
+                            "simulator '{}': stepSize {ss} is not a positive integer multiple of BaseStepSize {h}",
+                            s.name
+                        ),
+                    );
+                    1
+                } else {
+                    m as u32
+                }
+            }
+        };
+        let values = s
+            .initial_values
+            .map(|x| x.list)
+            .unwrap_or_default()
+            .into_iter()
+            .filter_map(|iv| self.initial_value(&s.name, iv))
+            .collect();
+        let source = s.source.strip_prefix("file://").unwrap_or(&s.source);
+        InstanceSpec {
+            fmu: dir.join(source),
+            name: s.name,
+            step_multiple: m,
+            values,
+            line,
+        }
+    }
+
+    fn initial_value(&mut self, simulator: &str, iv: InitialValue) -> Option<ValueSpec> {
+        let line = self.line_of(&format!("variable=\"{}\"", iv.variable));
+        let value = if let Some(v) = iv.real {
+            Value::Real(v.value)
+        } else if let Some(v) = iv.integer {
+            Value::Integer(v.value)
+        } else if let Some(v) = iv.boolean {
+            Value::Boolean(v.value)
+        } else if let Some(v) = iv.string {
+            Value::String(v.value)
+        } else {
+            self.error(
+                line,
+                format!(
+                    "simulator '{simulator}', InitialValue '{}': no Real/Integer/Boolean/String value",
+                    iv.variable
+                ),
+            );
+            return None;
+        };
+        Some(ValueSpec {
+            line,
+            variable: iv.variable,
+            value,
+        })
+    }
+
+    /// LinearTransformation functions by name: (factor, offset). Sum/VectorSum are errors.
+    fn linear_transformations(&mut self, functions: &Functions) -> HashMap<String, (f64, f64)> {
+        for f in functions.sum.iter().chain(functions.vector_sum.iter()) {
+            let line = self.line_of(&format!("name=\"{}\"", f.name));
+            self.error(
+                line,
+                format!(
+                    "function '{}': Sum/VectorSum functions are not supported",
+                    f.name
+                ),
+            );
+        }
+        functions
+            .linear
+            .iter()
+            .map(|f| {
+                (
+                    f.name.clone(),
+                    (f.factor.unwrap_or(1.0), f.offset.unwrap_or(0.0)),
+                )
+            })
+            .collect()
+    }
+
+    /// VariableConnections as they come, then one connection per LinearTransformation output
+    /// (functions in name order), with the function's factor and offset.
+    fn connections(
+        &mut self,
+        list: Option<Vec<Connection>>,
+        linear: &HashMap<String, (f64, f64)>,
+    ) -> Vec<ConnectionSpec> {
+        let mut connections = Vec::new();
+        let mut signals = Signals::default();
+        for c in list.unwrap_or_default() {
+            match c {
+                Connection::VariableConnection { variables } => {
+                    connections.extend(self.variable_connection(&variables));
+                }
+                Connection::SignalConnection { variable, signal } => {
+                    self.signal_connection(variable, signal, linear, &mut signals);
+                }
+                Connection::VariableGroupConnection {} | Connection::SignalGroupConnection {} => {
+                    self.error(
+                        None,
+                        "VariableGroupConnection/SignalGroupConnection (OSP-IS variable groups) are not supported",
+                    );
+                }
+            }
+        }
+        let mut fnames: Vec<&String> = linear.keys().collect();
+        fnames.sort();
+        for f in fnames {
+            connections.extend(self.transformed(f, linear[f], &signals));
+        }
+        connections
+    }
+
+    fn variable_connection(&mut self, variables: &[Endpoint]) -> Option<ConnectionSpec> {
+        if variables.len() != 2 {
+            self.error(
+                None,
+                "VariableConnection must have exactly two Variable elements",
+            );
+            return None;
+        }
+        let line = self.line_of(&format!(
+            "name=\"{}\"",
+            variables[1].name.replace('"', "&quot;")
+        ));
+        Some(ConnectionSpec {
+            from: var_ref(&variables[0]),
+            to: var_ref(&variables[1]),
+            gain: 1.0,
+            offset: 0.0,
+            line,
+            either_direction: true,
+            convert: false,
+        })
+    }
+
+    fn signal_connection(
+        &mut self,
+        variable: Endpoint,
+        signal: SignalEndpoint,
+        linear: &HashMap<String, (f64, f64)>,
+        signals: &mut Signals,
+    ) {
+        if !linear.contains_key(&signal.function) {
+            let line = self.line_of(&format!("function=\"{}\"", signal.function));
+            self.error(
+                line,
+                format!(
+                    "SignalConnection refers to unknown function '{}'",
+                    signal.function
+                ),
+            );
+            return;
+        }
+        match signal.name.as_str() {
+            "in" => {
+                signals.input.insert(signal.function, variable);
+            }
+            "out" => signals
+                .outputs
+                .entry(signal.function)
+                .or_default()
+                .push(variable),
+            other => self.error(
+                None,
+                format!(
+                    "function '{}': unknown signal '{other}' (LinearTransformation has 'in' and 'out')",
+                    signal.function
+                ),
+            ),
+        }
+    }
+
+    /// The connections through LinearTransformation `f`: one per "out".
+    fn transformed(
+        &mut self,
+        f: &str,
+        (gain, offset): (f64, f64),
+        signals: &Signals,
+    ) -> Vec<ConnectionSpec> {
+        let (Some(src), Some(dsts)) = (signals.input.get(f), signals.outputs.get(f)) else {
+            let line = self.line_of(&format!("name=\"{f}\""));
+            self.error(
+                line,
+                format!("LinearTransformation '{f}' needs one 'in' and at least one 'out' SignalConnection"),
+            );
+            return Vec::new();
+        };
+        let line = self.line_of(&format!("function=\"{f}\""));
+        dsts.iter()
+            .map(|d| ConnectionSpec {
+                from: var_ref(src),
+                to: var_ref(d),
+                gain,
+                offset,
+                line,
+                either_direction: false,
+                // a LinearTransformation may map one quantity onto another
+                convert: gain != 1.0 || offset != 0.0,
+            })
+            .collect()
+    }
+}
+
+fn esc(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+        .replace('"', "&quot;")
+}
+
+/// `target` relative to directory `base` (both made absolute), with forward slashes.
+fn relative(target: &Path, base: &Path) -> String {
+    let abs = |p: &Path| {
+        let p = if p.is_absolute() {
+            p.to_path_buf()
+        } else {
+            std::env::current_dir().unwrap_or_default().join(p)
+        };
+        p.canonicalize().unwrap_or(p)
+    };
+    let (t, b) = (abs(target), abs(base));
+    let target_parts: Vec<Component> = t.components().collect();
+    let base_parts: Vec<Component> = b.components().collect();
+    let common = target_parts
+        .iter()
+        .zip(&base_parts)
+        .take_while(|(a, b)| a == b)
+        .count();
+    let mut out = PathBuf::new();
+    for _ in common..base_parts.len() {
+        out.push("..");
+    }
+    for c in &target_parts[common..] {
+        out.push(c.as_os_str());
+    }
+    out.to_string_lossy().replace('\\', "/")
+}
+
+/// Writes `OspSystemStructure.xml` for a system; returns warnings about what OSP cannot carry.
+/// The system is validated first (FMU model descriptions are read, binaries are not loaded), so
+/// initial values get the element (`Real`/`Integer`/...) of the variable's FMI type. Events go
+/// into a libcosim scenario file `scenario.json` beside it.
+pub fn write(sys: &System, out: &Path) -> Result<Vec<String>> {
+    let unpacked = sys.unpack_fmus()?;
+    let mds: Vec<_> = unpacked.iter().map(|u| &u.model_description).collect();
+    let plan = sys.validate(&mds)?;
+    let scenario_path = out.with_file_name("scenario.json");
+    let warnings = lost_in_export(sys, &scenario_path);
+    let base = out.parent().unwrap_or(Path::new("."));
+    let base = if base.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        base
+    };
+    let mut x = String::new();
+    x.push_str("<?xml version=\"1.0\" encoding=\"utf-8\"?>\n");
+    x.push_str("<!-- written by shipsim export-osp -->\n");
+    x.push_str("<OspSystemStructure xmlns=\"http://opensimulationplatform.com/MSMI/OSPSystemStructure\" version=\"0.1\">\n");
+    let _ = writeln!(x, "    <StartTime>{:?}</StartTime>", sys.start_time);
+    let _ = writeln!(x, "    <EndTime>{:?}</EndTime>", plan.stop_time);
+    let _ = writeln!(x, "    <BaseStepSize>{:?}</BaseStepSize>", sys.step_size);
+    x.push_str("    <Algorithm>fixedStep</Algorithm>\n");
+    write_simulators(&mut x, sys, &plan, base);
+    write_functions(&mut x, &plan.connections);
+    write_connections(&mut x, sys, &plan.connections, &mds);
+    x.push_str("</OspSystemStructure>\n");
+    if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir)
+            .map_err(|e| Error::io(format!("creating {}", dir.display()), e))?;
+    }
+    std::fs::write(out, x).map_err(|e| Error::io(format!("writing {}", out.display()), e))?;
+    if !plan.events.is_empty() {
+        std::fs::write(&scenario_path, scenario_json(sys, &plan))
+            .map_err(|e| Error::io(format!("writing {}", scenario_path.display()), e))?;
+    }
+    Ok(warnings)
+}
+
+/// What `OspSystemStructure.xml` cannot carry, as warnings.
+fn lost_in_export(sys: &System, scenario_path: &Path) -> Vec<String> {
+    let mut warnings = Vec::new();
+    if sys.algorithm == Algorithm::GaussSeidel {
+        warnings.push("libcosim's fixedStep algorithm is Jacobi-type; the Gauss-Seidel setting is not carried over".to_string());
+    }
+    if !sys.events.is_empty() {
+        warnings.push(format!(
+            "{} scenario event(s) are not part of OspSystemStructure.xml: written to {} (libcosim \
+             scenario: `cosim run --scenario`, libcosimpy `CosimExecution.load_scenario`)",
+            sys.events.len(),
+            scenario_path.display()
+        ));
+    }
+    if sys.output.file.is_some() || sys.output.variables.is_some() {
+        warnings.push("output settings are not part of OspSystemStructure.xml".to_string());
+    }
+    warnings
+}
+
+/// `<Simulators>`: source relative to the output folder, stepSize, typed initial values.
+fn write_simulators(x: &mut String, sys: &System, plan: &Plan, base: &Path) {
+    x.push_str("    <Simulators>\n");
+    for (i, inst) in sys.instances.iter().enumerate() {
+        let _ = write!(
+            x,
+            "        <Simulator name=\"{}\" source=\"{}\" stepSize=\"{:?}\"",
+            esc(&inst.name),
+            esc(&relative(&inst.fmu, base)),
+            inst.step_multiple as f64 * sys.step_size
+        );
+        let svs = &plan.instances[i].start_values;
+        if svs.is_empty() {
+            x.push_str("/>\n");
+            continue;
+        }
+        x.push_str(">\n            <InitialValues>\n");
+        for sv in svs {
+            let (el, v) = match &sv.value {
+                TypedValue::Real(v) => ("Real", format!("{v:?}")),
+                TypedValue::Integer(v) => ("Integer", v.to_string()),
+                TypedValue::Boolean(v) => ("Boolean", v.to_string()),
+                TypedValue::String(v) => ("String", esc(v)),
+            };
+            let _ = writeln!(
+                x,
+                "                <InitialValue variable=\"{}\"><{el} value=\"{v}\"/></InitialValue>",
+                esc(&sv.variable)
+            );
+        }
+        x.push_str("            </InitialValues>\n        </Simulator>\n");
+    }
+    x.push_str("    </Simulators>\n");
+}
+
+fn is_transformed(c: &PlanConnection) -> bool {
+    c.gain != 1.0 || c.offset != 0.0
+}
+
+/// `<Functions>`: one LinearTransformation `lt<k>` per connection k with a gain or offset.
+fn write_functions(x: &mut String, connections: &[PlanConnection]) {
+    let transformed: Vec<_> = connections
+        .iter()
+        .enumerate()
+        .filter(|(_, c)| is_transformed(c))
+        .collect();
+    if transformed.is_empty() {
+        return;
+    }
+    x.push_str("    <Functions>\n");
+    for (k, c) in &transformed {
+        let _ = writeln!(
+            x,
+            "        <LinearTransformation name=\"lt{k}\" factor=\"{:?}\" offset=\"{:?}\"/>",
+            c.gain, c.offset
+        );
+    }
+    x.push_str("    </Functions>\n");
+}
+
+/// `<Connections>`: a VariableConnection, or two SignalConnections through `lt<k>`.
+fn write_connections(
+    x: &mut String,
+    sys: &System,
+    connections: &[PlanConnection],
+    mds: &[&ModelDescription],
+) {
+    if connections.is_empty() {
+        return;
+    }
+    x.push_str("    <Connections>\n");
+    let var_name = |inst: usize, vr: u32, input: bool| -> String {
+        mds[inst]
+            .model_variables
+            .variables
+            .iter()
+            .find(|v| v.value_reference == vr && (v.causality == Causality::Input) == input)
+            .map(|v| v.name.clone())
+            .unwrap_or_default()
+    };
+    for (k, c) in connections.iter().enumerate() {
+        let fname = esc(&var_name(c.from_instance, c.from_vr, false));
+        let tname = esc(&var_name(c.to_instance, c.to_vr, true));
+        let fi = esc(&sys.instances[c.from_instance].name);
+        let ti = esc(&sys.instances[c.to_instance].name);
+        if is_transformed(c) {
+            let _ = writeln!(x, "        <SignalConnection>\n            <Variable simulator=\"{fi}\" name=\"{fname}\"/>\n            <Signal function=\"lt{k}\" name=\"in\"/>\n        </SignalConnection>");
+            let _ = writeln!(x, "        <SignalConnection>\n            <Signal function=\"lt{k}\" name=\"out\"/>\n            <Variable simulator=\"{ti}\" name=\"{tname}\"/>\n        </SignalConnection>");
+        } else {
+            let _ = writeln!(x, "        <VariableConnection>\n            <Variable simulator=\"{fi}\" name=\"{fname}\" causality=\"output\"/>\n            <Variable simulator=\"{ti}\" name=\"{tname}\" causality=\"input\"/>\n        </VariableConnection>");
+        }
+    }
+    x.push_str("    </Connections>\n");
+}
+
+/// The system's events as a libcosim scenario (JSON): each event an "override" of the variable at
+/// its time relative to the start, and "end" = the run's end. Without "end" libcosim ends the
+/// scenario after its last event and resets the overridden variables (a variable with an initial
+/// value falls back to it), unlike shipsim, where a set value stays.
+fn scenario_json(sys: &System, plan: &Plan) -> String {
+    use serde_json::{json, Value};
+    let events: Vec<Value> = plan
+        .events
+        .iter()
+        .map(|e| {
+            let (inst, var) = e.name.split_once('.').unwrap_or(("", e.name.as_str()));
+            let value = match &e.value {
+                TypedValue::Real(v) => json!(v),
+                TypedValue::Integer(v) => json!(v),
+                TypedValue::Boolean(v) => json!(v),
+                TypedValue::String(v) => json!(v),
+            };
+            json!({
+                "time": e.step as f64 * plan.step_size,
+                "model": inst,
+                "variable": var,
+                "action": "override",
+                "value": value,
+            })
+        })
+        .collect();
+    let scenario = json!({
+        "description": format!("events of {}, written by shipsim export-osp", sys.source.display()),
+        "events": events,
+        "end": plan.stop_time - plan.start_time,
+    });
+    let mut text = serde_json::to_string_pretty(&scenario).unwrap_or_default();
+    text.push('\n');
+    text
+}

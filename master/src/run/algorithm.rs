@@ -1,0 +1,143 @@
+//! Master algorithms: how the instances of a macro step exchange values and step.
+//!
+//! An [`Algorithm`] does two things: one round of the initial exchange (instances in
+//! Initialization Mode, repeated once per instance so that initial values propagate along
+//! chains, as libcosim does), and one macro step from t_k to t_(k+1). The step loop
+//! ([`super::stepping`]) is generic over it, so the choice costs nothing per step.
+//!
+//! - [`Jacobi`]: every instance that steps at k takes its inputs from the outputs published at
+//!   the last communication point; an instance's outputs are published when its own step ends
+//!   (k + m_i), so slow instances do not leak future values into fast ones (libcosim's
+//!   fixed_step_algorithm with decimation factors).
+//! - [`GaussSeidel`]: instances step one after another in connection order, each reading the
+//!   newest outputs (already at t_(k+1) for those stepped earlier in the same macro step).
+//!
+//! To add one, implement the trait here, add a variant to [`crate::system::Algorithm`] (and
+//! its name to the readers), and dispatch to it in [`super::run_with`].
+
+use super::exchange::Values;
+use super::slot::{Slot, StepCount};
+use super::time_grid::TimeGrid;
+use crate::error::Result;
+use crate::instance::{Readable, Stepping};
+use crate::system::PlanEvent;
+
+/// One macro step of the run: k, t_k, and the events applied at it.
+pub struct MacroStep<'a> {
+    pub k: u64,
+    pub t: f64,
+    pub events: &'a [PlanEvent],
+}
+
+/// A fixed-step master algorithm.
+pub trait Algorithm {
+    /// One round of exchange between instances in Initialization Mode.
+    fn initial_exchange<S: Readable>(&self, slots: &mut [Slot<S>], values: &mut Values)
+        -> Result<()>;
+
+    /// Sets inputs, applies the step's events, steps the instances due at k, and publishes
+    /// their outputs into `values`.
+    fn step(
+        &self,
+        step: &MacroStep,
+        grid: &TimeGrid,
+        slots: &mut [Slot<Stepping>],
+        values: &mut Values,
+        count: &mut StepCount,
+    ) -> Result<()>;
+}
+
+/// All instances from the previous communication point's outputs.
+pub struct Jacobi;
+
+impl Algorithm for Jacobi {
+    fn initial_exchange<S: Readable>(
+        &self,
+        slots: &mut [Slot<S>],
+        values: &mut Values,
+    ) -> Result<()> {
+        for s in slots.iter_mut() {
+            s.get_outputs(values)?;
+        }
+        for s in slots.iter_mut() {
+            s.set_inputs(values)?;
+        }
+        Ok(())
+    }
+
+    #[inline]
+    fn step(
+        &self,
+        step: &MacroStep,
+        grid: &TimeGrid,
+        slots: &mut [Slot<Stepping>],
+        values: &mut Values,
+        count: &mut StepCount,
+    ) -> Result<()> {
+        let k = step.k;
+        for s in slots.iter_mut() {
+            if s.steps_at(k) {
+                s.set_inputs(values)?;
+            }
+        }
+        for e in step.events {
+            slots[e.instance].apply(e, step.t)?;
+        }
+        for s in slots.iter_mut() {
+            if s.steps_at(k) {
+                s.do_step(k, step.t, grid, count)?;
+            }
+        }
+        for s in slots.iter_mut() {
+            if s.steps_at(k + 1) || k + 1 == grid.n_steps() {
+                s.get_outputs(values)?;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// One instance after another in `order`, each from the newest outputs.
+pub struct GaussSeidel<'a> {
+    pub order: &'a [usize],
+}
+
+impl Algorithm for GaussSeidel<'_> {
+    fn initial_exchange<S: Readable>(
+        &self,
+        slots: &mut [Slot<S>],
+        values: &mut Values,
+    ) -> Result<()> {
+        for &i in self.order {
+            slots[i].set_inputs(values)?;
+            slots[i].get_outputs(values)?;
+        }
+        Ok(())
+    }
+
+    #[inline]
+    fn step(
+        &self,
+        step: &MacroStep,
+        grid: &TimeGrid,
+        slots: &mut [Slot<Stepping>],
+        values: &mut Values,
+        count: &mut StepCount,
+    ) -> Result<()> {
+        let k = step.k;
+        for &i in self.order {
+            let s = &mut slots[i];
+            if s.steps_at(k) {
+                s.set_inputs(values)?;
+            }
+            for e in step.events.iter().filter(|e| e.instance == i) {
+                s.apply(e, step.t)?;
+            }
+            if s.steps_at(k) {
+                s.do_step(k, step.t, grid, count)?;
+                s.get_outputs(values)?;
+            }
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,321 @@
+//! The exchange of values between instances, resolved before the first step.
+//!
+//! Every variable the run reads (a connection source or a recorded output) gets one place in
+//! the shared [`Values`], per FMI type; an instance's observed variables of one type are a
+//! contiguous range, so reading them is one batched `fmi2GetXxx` straight into that range.
+//! Every connected input knows the place it reads from (and, for Real, the gain and offset),
+//! so writing an instance's inputs is one gather into a scratch buffer and one batched
+//! `fmi2SetXxx`. Nothing here allocates after [`Exchange::build`].
+//!
+//! The three FMI types the exchange moves (Real, Integer, Boolean; Enumeration travels as
+//! Integer) are one generic [`Port`] over a [`Kind`].
+
+use crate::error::Result;
+use crate::fmu::VR;
+use crate::instance::{Instance, Readable};
+use crate::model_description::VarType;
+use crate::system::Plan;
+use std::collections::HashMap;
+
+/// The current value of every observed variable, one vector per FMI type.
+#[derive(Debug, Clone, Default)]
+pub struct Values {
+    pub real: Vec<f64>,
+    pub integer: Vec<i32>,
+    /// fmi2Boolean: 0 or 1.
+    pub boolean: Vec<i32>,
+}
+
+/// An FMI variable type as the exchange moves it: where its values live, how a connection
+/// transforms one, and the batched FMI calls that move them.
+pub trait Kind {
+    type Value: Copy + Default;
+    /// What a connection applies to a value on its way (Real: gain and offset).
+    type Map: Copy;
+    fn values(v: &Values) -> &[Self::Value];
+    fn values_mut(v: &mut Values) -> &mut [Self::Value];
+    fn map(value: Self::Value, map: Self::Map) -> Self::Value;
+    fn set<S>(inst: &mut Instance<S>, vrs: &[VR], values: &[Self::Value]) -> Result<()>;
+    fn get<S: Readable>(inst: &mut Instance<S>, vrs: &[VR], out: &mut [Self::Value])
+        -> Result<()>;
+}
+
+/// `fmi2Real`.
+pub struct Real;
+/// `fmi2Integer` (and Enumeration).
+pub struct Integer;
+/// `fmi2Boolean`.
+pub struct Boolean;
+
+/// A Real connection's `to = gain*from + offset`.
+#[derive(Clone, Copy, Debug)]
+pub struct Linear {
+    pub gain: f64,
+    pub offset: f64,
+}
+
+impl Kind for Real {
+    type Value = f64;
+    type Map = Linear;
+    fn values(v: &Values) -> &[f64] {
+        &v.real
+    }
+    fn values_mut(v: &mut Values) -> &mut [f64] {
+        &mut v.real
+    }
+    #[inline]
+    fn map(value: f64, m: Linear) -> f64 {
+        m.gain * value + m.offset
+    }
+    fn set<S>(inst: &mut Instance<S>, vrs: &[VR], values: &[f64]) -> Result<()> {
+        inst.set_real(vrs, values)
+    }
+    fn get<S: Readable>(inst: &mut Instance<S>, vrs: &[VR], out: &mut [f64]) -> Result<()> {
+        inst.get_real(vrs, out)
+    }
+}
+
+impl Kind for Integer {
+    type Value = i32;
+    type Map = ();
+    fn values(v: &Values) -> &[i32] {
+        &v.integer
+    }
+    fn values_mut(v: &mut Values) -> &mut [i32] {
+        &mut v.integer
+    }
+    #[inline]
+    fn map(value: i32, _: ()) -> i32 {
+        value
+    }
+    fn set<S>(inst: &mut Instance<S>, vrs: &[VR], values: &[i32]) -> Result<()> {
+        inst.set_integer(vrs, values)
+    }
+    fn get<S: Readable>(inst: &mut Instance<S>, vrs: &[VR], out: &mut [i32]) -> Result<()> {
+        inst.get_integer(vrs, out)
+    }
+}
+
+impl Kind for Boolean {
+    type Value = i32;
+    type Map = ();
+    fn values(v: &Values) -> &[i32] {
+        &v.boolean
+    }
+    fn values_mut(v: &mut Values) -> &mut [i32] {
+        &mut v.boolean
+    }
+    #[inline]
+    fn map(value: i32, _: ()) -> i32 {
+        value
+    }
+    fn set<S>(inst: &mut Instance<S>, vrs: &[VR], values: &[i32]) -> Result<()> {
+        inst.set_boolean(vrs, values)
+    }
+    fn get<S: Readable>(inst: &mut Instance<S>, vrs: &[VR], out: &mut [i32]) -> Result<()> {
+        inst.get_boolean(vrs, out)
+    }
+}
+
+/// One connected input: where its value comes from, and what the connection applies.
+struct Link<K: Kind> {
+    source: usize,
+    map: K::Map,
+}
+
+/// An instance's connected inputs and observed variables of one FMI type.
+pub struct Port<K: Kind> {
+    /// Connected inputs, in the order of the batched fmi2SetXxx.
+    input_vrs: Vec<VR>,
+    links: Vec<Link<K>>,
+    scratch: Vec<K::Value>,
+    /// Observed variables (connection sources and recorded outputs), in the order of the
+    /// batched fmi2GetXxx, stored at `Values[at..at + n]`.
+    output_vrs: Vec<VR>,
+    at: usize,
+}
+
+impl<K: Kind> Default for Port<K> {
+    fn default() -> Self {
+        Port {
+            input_vrs: Vec::new(),
+            links: Vec::new(),
+            scratch: Vec::new(),
+            output_vrs: Vec::new(),
+            at: 0,
+        }
+    }
+}
+
+impl<K: Kind> Port<K> {
+    fn connect(&mut self, vr: VR, source: usize, map: K::Map) {
+        self.input_vrs.push(vr);
+        self.links.push(Link { source, map });
+        self.scratch.push(K::Value::default());
+    }
+
+    /// The local index of observed variable `vr`, registering it on first use.
+    fn observe(&mut self, vr: VR, known: &mut HashMap<VR, usize>) -> usize {
+        *known.entry(vr).or_insert_with(|| {
+            self.output_vrs.push(vr);
+            self.output_vrs.len() - 1
+        })
+    }
+
+    #[inline]
+    fn set_inputs<S>(&mut self, inst: &mut Instance<S>, values: &Values) -> Result<()> {
+        if self.input_vrs.is_empty() {
+            return Ok(());
+        }
+        let shared = K::values(values);
+        for (x, l) in self.scratch.iter_mut().zip(&self.links) {
+            *x = K::map(shared[l.source], l.map);
+        }
+        K::set(inst, &self.input_vrs, &self.scratch)
+    }
+
+    #[inline]
+    fn get_outputs<S: Readable>(&self, inst: &mut Instance<S>, values: &mut Values) -> Result<()> {
+        let n = self.output_vrs.len();
+        if n == 0 {
+            return Ok(());
+        }
+        K::get(inst, &self.output_vrs, &mut K::values_mut(values)[self.at..self.at + n])
+    }
+}
+
+/// An instance's ports, one per FMI type.
+#[derive(Default)]
+pub struct Ports {
+    real: Port<Real>,
+    integer: Port<Integer>,
+    boolean: Port<Boolean>,
+}
+
+impl Ports {
+    /// Writes the instance's connected inputs from `values` (Real, then Integer, then Boolean).
+    #[inline]
+    pub fn set_inputs<S>(&mut self, inst: &mut Instance<S>, values: &Values) -> Result<()> {
+        self.real.set_inputs(inst, values)?;
+        self.integer.set_inputs(inst, values)?;
+        self.boolean.set_inputs(inst, values)
+    }
+
+    /// Reads the instance's observed variables into `values` (Real, then Integer, then Boolean).
+    #[inline]
+    pub fn get_outputs<S: Readable>(&self, inst: &mut Instance<S>, values: &mut Values) -> Result<()> {
+        self.real.get_outputs(inst, values)?;
+        self.integer.get_outputs(inst, values)?;
+        self.boolean.get_outputs(inst, values)
+    }
+}
+
+/// Where a recorded column lives in [`Values`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Column {
+    Real(usize),
+    Integer(usize),
+    Boolean(usize),
+}
+
+/// The resolved exchange of a plan: per-instance ports, the shared values, and the place of
+/// every recorded output.
+pub struct Exchange {
+    pub ports: Vec<Ports>,
+    pub values: Values,
+    /// `plan.outputs[j]` is at `columns[j]`.
+    pub columns: Vec<Column>,
+}
+
+/// The local index of each observed variable, per instance and type.
+type Observed = HashMap<(usize, VarType), HashMap<VR, usize>>;
+
+/// The exchange's type of a plan variable type (Enumeration is already Integer in a plan).
+fn kind_of(t: VarType) -> VarType {
+    match t {
+        VarType::Real | VarType::Boolean => t,
+        _ => VarType::Integer,
+    }
+}
+
+impl Exchange {
+    /// Resolves every connection and recorded output of `plan`.
+    pub fn build(plan: &Plan) -> Exchange {
+        let n = plan.instances.len();
+        let mut ports: Vec<Ports> = (0..n).map(|_| Ports::default()).collect();
+        let mut observed = Observed::new();
+        let sources = plan
+            .connections
+            .iter()
+            .map(|c| (c.from_instance, c.var_type, c.from_vr));
+        let recorded = plan.outputs.iter().map(|o| (o.instance, o.var_type, o.vr));
+        for (i, t, vr) in sources.chain(recorded) {
+            let known = observed.entry((i, kind_of(t))).or_default();
+            match kind_of(t) {
+                VarType::Real => ports[i].real.observe(vr, known),
+                VarType::Boolean => ports[i].boolean.observe(vr, known),
+                _ => ports[i].integer.observe(vr, known),
+            };
+        }
+        let values = place_outputs(&mut ports);
+        let global = |ports: &[Ports], i: usize, t: VarType, vr: VR| -> usize {
+            let local = observed[&(i, kind_of(t))][&vr];
+            match kind_of(t) {
+                VarType::Real => ports[i].real.at + local,
+                VarType::Boolean => ports[i].boolean.at + local,
+                _ => ports[i].integer.at + local,
+            }
+        };
+        for c in &plan.connections {
+            let g = global(&ports, c.from_instance, c.var_type, c.from_vr);
+            let p = &mut ports[c.to_instance];
+            match kind_of(c.var_type) {
+                VarType::Real => p.real.connect(
+                    c.to_vr,
+                    g,
+                    Linear {
+                        gain: c.gain,
+                        offset: c.offset,
+                    },
+                ),
+                VarType::Boolean => p.boolean.connect(c.to_vr, g, ()),
+                _ => p.integer.connect(c.to_vr, g, ()),
+            }
+        }
+        let columns = plan
+            .outputs
+            .iter()
+            .map(|o| {
+                let g = global(&ports, o.instance, o.var_type, o.vr);
+                match kind_of(o.var_type) {
+                    VarType::Real => Column::Real(g),
+                    VarType::Boolean => Column::Boolean(g),
+                    _ => Column::Integer(g),
+                }
+            })
+            .collect();
+        Exchange {
+            ports,
+            values,
+            columns,
+        }
+    }
+}
+
+/// Lays the observed variables out instance after instance; returns the zeroed shared values.
+fn place_outputs(ports: &mut [Ports]) -> Values {
+    let (mut nr, mut ni, mut nb) = (0, 0, 0);
+    for p in ports.iter_mut() {
+        p.real.at = nr;
+        nr += p.real.output_vrs.len();
+        p.integer.at = ni;
+        ni += p.integer.output_vrs.len();
+        p.boolean.at = nb;
+        nb += p.boolean.output_vrs.len();
+    }
+    Values {
+        real: vec![0.0; nr],
+        integer: vec![0; ni],
+        boolean: vec![0; nb],
+    }
+}

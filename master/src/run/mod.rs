@@ -1,0 +1,289 @@
+//! The fixed-step master: runs a validated [`Plan`] with loaded FMUs.
+//!
+//! A run goes through these files in order:
+//!
+//! 1. [`exchange`]: the plan's connections and recorded outputs resolved into per-instance
+//!    typed ports and one shared value store;
+//! 2. [`recorder`]: the observer that receives the recorded rows (CSV file, memory, ...);
+//! 3. [`initialize`]: instantiation, start values, initialization with the initial exchange;
+//! 4. [`stepping`]: the step loop, generic over the [`algorithm`] (Jacobi or Gauss-Seidel),
+//!    on the communication points of [`time_grid`], each instance a [`slot`];
+//! 5. termination of every instance (here), so that a failing fmi2Terminate is reported.
+//!
+//! Clean termination holds on every path: an instance dropped on an error or an interrupt is
+//! terminated and freed ([`crate::instance`]). The step loop allocates nothing.
+//!
+//! The library installs no process-wide state (no signal handler, no logger): a caller that
+//! wants Ctrl-C to stop a run sets [`RunOptions::interrupt`] from its own handler, as the CLI
+//! does. FMU log messages go to [`RunOptions::log_sink`] (default: stderr, warnings and worse).
+
+use crate::error::{Error, Result};
+use crate::fmu::Fmu;
+use crate::instance::LogSink;
+use crate::model_description::ModelDescription;
+use crate::system::{Algorithm as AlgorithmChoice, Plan, System};
+use std::collections::HashMap;
+use std::io::Write;
+use std::path::PathBuf;
+use std::sync::atomic::AtomicBool;
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+pub mod algorithm;
+pub mod exchange;
+pub mod initialize;
+pub mod progress;
+pub mod recorder;
+pub mod slot;
+pub mod stepping;
+pub mod time_grid;
+
+use algorithm::{Algorithm, GaussSeidel, Jacobi};
+use exchange::Exchange;
+pub use recorder::{ColumnInfo, CsvRecorder, MemoryRecorder, Recorder, Row, Sample};
+use stepping::{Recording, Stepper};
+pub use time_grid::TimeGrid;
+
+/// How to run.
+#[derive(Clone, Default)]
+pub struct RunOptions {
+    /// FMU log messages below fmi2Warning are shown too, and loggingOn is passed to the FMUs.
+    pub verbose: bool,
+    /// Show a progress bar (the CLI enables it only when stderr is a terminal).
+    pub progress: bool,
+    /// Set to true (e.g. by Ctrl-C) to stop the run cleanly.
+    pub interrupt: Option<Arc<AtomicBool>>,
+    pub log_sink: Option<LogSink>,
+}
+
+/// What a run did.
+#[derive(Debug, Clone)]
+pub struct Summary {
+    pub macro_steps: u64,
+    /// Sum over instances of fmi2DoStep calls.
+    pub fmu_steps: u64,
+    pub start_time: f64,
+    pub end_time: f64,
+    /// Wall time of the step loop only (after initialization).
+    pub wall_time: Duration,
+    /// Wall time including loading, instantiation and initialization.
+    pub total_wall_time: Duration,
+    pub rows: u64,
+    /// Set when an FMU ended the simulation early (fmi2Discard + fmi2Terminated).
+    pub terminated_by: Option<String>,
+    pub output_file: Option<PathBuf>,
+}
+
+impl Summary {
+    pub fn real_time_factor(&self) -> f64 {
+        (self.end_time - self.start_time) / self.wall_time.as_secs_f64().max(1e-12)
+    }
+}
+
+impl std::fmt::Display for Summary {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let w = self.wall_time.as_secs_f64();
+        writeln!(
+            f,
+            "simulated {} s .. {} s: {} macro steps, {} FMU steps",
+            self.start_time, self.end_time, self.macro_steps, self.fmu_steps
+        )?;
+        write!(
+            f,
+            "wall time {:.3} s (step loop), {:.3} s total; real-time factor {:.1}; {:.3} us per macro step, {:.3} us per FMU step",
+            w,
+            self.total_wall_time.as_secs_f64(),
+            self.real_time_factor(),
+            w * 1e6 / self.macro_steps.max(1) as f64,
+            w * 1e6 / self.fmu_steps.max(1) as f64
+        )?;
+        if let Some(t) = &self.terminated_by {
+            write!(f, "\n{t}")?;
+        }
+        if let Some(p) = &self.output_file {
+            write!(f, "\n{} rows written to {}", self.rows, p.display())?;
+        }
+        Ok(())
+    }
+}
+
+/// Loads each distinct FMU once (instances of the same file share one loaded library).
+pub fn load_fmus(system: &System) -> Result<Vec<Arc<Fmu>>> {
+    let mut cache: HashMap<PathBuf, Arc<Fmu>> = HashMap::new();
+    let mut out = Vec::new();
+    for inst in &system.instances {
+        let key = inst.fmu.canonicalize().unwrap_or_else(|_| inst.fmu.clone());
+        let fmu = match cache.get(&key) {
+            Some(f) => {
+                if f.co_simulation().can_be_instantiated_only_once_per_process {
+                    return Err(Error::fmu(
+                        &inst.fmu,
+                        format!(
+                            "instance '{}': the FMU declares canBeInstantiatedOnlyOncePerProcess=\"true\" and is already used by another instance",
+                            inst.name
+                        ),
+                    ));
+                }
+                f.clone()
+            }
+            None => {
+                system.require_fmu(inst)?;
+                let f = Arc::new(Fmu::load(&inst.fmu).map_err(|e| match e {
+                    Error::Fmu { path, message } => Error::Fmu {
+                        path,
+                        message: format!("(instance '{}') {message}", inst.name),
+                    },
+                    e => e,
+                })?);
+                cache.insert(key, f.clone());
+                f
+            }
+        };
+        out.push(fmu);
+    }
+    Ok(out)
+}
+
+/// Where rows go.
+pub enum Output {
+    None,
+    File(PathBuf),
+    Writer(Box<dyn Write>),
+}
+
+/// Runs a validated plan with loaded FMUs (`fmus[i]` for `plan.instances[i]`), recording into
+/// a CSV file or writer.
+pub fn run(plan: &Plan, fmus: &[Arc<Fmu>], output: Output, opts: &RunOptions) -> Result<Summary> {
+    let (writer, path): (Option<Box<dyn Write>>, Option<PathBuf>) = match output {
+        Output::None => (None, None),
+        Output::File(p) => (Some(create_output_file(&p)?), Some(p)),
+        Output::Writer(w) => (Some(w), None),
+    };
+    let mut csv = writer.map(CsvRecorder::new);
+    let mut summary = run_with(
+        plan,
+        fmus,
+        csv.as_mut().map(|r| r as &mut dyn Recorder),
+        opts,
+    )?;
+    summary.output_file = path;
+    Ok(summary)
+}
+
+/// The output file, with its folder created; buffered.
+fn create_output_file(p: &std::path::Path) -> Result<Box<dyn Write>> {
+    if let Some(dir) = p.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir)
+            .map_err(|e| Error::io(format!("cannot create output folder {}", dir.display()), e))?;
+    }
+    let f = std::fs::File::create(p)
+        .map_err(|e| Error::io(format!("cannot create output file {}", p.display()), e))?;
+    Ok(Box::new(std::io::BufWriter::with_capacity(1 << 16, f)))
+}
+
+/// Runs a validated plan with loaded FMUs, recording into any [`Recorder`] (or none).
+pub fn run_with(
+    plan: &Plan,
+    fmus: &[Arc<Fmu>],
+    recorder: Option<&mut dyn Recorder>,
+    opts: &RunOptions,
+) -> Result<Summary> {
+    match plan.algorithm {
+        AlgorithmChoice::Jacobi => execute(&Jacobi, plan, fmus, recorder, opts),
+        AlgorithmChoice::GaussSeidel => {
+            let gs = GaussSeidel { order: &plan.order };
+            execute(&gs, plan, fmus, recorder, opts)
+        }
+    }
+}
+
+/// The rows a run records if it runs to its end: t_0, every `decimation` steps, and t_n.
+fn expected_rows(plan: &Plan) -> u64 {
+    let dec = plan.decimation as u64;
+    1 + plan.n_steps / dec + u64::from(plan.n_steps % dec != 0)
+}
+
+fn execute<A: Algorithm>(
+    algorithm: &A,
+    plan: &Plan,
+    fmus: &[Arc<Fmu>],
+    recorder: Option<&mut dyn Recorder>,
+    opts: &RunOptions,
+) -> Result<Summary> {
+    let begin = Instant::now();
+    let Exchange {
+        ports,
+        mut values,
+        columns,
+    } = Exchange::build(plan);
+    let mut recording = match recorder {
+        None => None,
+        Some(recorder) => {
+            let infos: Vec<ColumnInfo> = plan
+                .outputs
+                .iter()
+                .map(|o| ColumnInfo {
+                    name: o.header.clone(),
+                    var_type: o.var_type,
+                })
+                .collect();
+            recorder.start(&infos, expected_rows(plan))?;
+            Some(Recording {
+                recorder,
+                columns: &columns,
+                decimation: plan.decimation as u64,
+                rows: 0,
+            })
+        }
+    };
+    let slots = initialize::initialize(algorithm, plan, fmus, ports, &mut values, opts)?;
+    if let Some(r) = recording.as_mut() {
+        r.row(plan.start_time, &values)?;
+    }
+    let grid = TimeGrid::new(plan.start_time, plan.step_size, plan.n_steps);
+    let mut stepper = Stepper {
+        grid,
+        events: &plan.events,
+        slots,
+        values,
+        recording,
+        progress: progress::Progress::new(opts.progress, plan.n_steps),
+        interrupt: opts.interrupt.as_deref(),
+    };
+    let end = stepper.run(algorithm)?;
+    let rows = stepper.recording.as_ref().map(|r| r.rows).unwrap_or(0);
+    // Terminate explicitly so that a failing fmi2Terminate is reported.
+    for s in stepper.slots {
+        s.inst.terminate()?;
+    }
+    Ok(Summary {
+        macro_steps: end.steps,
+        fmu_steps: end.count.fmu_steps,
+        start_time: plan.start_time,
+        end_time: grid.at(end.steps),
+        wall_time: end.wall,
+        total_wall_time: begin.elapsed(),
+        rows,
+        terminated_by: end.count.terminated_by,
+        output_file: None,
+    })
+}
+
+/// Loads a system's FMUs and validates it against their model descriptions. The plan's
+/// warnings are for the caller to show.
+pub fn prepare(system: &System) -> Result<(Plan, Vec<Arc<Fmu>>)> {
+    let fmus = load_fmus(system)?;
+    let mds: Vec<&ModelDescription> = fmus.iter().map(|f| &f.model_description).collect();
+    let plan = system.validate(&mds)?;
+    Ok((plan, fmus))
+}
+
+/// Validates a system, loads its FMUs and runs it ([`prepare`] then [`run`]). The plan's
+/// warnings are returned in it, not printed.
+pub fn run_system(system: &System, output: Output, opts: &RunOptions) -> Result<(Plan, Summary)> {
+    let begin = Instant::now();
+    let (plan, fmus) = prepare(system)?;
+    let mut summary = run(&plan, &fmus, output, opts)?;
+    summary.total_wall_time = begin.elapsed();
+    Ok((plan, summary))
+}

@@ -1,0 +1,125 @@
+//! The step loop: macro steps from t_0 to t_n with an [`Algorithm`], recording, progress and
+//! interruption. Nothing in it allocates on the success path.
+
+use super::algorithm::{Algorithm, MacroStep};
+use super::exchange::{Column, Values};
+use super::progress::Progress;
+use super::recorder::{Recorder, Row};
+use super::slot::{Slot, StepCount};
+use super::time_grid::TimeGrid;
+use crate::error::{Error, Result};
+use crate::instance::Stepping;
+use crate::system::PlanEvent;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
+
+/// Where recorded rows go, and which.
+pub struct Recording<'r> {
+    pub recorder: &'r mut dyn Recorder,
+    pub columns: &'r [Column],
+    /// A row every `decimation` base steps (and at the last point).
+    pub decimation: u64,
+    pub rows: u64,
+}
+
+impl Recording<'_> {
+    #[inline]
+    pub fn row(&mut self, t: f64, values: &Values) -> Result<()> {
+        self.rows += 1;
+        self.recorder.record(t, &Row::new(self.columns, values))
+    }
+}
+
+/// A run at its first communication point, ready to step.
+pub struct Stepper<'a> {
+    pub grid: TimeGrid,
+    pub events: &'a [PlanEvent],
+    pub slots: Vec<Slot<Stepping>>,
+    pub values: Values,
+    pub recording: Option<Recording<'a>>,
+    pub progress: Option<Progress>,
+    pub interrupt: Option<&'a AtomicBool>,
+}
+
+/// How the step loop ended.
+pub struct LoopEnd {
+    /// Base steps taken.
+    pub steps: u64,
+    pub count: StepCount,
+    /// Wall time of the loop.
+    pub wall: Duration,
+}
+
+impl Stepper<'_> {
+    /// Steps to the end of the run, or until an instance ends it or the interrupt flag is set
+    /// (then the recorder is finished and the error is [`Error::Interrupted`]).
+    pub fn run<A: Algorithm>(&mut self, algorithm: &A) -> Result<LoopEnd> {
+        let start = Instant::now();
+        let grid = self.grid;
+        let n_steps = grid.n_steps();
+        let mut count = StepCount::default();
+        let mut next_event = 0usize;
+        let mut k = 0u64;
+        while k < n_steps {
+            let t = grid.at(k);
+            if self.interrupted() {
+                return Err(self.interrupt_at(t));
+            }
+            let first = next_event;
+            while next_event < self.events.len() && self.events[next_event].step == k {
+                next_event += 1;
+            }
+            let step = MacroStep {
+                k,
+                t,
+                events: &self.events[first..next_event],
+            };
+            algorithm.step(&step, &grid, &mut self.slots, &mut self.values, &mut count)?;
+            k += 1;
+            let ended = count.terminated_by.is_some();
+            if let Some(r) = self.recording.as_mut() {
+                if k % r.decimation == 0 || k == n_steps || ended {
+                    r.row(grid.at(k), &self.values)?;
+                }
+            }
+            if let Some(p) = &self.progress {
+                p.update(k, &grid);
+            }
+            if ended {
+                break;
+            }
+        }
+        let wall = start.elapsed();
+        if let Some(p) = &self.progress {
+            p.finish();
+        }
+        if let Some(r) = self.recording.as_mut() {
+            r.recorder.finish()?;
+        }
+        Ok(LoopEnd {
+            steps: k,
+            count,
+            wall,
+        })
+    }
+
+    #[inline]
+    fn interrupted(&self) -> bool {
+        self.interrupt
+            .map(|f| f.load(Ordering::Relaxed))
+            .unwrap_or(false)
+    }
+
+    /// Finishes the recorder (the rows so far are kept) and leaves the bar where it stopped.
+    fn interrupt_at(&mut self, time: f64) -> Error {
+        if let Some(r) = self.recording.as_mut() {
+            if let Err(e) = r.recorder.finish() {
+                return e;
+            }
+        }
+        if let Some(p) = &self.progress {
+            p.abandon();
+        }
+        Error::Interrupted { time }
+    }
+}

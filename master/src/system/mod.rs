@@ -1,0 +1,209 @@
+//! The format-neutral co-simulation system: what a system file says, whatever format it came in.
+//!
+//! - [`System`] and its parts ([`InstanceSpec`], [`ConnectionSpec`], [`EventSpec`],
+//!   [`OutputSpec`]) are what the readers in [`crate::format`] produce: names and values as
+//!   written, with the file and line they came from.
+//! - [`validate`] checks a system against the FMUs' model descriptions and resolves it into a
+//!   [`Plan`] ([`plan`]): instance indices, value references, types and step indices, everything
+//!   the master ([`crate::run`]) needs before the first step.
+//!
+//! This module depends on no reader: `format::toml` and `format::osp` depend on it.
+
+use crate::error::{did_you_mean, Error, Result};
+use crate::fmu::UnpackedFmu;
+use std::path::PathBuf;
+
+pub mod plan;
+pub mod validate;
+
+pub use plan::{Plan, PlanConnection, PlanEvent, PlanInstance, PlanOutput, StartValue};
+
+/// Master algorithm (implemented in [`crate::run::algorithm`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Algorithm {
+    /// All instances step in parallel from the outputs of the previous communication point.
+    #[default]
+    Jacobi,
+    /// Instances step one after another in connection order, each using the newest outputs.
+    GaussSeidel,
+}
+
+/// A value given in a system file or on the command line.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Value {
+    Real(f64),
+    Integer(i64),
+    Boolean(bool),
+    String(String),
+    /// Unparsed text (from `--set`), converted by the variable's type during validation.
+    Text(String),
+}
+
+impl std::fmt::Display for Value {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Value::Real(v) => write!(f, "{v}"),
+            Value::Integer(v) => write!(f, "{v}"),
+            Value::Boolean(v) => write!(f, "{v}"),
+            Value::String(v) => write!(f, "\"{v}\""),
+            Value::Text(v) => write!(f, "{v}"),
+        }
+    }
+}
+
+/// A value after checking it against the variable type.
+#[derive(Debug, Clone, PartialEq)]
+pub enum TypedValue {
+    Real(f64),
+    Integer(i32),
+    Boolean(bool),
+    String(String),
+}
+
+#[derive(Debug, Clone)]
+pub struct ValueSpec {
+    pub variable: String,
+    pub value: Value,
+    pub line: Option<usize>,
+}
+
+#[derive(Debug, Clone)]
+pub struct InstanceSpec {
+    pub name: String,
+    /// Path to the .fmu, resolved against the system file's directory.
+    pub fmu: PathBuf,
+    pub step_multiple: u32,
+    pub values: Vec<ValueSpec>,
+    pub line: Option<usize>,
+}
+
+/// `instance.variable`.
+#[derive(Debug, Clone, PartialEq, Eq, Hash)]
+pub struct VarRef {
+    pub instance: String,
+    pub variable: String,
+}
+
+impl std::fmt::Display for VarRef {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}.{}", self.instance, self.variable)
+    }
+}
+
+impl VarRef {
+    /// Splits at the first dot: instance names cannot contain dots, variable names may.
+    pub fn parse(s: &str) -> Option<VarRef> {
+        let (i, v) = s.trim().split_once('.')?;
+        if i.is_empty() || v.is_empty() {
+            return None;
+        }
+        Some(VarRef {
+            instance: i.to_string(),
+            variable: v.to_string(),
+        })
+    }
+}
+
+#[derive(Debug, Clone)]
+pub struct ConnectionSpec {
+    pub from: VarRef,
+    pub to: VarRef,
+    pub gain: f64,
+    pub offset: f64,
+    pub line: Option<usize>,
+    /// OSP VariableConnection: the direction follows the variables' causalities.
+    pub either_direction: bool,
+    /// The gain converts between physically different quantities (e.g. a wave moment in N.m
+    /// into a rudder-equivalent disturbance in rad): the unit check is skipped for it.
+    pub convert: bool,
+}
+
+#[derive(Debug, Clone)]
+pub struct EventSpec {
+    pub time: f64,
+    pub target: VarRef,
+    pub value: Value,
+    pub line: Option<usize>,
+}
+
+#[derive(Debug, Clone, Default)]
+pub struct OutputSpec {
+    pub file: Option<PathBuf>,
+    /// `inst.var` or `inst.*`; None = every output variable of every instance.
+    pub variables: Option<Vec<String>>,
+    pub decimation: u32,
+}
+
+/// A co-simulation system, whatever file it came from.
+#[derive(Debug, Clone)]
+pub struct System {
+    pub source: PathBuf,
+    pub start_time: f64,
+    pub stop_time: Option<f64>,
+    pub step_size: f64,
+    pub algorithm: Algorithm,
+    pub instances: Vec<InstanceSpec>,
+    pub connections: Vec<ConnectionSpec>,
+    pub events: Vec<EventSpec>,
+    pub output: OutputSpec,
+}
+
+impl System {
+    /// The instance's FMU file exists (an error naming the file, line and instance if not).
+    pub fn require_fmu(&self, inst: &InstanceSpec) -> Result<()> {
+        if inst.fmu.exists() {
+            return Ok(());
+        }
+        Err(Error::system(
+            &self.source,
+            inst.line,
+            format!(
+                "instance '{}': FMU file '{}' not found",
+                inst.name,
+                inst.fmu.display()
+            ),
+        ))
+    }
+
+    /// Every instance's FMU unpacked, with its model description read (binaries not loaded).
+    pub fn unpack_fmus(&self) -> Result<Vec<UnpackedFmu>> {
+        self.instances
+            .iter()
+            .map(|inst| {
+                self.require_fmu(inst)?;
+                UnpackedFmu::open(&inst.fmu)
+            })
+            .collect()
+    }
+
+    /// Applies `--set inst.var=value` overrides (they replace values from the file).
+    pub fn apply_overrides(&mut self, sets: &[String]) -> Result<()> {
+        for s in sets {
+            let Some((lhs, rhs)) = s.split_once('=') else {
+                return Err(Error::Other(format!(
+                    "--set {s}: expected instance.variable=value"
+                )));
+            };
+            let Some(r) = VarRef::parse(lhs) else {
+                return Err(Error::Other(format!(
+                    "--set {s}: expected instance.variable=value"
+                )));
+            };
+            let names: Vec<String> = self.instances.iter().map(|i| i.name.clone()).collect();
+            let Some(inst) = self.instances.iter_mut().find(|i| i.name == r.instance) else {
+                return Err(Error::Other(format!(
+                    "--set {s}: no instance '{}'{}",
+                    r.instance,
+                    did_you_mean(&r.instance, names.iter().map(|s| s.as_str()))
+                )));
+            };
+            inst.values.retain(|v| v.variable != r.variable);
+            inst.values.push(ValueSpec {
+                variable: r.variable,
+                value: Value::Text(rhs.trim().to_string()),
+                line: None,
+            });
+        }
+        Ok(())
+    }
+}

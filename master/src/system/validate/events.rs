@@ -1,0 +1,67 @@
+//! Events: a value set at a base-step point during the run, on an input or tunable parameter.
+
+use super::connections::Driven;
+use super::values::convert;
+use super::{Checker, Grid};
+use crate::system::{EventSpec, PlanEvent};
+
+impl Checker<'_> {
+    /// Every event checked and resolved, sorted by step (stable: same-step events keep their
+    /// order in the file).
+    pub(super) fn events(&mut self, grid: &Grid, driven: &Driven) -> Vec<PlanEvent> {
+        let mut events: Vec<PlanEvent> = self
+            .sys
+            .events
+            .iter()
+            .filter_map(|e| self.event(e, grid, driven))
+            .collect();
+        events.sort_by_key(|e| e.step);
+        events
+    }
+
+    fn event(&mut self, e: &EventSpec, grid: &Grid, driven: &Driven) -> Option<PlanEvent> {
+        let (i, vi) = self
+            .resolve(&e.target, e.line, "event")
+            .map_err(|err| self.errors.push(err))
+            .ok()?;
+        let sv = &self.mds[i].model_variables.variables[vi];
+        if !sv.settable_in_step_mode() {
+            let err = self.err(e.line, format!(
+                "event at t = {}: '{}' is {} {}; only inputs and tunable parameters can change during a run",
+                e.time, e.target, sv.variability, sv.causality));
+            self.errors.push(err);
+            return None;
+        }
+        let tv = match convert(&e.value, sv.var_type().unwrap()) {
+            Ok(v) => v,
+            Err(m) => {
+                let err = self.err(
+                    e.line,
+                    format!("event at t = {}, '{}': {m}", e.time, e.target),
+                );
+                self.errors.push(err);
+                return None;
+            }
+        };
+        let sys = self.sys;
+        let kf = (e.time - sys.start_time) / sys.step_size;
+        let k = kf.round();
+        if !(k >= 0.0) || (kf - k).abs() > 1e-6 || k as u64 >= grid.n_steps {
+            let err = self.err(e.line, format!(
+                "event at t = {} for '{}': the time must be a base-step point t0 + k*h in [{}, {})",
+                e.time, e.target, sys.start_time, grid.stop_on_grid));
+            self.errors.push(err);
+            return None;
+        }
+        if driven.contains_key(&(i, vi)) {
+            self.warnings.push(format!("{}: event sets '{}', which a connection also drives; the connection overrides it at the next exchange", self.loc(e.line), e.target));
+        }
+        Some(PlanEvent {
+            step: k as u64,
+            instance: i,
+            vr: sv.value_reference,
+            value: tv,
+            name: e.target.to_string(),
+        })
+    }
+}
