@@ -6,7 +6,7 @@
 //!   resolves every symbol once; [`instance`] is a slave instance whose FMI lifecycle is
 //!   enforced by types; [`model_description`] is the typed `modelDescription.xml`.
 //! - **System**: [`system`] is the format-neutral system and its validation into a
-//!   [`system::Plan`]; [`format`] holds the file formats that read into it (native TOML, OSP
+//!   [`system::Plan`]; [`format`](mod@format) holds the file formats that read into it (native TOML, OSP
 //!   `OspSystemStructure.xml`) and write out of it (OSP).
 //! - **Master**: [`run`] executes a plan: exchange, recorders, Jacobi and Gauss-Seidel, the
 //!   step loop.

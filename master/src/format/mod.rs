@@ -1,5 +1,5 @@
 //! System file formats. Each reader turns a file into the format-neutral
-//! [`System`](crate::system::System); the writer turns one back into a file another tool runs.
+//! [`System`]; the writer turns one back into a file another tool runs.
 //!
 //! - [`toml`]: shipsim's native system file (read).
 //! - [`osp`]: OSP `OspSystemStructure.xml`, libcosim's format (read and write).

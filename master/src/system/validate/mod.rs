@@ -1,16 +1,16 @@
 //! Validation: a [`System`] checked against the FMUs' model descriptions and resolved into a
 //! [`Plan`].
 //!
-//! One [`Checker`] carries the system, the model descriptions, the instance index and the
+//! One `Checker` carries the system, the model descriptions, the instance index and the
 //! errors and warnings found so far; each concern is a small method in its own file, run in
 //! this order (which is also the order of the messages):
 //!
 //! 1. the time grid (this file),
-//! 2. the instances and their start values (this file, [`values`]),
-//! 3. the connections, their types and units, and unconnected inputs ([`connections`]),
-//! 4. the events ([`events`]),
-//! 5. the recorded outputs ([`outputs`]),
-//! 6. the stepping order, algebraic loops and dropped last steps ([`order`]).
+//! 2. the instances and their start values (this file and `values.rs`),
+//! 3. the connections, their types and units, and unconnected inputs (`connections.rs`),
+//! 4. the events (`events.rs`),
+//! 5. the recorded outputs (`outputs.rs`),
+//! 6. the stepping order, algebraic loops and dropped last steps (`order.rs`).
 //!
 //! Every error names the file, the line when known, the instance and the variable, with
 //! close-name suggestions; all errors are returned together.
