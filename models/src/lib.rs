@@ -4,6 +4,7 @@
 pub mod control;
 pub mod controllers;
 pub mod disturbances;
+pub mod error;
 pub mod hull;
 pub mod integrate;
 pub mod manoeuvre;

@@ -27,6 +27,7 @@
 //!
 //! A global `noise_scale` multiplies every σ (004 uses 1, 0.001 and 0).
 
+use crate::error::{check_non_negative, check_positive};
 use crate::random::{channel, NoiseStream};
 use serde::{Deserialize, Serialize};
 
@@ -136,16 +137,10 @@ impl SensorParams {
 
     pub fn validate(&self) -> Result<(), String> {
         for (c, (name, _)) in self.channels.iter().zip(CHANNEL_NAMES) {
-            if !(c.sigma >= 0.0 && c.sigma.is_finite()) {
-                return Err(format!("{name}_sigma = {} must be >= 0", c.sigma));
-            }
-            if !(c.interval > 0.0 && c.interval.is_finite()) {
-                return Err(format!("{name}_interval = {} must be > 0", c.interval));
-            }
+            check_non_negative(&format!("{name}_sigma"), c.sigma)?;
+            check_positive(&format!("{name}_interval"), c.interval)?;
         }
-        if !(self.noise_scale >= 0.0 && self.noise_scale.is_finite()) {
-            return Err(format!("noise_scale = {} must be >= 0", self.noise_scale));
-        }
+        check_non_negative("noise_scale", self.noise_scale)?;
         Ok(())
     }
 }

@@ -37,8 +37,8 @@
 //! not depend on the step size. The second-order servo uses classical RK4 on a fixed sub-step of at
 //! most [`SteeringGearParams::max_substep`].
 
+use crate::error::{check_positive, ParamError};
 use serde::{Deserialize, Serialize};
-use std::fmt;
 
 /// Order of the servo loop.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -113,23 +113,12 @@ impl SteeringGearParams {
 
     /// Checks every parameter; the message names the parameter and its value.
     pub fn validate(&self) -> Result<(), ParamError> {
-        fn positive(name: &'static str, v: f64) -> Result<(), ParamError> {
-            if v.is_finite() && v > 0.0 {
-                Ok(())
-            } else {
-                Err(ParamError {
-                    name,
-                    value: v,
-                    rule: "must be finite and > 0",
-                })
-            }
-        }
-        positive("angle_max", self.angle_max)?;
-        positive("rate_max", self.rate_max)?;
-        positive("time_constant", self.time_constant)?;
-        positive("omega0", self.omega0)?;
-        positive("zeta0", self.zeta0)?;
-        positive("max_substep", self.max_substep)?;
+        check_positive("angle_max", self.angle_max)?;
+        check_positive("rate_max", self.rate_max)?;
+        check_positive("time_constant", self.time_constant)?;
+        check_positive("omega0", self.omega0)?;
+        check_positive("zeta0", self.zeta0)?;
+        check_positive("max_substep", self.max_substep)?;
         Ok(())
     }
 }
@@ -139,22 +128,6 @@ impl Default for SteeringGearParams {
         Self::rrs_003()
     }
 }
-
-/// A parameter outside its legal range.
-#[derive(Clone, Debug, PartialEq)]
-pub struct ParamError {
-    pub name: &'static str,
-    pub value: f64,
-    pub rule: &'static str,
-}
-
-impl fmt::Display for ParamError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "parameter {} = {} {}", self.name, self.value, self.rule)
-    }
-}
-
-impl std::error::Error for ParamError {}
 
 /// The steering machine's state.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

@@ -4,9 +4,9 @@
 //! table maps the model onto FMI variables.
 
 use fmi2_export::FmuModel;
+use models::error::{check_positive, ParamError};
 use models::hull::nomoto::{NomotoInputs, NomotoModel, NomotoOutputs, NomotoShip};
 use models::hull::DEG;
-use models::steering_gear::ParamError;
 use serde::{Deserialize, Serialize};
 
 /// Parameters, inputs and state of one instance.
@@ -63,12 +63,7 @@ impl Default for NomotoShipFmu {
 
 /// A model error with the model's parameter name replaced by the FMU variable's name.
 fn param_error(e: ParamError) -> String {
-    let name = match e.name {
-        "t" => "t_prime",
-        "k" => "k_prime",
-        other => other,
-    };
-    format!("parameter {name} = {} {}", e.value, e.rule)
+    e.renamed(&[("t", "t_prime"), ("k", "k_prime")]).to_string()
 }
 
 impl NomotoShipFmu {
@@ -107,12 +102,7 @@ impl NomotoShipFmu {
             self.speed
         };
         let mut ship = NomotoShip::new(model, length, speed).map_err(param_error)?;
-        if !(self.max_substep.is_finite() && self.max_substep > 0.0) {
-            return Err(format!(
-                "parameter max_substep = {} must be finite and > 0",
-                self.max_substep
-            ));
-        }
+        check_positive("max_substep", self.max_substep)?;
         ship.max_substep = self.max_substep;
         Ok(ship)
     }

@@ -5,6 +5,7 @@
 
 use fmi2_export::FmuModel;
 use models::controllers::mve::{parameters_of, Mve, MveParams};
+use models::error::check_positive;
 use models::hull::tokyo_maru::TokyoMaruCoefficients;
 use models::observers::path_model::states_prime;
 use serde::{Deserialize, Serialize};
@@ -94,9 +95,8 @@ fmi2_export::fmu! {
 
 impl FmuModel for PathEstimatorFmu {
     fn initialize(&mut self, _start_time: f64) -> Result<(), String> {
-        if !(self.ship_length > 0.0 && self.ship_speed > 0.0) {
-            return Err("ship_length and ship_speed must be > 0".into());
-        }
+        check_positive("ship_length", self.ship_length)?;
+        check_positive("ship_speed", self.ship_speed)?;
         self.mve = Mve::new(self.p, self.initial_estimate()).map_err(|e| e.to_string())?;
         Ok(())
     }

@@ -2,6 +2,7 @@
 //! Tokyo Maru 7-state design model (`models::observers::path_kalman`). No physics here.
 
 use fmi2_export::FmuModel;
+use models::error::check_positive;
 use models::hull::tokyo_maru::{TokyoMaruCoefficients, L, U};
 use models::observers::path_kalman::{PathKalmanConfig, PathKalmanFilter};
 use serde::{Deserialize, Serialize};
@@ -58,9 +59,7 @@ impl PathKalmanFilterFmu {
             ("euler_step_prime", self.euler_step_prime),
             ("innovation_window", self.innovation_window),
         ] {
-            if !(v > 0.0) {
-                return Err(format!("{name} = {v} must be > 0"));
-            }
+            check_positive(name, v)?;
         }
         self.config.t_r = self.steering_time_constant * U / L;
         Ok(())

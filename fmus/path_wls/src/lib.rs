@@ -7,6 +7,7 @@
 use fmi2_export::FmuModel;
 use models::controllers::path::UpdateDecision;
 use models::controllers::wls::{WlsEstimator, WlsSchedule, WlsSettings};
+use models::error::check_positive;
 use models::hull::tokyo_maru::TokyoMaruCoefficients;
 use models::observers::path_model::states_prime;
 use serde::{Deserialize, Serialize};
@@ -147,17 +148,11 @@ fmi2_export::fmu! {
 
 impl FmuModel for PathWlsFmu {
     fn initialize(&mut self, start_time: f64) -> Result<(), String> {
-        if !(self.ship_length > 0.0 && self.ship_speed > 0.0) {
-            return Err(format!(
-                "ship_length = {} and ship_speed = {} must be > 0",
-                self.ship_length, self.ship_speed
-            ));
-        }
-        for (i, r) in self.r.iter().enumerate() {
-            if !(*r > 0.0 && r.is_finite()) {
-                let n = ["r_heading", "r_yaw_rate", "r_drift_angle", "r_cross_track"][i];
-                return Err(format!("parameter {n} = {r} must be > 0"));
-            }
+        check_positive("ship_length", self.ship_length)?;
+        check_positive("ship_speed", self.ship_speed)?;
+        let names = ["r_heading", "r_yaw_rate", "r_drift_angle", "r_cross_track"];
+        for (n, r) in names.iter().zip(self.r) {
+            check_positive(n, r)?;
         }
         self.start_time = start_time;
         let x0 = initial_estimate(self.initial_depth_ratio);

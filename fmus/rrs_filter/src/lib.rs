@@ -2,6 +2,7 @@
 //! (`models::observers::rrs_filter`). No physics here.
 
 use fmi2_export::FmuModel;
+use models::error::check_positive;
 use models::observers::rrs_filter::{
     RollFilter, RollFilterParams, RrsFilter, RrsFilterInputs, SpeedAdaptation, SpeedFilter,
     SpeedFilterParams, YawFilterParams,
@@ -40,9 +41,7 @@ impl RrsFilterFmu {
     }
 
     fn build(&self) -> Result<RrsFilter, String> {
-        if !(self.design_speed > 0.0) {
-            return Err(format!("design_speed = {} must be > 0", self.design_speed));
-        }
+        check_positive("design_speed", self.design_speed)?;
         RrsFilter::new(
             self.roll_params(),
             self.yaw_params(),
@@ -176,9 +175,7 @@ impl FmuModel for RrsFilterFmu {
     }
 
     fn parameters_changed(&mut self) -> Result<(), String> {
-        if !(self.design_speed > 0.0) {
-            return Err(format!("design_speed = {} must be > 0", self.design_speed));
-        }
+        check_positive("design_speed", self.design_speed)?;
         let roll_params = self.roll_params();
         if roll_params != *self.filter.roll.params() {
             let mut roll = RollFilter::new(roll_params)?;

@@ -3,6 +3,7 @@
 //! No physics here: the variable table maps the model onto FMI variables.
 
 use fmi2_export::FmuModel;
+use models::error::check_positive;
 use models::hull::rrs_ship::{RrsShip, RrsShipInputs, RrsShipOutputs, U_22KN};
 use models::hull::DEG;
 use serde::{Deserialize, Serialize};
@@ -55,9 +56,7 @@ impl RrsShipFmu {
             ("min_speed", self.min_speed),
             ("max_substep", self.max_substep),
         ] {
-            if !(v.is_finite() && v > 0.0) {
-                return Err(format!("parameter {name} = {v} must be finite and > 0"));
-            }
+            check_positive(name, v)?;
         }
         Ok(())
     }

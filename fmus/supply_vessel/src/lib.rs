@@ -3,6 +3,7 @@
 //! physics here: the variable table maps the model onto FMI variables.
 
 use fmi2_export::FmuModel;
+use models::error::check_positive;
 use models::hull::supply_vessel::{
     SupplyVessel, SupplyVesselInputs, SupplyVesselOutputs, NORTHERN_CLIPPER_D, NORTHERN_CLIPPER_M,
 };
@@ -130,12 +131,7 @@ fmi2_export::fmu! {
 impl FmuModel for SupplyVesselFmu {
     fn initialize(&mut self, _start_time: f64) -> Result<(), String> {
         let mut vessel = SupplyVessel::new(self.m, self.d).map_err(|e| e.to_string())?;
-        if !(self.max_substep.is_finite() && self.max_substep > 0.0) {
-            return Err(format!(
-                "parameter max_substep = {} must be finite and > 0",
-                self.max_substep
-            ));
-        }
+        check_positive("max_substep", self.max_substep)?;
         vessel.max_substep = self.max_substep;
         self.vessel = vessel;
         Ok(())

@@ -30,7 +30,8 @@
 //! (z += e h) and τ at the end of the step uses the held inputs. No thrust allocation or limits:
 //! B_u is not given for *Northern Clipper* (spec §3.1), so τ is the generalized force itself.
 
-use super::{positive, ControlError};
+use super::ControlError;
+use crate::error::{check_finite, check_non_negative, check_positive};
 use crate::hull::wrap_pi;
 use serde::{Deserialize, Serialize};
 
@@ -69,32 +70,14 @@ impl DpParams {
 
     pub fn validate(&self) -> Result<(), ControlError> {
         for i in 0..3 {
-            positive("mass", self.mass[i])?;
-            let nonneg = |name: &str, v: f64| {
-                if v >= 0.0 && v.is_finite() {
-                    Ok(())
-                } else {
-                    Err(ControlError(format!(
-                        "parameter {name} = {v} must be >= 0 and finite"
-                    )))
-                }
-            };
-            nonneg("damping", self.damping[i])?;
-            nonneg("bandwidth", self.bandwidth[i])?;
-            if !(self.test_amplitude[i].is_finite() && self.test_frequency[i].is_finite()) {
-                return Err(ControlError(format!(
-                    "test input {i}: amplitude {} and frequency {} must be finite",
-                    self.test_amplitude[i], self.test_frequency[i]
-                )));
-            }
+            check_positive("mass", self.mass[i])?;
+            check_non_negative("damping", self.damping[i])?;
+            check_non_negative("bandwidth", self.bandwidth[i])?;
+            check_finite("test_amplitude", self.test_amplitude[i])?;
+            check_finite("test_frequency", self.test_frequency[i])?;
         }
-        positive("relative_damping", self.relative_damping)?;
-        if !(self.integral_ratio >= 0.0 && self.integral_ratio.is_finite()) {
-            return Err(ControlError(format!(
-                "parameter integral_ratio = {} must be >= 0 and finite",
-                self.integral_ratio
-            )));
-        }
+        check_positive("relative_damping", self.relative_damping)?;
+        check_non_negative("integral_ratio", self.integral_ratio)?;
         Ok(())
     }
 

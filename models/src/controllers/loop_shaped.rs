@@ -29,6 +29,7 @@
 //! with the plant). Per sample: one fixed-size state update, no allocation.
 
 use super::ControlError;
+use crate::error::{check_finite, check_positive, check_positive_or_infinite};
 use nalgebra::{Complex, DMatrix, SMatrix, SVector};
 use serde::{Deserialize, Serialize};
 
@@ -207,10 +208,8 @@ impl<const N: usize> TustinController<N> {
                 tf.num.len()
             )));
         }
-        super::positive("sample step", step)?;
-        if !(limit > 0.0) {
-            return Err(ControlError(format!("command limit {limit} must be > 0")));
-        }
+        check_positive("sample step", step)?;
+        check_positive_or_infinite("command limit", limit)?;
         let a0 = tf.den[0];
         let den: Vec<f64> = tf.den.iter().map(|c| c / a0).collect();
         let mut num = vec![0.0; N + 1 - tf.num.len()];
@@ -331,7 +330,7 @@ impl LoopShapingCommon {
             ("length", self.length),
             ("speed", self.speed),
         ] {
-            super::positive(n, v)?;
+            check_positive(n, v)?;
         }
         Ok(())
     }
@@ -361,8 +360,8 @@ impl HeadingDesign {
     pub fn controller(&self) -> Result<TransferFunction, ControlError> {
         let c = &self.common;
         c.validate()?;
-        super::positive("omega_n", self.omega_n)?;
-        super::positive("zeta", self.zeta)?;
+        check_positive("omega_n", self.omega_n)?;
+        check_positive("zeta", self.zeta)?;
         let w2 = self.omega_n * self.omega_n;
         Ok(TransferFunction {
             num: poly_mul(
@@ -406,10 +405,12 @@ impl Default for TrackDesign {
 impl TrackDesign {
     pub fn controller(&self) -> Result<TransferFunction, ControlError> {
         self.common.validate()?;
-        if !self.gain.is_finite() || self.zeros.iter().chain(&self.poles).any(|v| !v.is_finite()) {
-            return Err(ControlError(
-                "track controller gain, zeros and poles must be finite".into(),
-            ));
+        check_finite("gain", self.gain)?;
+        for v in &self.zeros {
+            check_finite("zeros", *v)?;
+        }
+        for v in &self.poles {
+            check_finite("poles", *v)?;
         }
         Ok(TransferFunction {
             num: poly_from_roots(self.gain, &self.zeros),

@@ -39,19 +39,8 @@ impl From<crate::control::riccati::RiccatiError> for ControlError {
     }
 }
 
-impl From<crate::steering_gear::ParamError> for ControlError {
-    fn from(e: crate::steering_gear::ParamError) -> Self {
+impl From<crate::error::ParamError> for ControlError {
+    fn from(e: crate::error::ParamError) -> Self {
         ControlError(e.to_string())
-    }
-}
-
-/// Checks `value` > 0 and finite.
-pub(crate) fn positive(name: &str, value: f64) -> Result<(), ControlError> {
-    if value > 0.0 && value.is_finite() {
-        Ok(())
-    } else {
-        Err(ControlError(format!(
-            "parameter {name} = {value} must be > 0 and finite"
-        )))
     }
 }

@@ -22,6 +22,7 @@
 //! * Eq. (86): the noise part Č has zeros in the δ′ columns (the rudder angle is exact).
 
 use super::ControlError;
+use crate::error::{check_non_negative, check_positive};
 use crate::hull::tokyo_maru::TokyoMaruCoefficients;
 use nalgebra::{SMatrix, SVector};
 use serde::{Deserialize, Serialize};
@@ -98,7 +99,7 @@ pub struct MveMatrices {
 
 impl MveParams {
     pub fn validate(&self) -> Result<(), ControlError> {
-        super::positive("dt", self.dt)?;
+        check_positive("dt", self.dt)?;
         if self.interval < 2 {
             return Err(ControlError(format!(
                 "parameter interval = {} must be > 1 (the derivation needs l > 1)",
@@ -106,19 +107,16 @@ impl MveParams {
             )));
         }
         for (i, s) in self.sigma.iter().enumerate() {
-            super::positive(["sigma_psi", "sigma_r", "sigma_beta", "sigma_eta"][i], *s)?;
+            check_positive(["sigma_psi", "sigma_r", "sigma_beta", "sigma_eta"][i], *s)?;
         }
-        for v in self
-            .q
-            .iter()
-            .chain(&self.alpha2)
-            .chain(&self.phi)
-            .chain(&self.p0)
-        {
-            if !(*v >= 0.0 && v.is_finite()) {
-                return Err(ControlError(format!(
-                    "MVE variances and intensities must be >= 0 (got {v})"
-                )));
+        for (name, values) in [
+            ("q", &self.q[..]),
+            ("alpha2", &self.alpha2[..]),
+            ("phi", &self.phi[..]),
+            ("p0", &self.p0[..]),
+        ] {
+            for v in values {
+                check_non_negative(name, *v)?;
             }
         }
         Ok(())

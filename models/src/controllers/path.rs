@@ -33,7 +33,10 @@
 //! CAREs) only at initialization, on a parameter change and on the adaptation clock.
 
 use super::lq::lq_gain_feedforward;
-use super::{positive, ControlError};
+use super::ControlError;
+use crate::error::{
+    check_finite, check_non_negative, check_positive, check_positive_or_infinite, require,
+};
 use crate::hull::tokyo_maru::{TokyoMaruCoefficients, L, U};
 pub use crate::observers::path_model::{DisturbanceModel, PathDesignModel, A44, A55, EPSILON};
 use nalgebra::{DMatrix, SMatrix, SVector};
@@ -41,37 +44,40 @@ use serde::{Deserialize, Serialize};
 
 /// Checks design data of the shared 7-state model.
 pub fn validate_design(d: &PathDesignModel) -> Result<(), ControlError> {
-    positive("t_r", d.t_r)?;
-    positive("b11", d.b11)?;
+    check_positive("t_r", d.t_r)?;
+    check_positive("b11", d.b11)?;
     for (n, v) in [
         ("a44", d.a44),
         ("a55", d.a55),
         ("q_n", d.q[0]),
         ("q_y", d.q[1]),
     ] {
-        if !(v >= 0.0 && v.is_finite()) {
-            return Err(ControlError(format!("parameter {n} = {v} must be >= 0")));
-        }
+        check_non_negative(n, v)?;
     }
     for (i, v) in d.r.iter().enumerate() {
-        positive(["r_psi", "r_r", "r_eta"][i], *v)?;
+        check_positive(["r_psi", "r_r", "r_eta"][i], *v)?;
     }
     match d.disturbance {
         DisturbanceModel::ShapingFilter { t_n, t_y } => {
-            positive("t_n", t_n)?;
-            positive("t_y", t_y)?;
+            check_positive("t_n", t_n)?;
+            check_positive("t_y", t_y)?;
         }
-        DisturbanceModel::RandomWalk { epsilon } => positive("epsilon", epsilon)?,
+        DisturbanceModel::RandomWalk { epsilon } => check_positive("epsilon", epsilon)?,
     }
     let c = &d.coefficients;
-    for v in [
-        c.f22, c.f23, c.f25, c.g21, c.g22, c.f32, c.f33, c.f35, c.g31, c.g32,
+    for (n, v) in [
+        ("f22", c.f22),
+        ("f23", c.f23),
+        ("f25", c.f25),
+        ("g21", c.g21),
+        ("g22", c.g22),
+        ("f32", c.f32),
+        ("f33", c.f33),
+        ("f35", c.f35),
+        ("g31", c.g31),
+        ("g32", c.g32),
     ] {
-        if !v.is_finite() {
-            return Err(ControlError(format!(
-                "design coefficient {v} is not finite"
-            )));
-        }
+        check_finite(n, v)?;
     }
     Ok(())
 }
@@ -265,37 +271,29 @@ impl Default for PathControllerParams {
 impl PathControllerParams {
     pub fn validate(&self) -> Result<(), ControlError> {
         validate_design(&self.design)?;
-        if !(self.design_depth_ratio > 0.0) {
-            return Err(ControlError(format!(
-                "parameter design_depth_ratio = {} must be > 0 (inf allowed)",
-                self.design_depth_ratio
-            )));
-        }
-        positive("update_interval", self.update_interval)?;
-        if !(self.schedule_tolerance >= 0.0) {
-            return Err(ControlError(format!(
-                "parameter schedule_tolerance = {} must be >= 0",
-                self.schedule_tolerance
-            )));
-        }
-        positive("length", self.length)?;
-        positive("speed", self.speed)?;
+        check_positive_or_infinite("design_depth_ratio", self.design_depth_ratio)?;
+        check_positive("update_interval", self.update_interval)?;
+        require(
+            self.schedule_tolerance >= 0.0,
+            "schedule_tolerance",
+            self.schedule_tolerance,
+            "must be >= 0",
+        )?;
+        check_positive("length", self.length)?;
+        check_positive("speed", self.speed)?;
         let d = &self.dither;
         if d.enabled {
-            positive("dither_period", d.period)?;
-            positive("dither_window", d.window)?;
-            positive("dither_cycle", d.cycle)?;
+            check_positive("dither_period", d.period)?;
+            check_positive("dither_window", d.window)?;
+            check_positive("dither_cycle", d.cycle)?;
             if d.window > d.cycle {
                 return Err(ControlError(format!(
                     "parameter dither_window = {} must not exceed dither_cycle = {}",
                     d.window, d.cycle
                 )));
             }
-            if !d.amplitude.is_finite() || !d.start.is_finite() {
-                return Err(ControlError(
-                    "dither amplitude and start must be finite".into(),
-                ));
-            }
+            check_finite("dither_amplitude", d.amplitude)?;
+            check_finite("dither_start", d.start)?;
         }
         Ok(())
     }

@@ -32,6 +32,7 @@
 
 use super::ControlError;
 use crate::control::riccati;
+use crate::error::{check_non_negative, check_positive, require};
 use crate::hull::rrs_ship::{RrsHullCoefficients, RrsSpeedLaws};
 use nalgebra::{DMatrix, SMatrix, SVector};
 use serde::{Deserialize, Serialize};
@@ -95,16 +96,9 @@ pub fn lq_gain<const N: usize>(
     q: &[f64; N],
     r: f64,
 ) -> Result<SVector<f64, N>, ControlError> {
-    if !(r > 0.0) {
-        return Err(ControlError(format!("control weight r = {r} must be > 0")));
-    }
+    check_positive("r", r)?;
     for (i, v) in q.iter().enumerate() {
-        if !(*v >= 0.0 && v.is_finite()) {
-            return Err(ControlError(format!(
-                "weight q{} = {v} must be >= 0",
-                i + 1
-            )));
-        }
+        check_non_negative(&format!("q{}", i + 1), *v)?;
     }
     let ad = DMatrix::from_column_slice(N, N, a.as_slice());
     let bd = DMatrix::from_column_slice(N, 1, b.as_slice());
@@ -200,11 +194,14 @@ impl<const N: usize> Default for InnovationProcess<N> {
 /// k_dr < 0: δ_ψ = −(k1 ψ + k2 ψ̇ + k3 x3) for the model ψ̈ = (−ψ̇ + k_dr δ + x3)/τ_r.
 /// Returns (k1, k2, k3).
 pub fn course_gains(tau_r: f64, k_dr: f64, lambda: f64) -> Result<[f64; 3], ControlError> {
-    if !(tau_r > 0.0 && lambda > 0.0 && k_dr != 0.0 && k_dr.is_finite()) {
-        return Err(ControlError(format!(
-            "course controller needs tau_r > 0, lambda > 0, k_dr != 0 (got {tau_r}, {lambda}, {k_dr})"
-        )));
-    }
+    check_positive("tau_r", tau_r)?;
+    check_positive("lambda", lambda)?;
+    require(
+        k_dr != 0.0 && k_dr.is_finite(),
+        "k_dr",
+        k_dr,
+        "must be finite and != 0",
+    )?;
     let k1 = k_dr.signum() * (1.0 / lambda).sqrt();
     let k2 = ((1.0 + 2.0 * tau_r * k_dr * k1).sqrt() - 1.0) / k_dr;
     Ok([k1, k2, 1.0 / k_dr])
@@ -462,24 +459,21 @@ impl Default for RrsAutopilotParams {
 
 impl RrsAutopilotParams {
     pub fn validate(&self) -> Result<(), ControlError> {
-        let pos = |n: &str, v: f64| super::positive(n, v);
-        pos("r", self.r)?;
-        pos("lambda", self.lambda)?;
-        pos("angle_max", self.angle_max)?;
-        pos("rate_max", self.rate_max)?;
-        pos("min_speed", self.min_speed)?;
-        pos("max_substep", self.max_substep)?;
-        pos("innovation_scale", self.innovation_scale)?;
-        if !(self.agc_memory_time >= 0.0) {
-            return Err(ControlError(format!(
-                "parameter agc_memory_time = {} must be >= 0",
-                self.agc_memory_time
-            )));
-        }
+        check_positive("r", self.r)?;
+        check_positive("lambda", self.lambda)?;
+        check_positive("angle_max", self.angle_max)?;
+        check_positive("rate_max", self.rate_max)?;
+        check_positive("min_speed", self.min_speed)?;
+        check_positive("max_substep", self.max_substep)?;
+        check_positive("innovation_scale", self.innovation_scale)?;
+        require(
+            self.agc_memory_time >= 0.0,
+            "agc_memory_time",
+            self.agc_memory_time,
+            "must be >= 0",
+        )?;
         for (n, v) in [("roll_q2", self.roll_q2), ("roll_q3", self.roll_q3)] {
-            if !(v >= 0.0 && v.is_finite()) {
-                return Err(ControlError(format!("parameter {n} = {v} must be >= 0")));
-            }
+            check_non_negative(n, v)?;
         }
         let a = &self.adaptation;
         for (n, v) in [
@@ -488,13 +482,11 @@ impl RrsAutopilotParams {
             ("q_operator", a.q_operator),
             ("alpha", a.alpha),
         ] {
-            if !(v >= 0.0 && v.is_finite()) {
-                return Err(ControlError(format!("parameter {n} = {v} must be >= 0")));
-            }
+            check_non_negative(n, v)?;
         }
-        pos("roll_variance_target", a.roll_variance_target)?;
-        pos("roll_variance_time", a.roll_variance_time)?;
-        pos("heading_error_max", a.heading_error_max)?;
+        check_positive("roll_variance_target", a.roll_variance_target)?;
+        check_positive("roll_variance_time", a.roll_variance_time)?;
+        check_positive("heading_error_max", a.heading_error_max)?;
         if self.laws.k_dr0 == 0.0 {
             return Err(ControlError("k_dr0 = 0: no rudder-to-yaw effect".into()));
         }

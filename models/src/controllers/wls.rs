@@ -23,6 +23,7 @@
 
 use super::path::{validity, UpdateDecision, TABLE_10};
 use super::ControlError;
+use crate::error::{check_finite, check_positive};
 use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
 
@@ -117,7 +118,7 @@ pub fn fit(w: &Window, s: &WlsSettings, p0: [f64; 8]) -> Result<WlsFit, ControlE
             w.rudder.len()
         )));
     }
-    super::positive("dt", s.dt)?;
+    check_positive("dt", s.dt)?;
     let mut p = p0;
     let mut r = residuals(&p, w, s);
     let mut evals = 1;
@@ -197,20 +198,15 @@ pub struct WlsSchedule {
 
 impl WlsSchedule {
     pub fn validate(&self) -> Result<(), ControlError> {
-        super::positive("window_length", self.window_length)?;
-        super::positive("update_cycle", self.update_cycle)?;
+        check_positive("window_length", self.window_length)?;
+        check_positive("update_cycle", self.update_cycle)?;
         if self.window_length > self.update_cycle {
             return Err(ControlError(format!(
                 "parameter window_length = {} must not exceed update_cycle = {}",
                 self.window_length, self.update_cycle
             )));
         }
-        if !self.window_start.is_finite() {
-            return Err(ControlError(format!(
-                "parameter window_start = {} must be finite",
-                self.window_start
-            )));
-        }
+        check_finite("window_start", self.window_start)?;
         Ok(())
     }
 
@@ -260,9 +256,9 @@ impl WlsEstimator {
         p0: [f64; 8],
     ) -> Result<Self, ControlError> {
         schedule.validate()?;
-        super::positive("dt", settings.dt)?;
+        check_positive("dt", settings.dt)?;
         for (i, w) in settings.weight.iter().enumerate() {
-            super::positive(["w_psi", "w_r", "w_beta", "w_eta"][i], *w)?;
+            check_positive(["w_psi", "w_r", "w_beta", "w_eta"][i], *w)?;
         }
         if settings.max_evaluations < 10 {
             return Err(ControlError(format!(

@@ -41,6 +41,7 @@
 //! All random processes run on the fixed internal grid of [`super::shaping`].
 
 use super::shaping::{quantise_time, FirstOrderProcess, Start, WhiteSequence};
+use crate::error::{check_non_negative, check_positive};
 use crate::random::{channel, NoiseStream};
 use serde::{Deserialize, Serialize};
 
@@ -182,27 +183,13 @@ impl CurrentParams {
     }
 
     pub fn validate(&self) -> Result<(), String> {
-        let pos = |name: &str, v: f64| {
-            if v > 0.0 && v.is_finite() {
-                Ok(())
-            } else {
-                Err(format!("{name} = {v} must be > 0"))
-            }
-        };
-        let nonneg = |name: &str, v: f64| {
-            if v >= 0.0 && v.is_finite() {
-                Ok(())
-            } else {
-                Err(format!("{name} = {v} must be >= 0"))
-            }
-        };
-        pos("ship_speed", self.ship_speed)?;
-        pos("ship_length", self.ship_length)?;
-        pos("density", self.density)?;
-        pos("internal_step", self.internal_step)?;
-        pos("shaping_time_constant", self.shaping_time_constant)?;
-        pos("bias_time_constant", self.bias_time_constant)?;
-        nonneg("ramp_duration", self.ramp_duration)?;
+        check_positive("ship_speed", self.ship_speed)?;
+        check_positive("ship_length", self.ship_length)?;
+        check_positive("density", self.density)?;
+        check_positive("internal_step", self.internal_step)?;
+        check_positive("shaping_time_constant", self.shaping_time_constant)?;
+        check_positive("bias_time_constant", self.bias_time_constant)?;
+        check_non_negative("ramp_duration", self.ramp_duration)?;
         if !(self.design_t_ramp > self.design_t_constant) {
             return Err(format!(
                 "design_t_ramp = {} must exceed design_t_constant = {}",
@@ -220,7 +207,7 @@ impl CurrentParams {
             ("bias_psi_y", self.bias_psi[1]),
             ("bias_psi_n", self.bias_psi[2]),
         ] {
-            nonneg(n, v)?;
+            check_non_negative(n, v)?;
         }
         Ok(())
     }
@@ -322,9 +309,7 @@ impl Current {
         t_start: f64,
         ramp_duration: f64,
     ) -> Result<(), String> {
-        if !(ramp_duration >= 0.0) {
-            return Err(format!("ramp_duration = {ramp_duration} must be >= 0"));
-        }
+        check_non_negative("ramp_duration", ramp_duration)?;
         let p = &mut self.params;
         p.speed_initial = speed_initial;
         p.speed_final = speed_final;

@@ -58,6 +58,7 @@
 //! ω = √(2πg/λ) = 0.711 rad/s, L 2085-2089). Use `hs` 1.25 or 2.5 for the band's ends.
 
 use super::shaping::{quantise_time, SecondOrderProcess, Start};
+use crate::error::{check_non_negative, check_positive, require};
 use crate::random::{channel, NoiseStream};
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
@@ -124,17 +125,15 @@ impl SeaState {
     }
 
     pub fn validate(&self) -> Result<(), String> {
-        if !(self.hs >= 0.0 && self.hs.is_finite()) {
-            return Err(format!(
-                "significant_wave_height = {} must be >= 0",
-                self.hs
-            ));
-        }
-        if !(self.period > 0.0 && self.period.is_finite()) {
-            return Err(format!("wave_period = {} must be > 0", self.period));
-        }
-        if self.spectrum == SpectrumKind::Jonswap && !(self.gamma >= 1.0 && self.gamma <= 20.0) {
-            return Err(format!("jonswap_gamma = {} must be in [1, 20]", self.gamma));
+        check_non_negative("significant_wave_height", self.hs)?;
+        check_positive("wave_period", self.period)?;
+        if self.spectrum == SpectrumKind::Jonswap {
+            require(
+                (1.0..=20.0).contains(&self.gamma),
+                "jonswap_gamma",
+                self.gamma,
+                "must be in [1, 20]",
+            )?;
         }
         Ok(())
     }
@@ -376,27 +375,11 @@ impl WaveParams {
                 self.components
             ));
         }
-        if !(self.shaping_damping > 0.0) {
-            return Err(format!(
-                "shaping_damping = {} must be > 0",
-                self.shaping_damping
-            ));
-        }
-        if !(self.internal_step > 0.0 && self.internal_step.is_finite()) {
-            return Err(format!(
-                "internal_step = {} must be > 0",
-                self.internal_step
-            ));
-        }
-        if !(self.wf_omega0 > 0.0 && self.wf_zeta > 0.0) {
-            return Err(format!(
-                "wf_omega0 = {} and wf_zeta = {} must be > 0",
-                self.wf_omega0, self.wf_zeta
-            ));
-        }
-        if !(self.gravity > 0.0) {
-            return Err(format!("gravity = {} must be > 0", self.gravity));
-        }
+        check_positive("shaping_damping", self.shaping_damping)?;
+        check_positive("internal_step", self.internal_step)?;
+        check_positive("wf_omega0", self.wf_omega0)?;
+        check_positive("wf_zeta", self.wf_zeta)?;
+        check_positive("gravity", self.gravity)?;
         Ok(())
     }
 }

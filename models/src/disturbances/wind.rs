@@ -26,6 +26,7 @@
 //! V is clipped at 0.
 
 use super::shaping::{quantise_time, FirstOrderProcess, Start};
+use crate::error::{check_non_negative, check_positive};
 use crate::random::{channel, NoiseStream};
 use serde::{Deserialize, Serialize};
 
@@ -71,18 +72,14 @@ impl WindParams {
             ("gust_std", self.gust_std),
             ("direction_std", self.direction_std),
         ] {
-            if !(v >= 0.0 && v.is_finite()) {
-                return Err(format!("{n} = {v} must be >= 0"));
-            }
+            check_non_negative(n, v)?;
         }
         for (n, v) in [
             ("gust_time_constant", self.gust_time_constant),
             ("direction_time_constant", self.direction_time_constant),
             ("internal_step", self.internal_step),
         ] {
-            if !(v > 0.0 && v.is_finite()) {
-                return Err(format!("{n} = {v} must be > 0"));
-            }
+            check_positive(n, v)?;
         }
         Ok(())
     }

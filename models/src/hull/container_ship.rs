@@ -32,9 +32,9 @@
 //! the bound of §8), inputs held over the step; see [`crate::integrate`]. U, the rudder and the
 //! shaft logic are evaluated inside every RK stage (§8).
 
-use super::{check_finite, check_positive, mss_rudder_rate, wrap_pi, DEG};
+use super::{mss_rudder_rate, wrap_pi, DEG};
+use crate::error::{check_finite, check_positive, require, ParamError};
 use crate::integrate::rk4_advance;
-use crate::steering_gear::ParamError;
 use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
@@ -179,13 +179,12 @@ impl ContainerShipParams {
         check_positive("rudder_rate_max", self.rudder_rate_max)?;
         check_positive("shaft_max_rpm", self.shaft_max_rpm)?;
         check_positive("shaft_min_rpm", self.shaft_min_rpm)?;
-        if self.shaft_min_rpm >= self.shaft_max_rpm {
-            return Err(ParamError {
-                name: "shaft_min_rpm",
-                value: self.shaft_min_rpm,
-                rule: "must be < shaft_max_rpm",
-            });
-        }
+        require(
+            self.shaft_min_rpm < self.shaft_max_rpm,
+            "shaft_min_rpm",
+            self.shaft_min_rpm,
+            "must be < shaft_max_rpm",
+        )?;
         check_positive("gm", self.gm)?;
         check_positive("min_speed", self.min_speed)?;
         check_positive("max_substep", self.max_substep)?;

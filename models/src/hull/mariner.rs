@@ -22,9 +22,9 @@
 //! RK4 with a fixed sub-step ≤ [`MarinerParams::max_substep`] (default 0.05 s), inputs held over
 //! the step; see [`crate::integrate`].
 
-use super::{check_finite, check_positive, mss_rudder_rate, wrap_pi, DEG};
+use super::{mss_rudder_rate, wrap_pi, DEG};
+use crate::error::{check_finite, check_positive, require, ParamError};
 use crate::integrate::rk4_advance;
-use crate::steering_gear::ParamError;
 use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 
@@ -166,13 +166,12 @@ impl Mariner {
         for (i, &s) in state.iter().enumerate() {
             check_finite(NAMES[i], s)?;
         }
-        if params.u0 + state[0] <= 0.0 {
-            return Err(ParamError {
-                name: "delta_u",
-                value: state[0],
-                rule: "u0 + delta_u must be > 0",
-            });
-        }
+        require(
+            params.u0 + state[0] > 0.0,
+            "delta_u",
+            state[0],
+            "u0 + delta_u must be > 0",
+        )?;
         Ok(Mariner {
             params,
             state,

@@ -51,36 +51,6 @@ pub(crate) fn mss_rudder_rate(command: f64, delta: f64, max: f64, rate_max: f64)
     (dc - delta).clamp(-rate_max, rate_max)
 }
 
-pub(crate) fn check_positive(
-    name: &'static str,
-    v: f64,
-) -> Result<(), crate::steering_gear::ParamError> {
-    if v.is_finite() && v > 0.0 {
-        Ok(())
-    } else {
-        Err(crate::steering_gear::ParamError {
-            name,
-            value: v,
-            rule: "must be finite and > 0",
-        })
-    }
-}
-
-pub(crate) fn check_finite(
-    name: &'static str,
-    v: f64,
-) -> Result<(), crate::steering_gear::ParamError> {
-    if v.is_finite() {
-        Ok(())
-    } else {
-        Err(crate::steering_gear::ParamError {
-            name,
-            value: v,
-            rule: "must be finite",
-        })
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;

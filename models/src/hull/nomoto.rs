@@ -46,9 +46,9 @@
 //! RK4 with a fixed sub-step ≤ [`NomotoShip::max_substep`] (default 0.1 s, i.e. ≤ 0.008 L/U
 //! for the DDG-51 at 22 kn), inputs held over the step; see [`crate::integrate`].
 
-use super::{check_finite, check_positive, wrap_pi, KNOT};
+use super::{wrap_pi, KNOT};
+use crate::error::{check_finite, check_positive, require, ParamError};
 use crate::integrate::rk4_advance;
-use crate::steering_gear::ParamError;
 use nalgebra::{Matrix2, Vector2};
 use serde::{Deserialize, Serialize};
 
@@ -147,13 +147,12 @@ impl NomotoShip {
                     check_finite(name, v)?;
                 }
                 let det = m[0][0] * m[1][1] - m[0][1] * m[1][0];
-                if !(det.abs() > 0.0) {
-                    return Err(ParamError {
-                        name: "m (determinant)",
-                        value: det,
-                        rule: "mass matrix must be invertible",
-                    });
-                }
+                require(
+                    det.abs() > 0.0,
+                    "m (determinant)",
+                    det,
+                    "mass matrix must be invertible",
+                )?;
             }
         }
         Ok(NomotoShip {

@@ -45,9 +45,9 @@
 //! RK4 with a fixed sub-step ≤ [`RrsShip::max_substep`] (default 0.05 s; the fastest pole of
 //! either model is ≈ 1.2 rad/s), inputs held over the step; see [`crate::integrate`].
 
-use super::{check_positive, wrap_pi, KNOT};
+use super::{wrap_pi, KNOT};
+use crate::error::{check_finite, check_positive, ParamError};
 use crate::integrate::rk4_advance;
-use crate::steering_gear::ParamError;
 use nalgebra::{SMatrix, SVector};
 use serde::{Deserialize, Serialize};
 
@@ -120,7 +120,7 @@ impl RrsHullCoefficients {
             ("k_rp", self.k_rp),
             ("k_vp", self.k_vp),
         ] {
-            super::check_finite(n, v)?;
+            check_finite(n, v)?;
         }
         Ok(())
     }
@@ -158,7 +158,7 @@ impl RrsWaveCoefficients {
             ("tau_wr", self.tau_wr),
             ("k_wp", self.k_wp),
         ] {
-            super::check_finite(n, v)?;
+            check_finite(n, v)?;
         }
         Ok(())
     }
@@ -251,7 +251,7 @@ impl RrsSpeedLaws {
             ("z_n1", self.z_n1),
             ("k_vr0", self.k_vr0),
         ] {
-            super::check_finite(n, v)?;
+            check_finite(n, v)?;
         }
         Ok(())
     }

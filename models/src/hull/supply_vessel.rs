@@ -25,9 +25,9 @@
 //! RK4 with a fixed sub-step ≤ [`SupplyVessel::max_substep`] (default 0.1 s; the fastest open-loop
 //! time constant is 8.40 s), inputs held over the step; see [`crate::integrate`].
 
-use super::{check_finite, check_positive, wrap_pi};
+use super::wrap_pi;
+use crate::error::{check_finite, check_positive, require, ParamError};
 use crate::integrate::rk4_advance;
-use crate::steering_gear::ParamError;
 use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 
@@ -103,13 +103,12 @@ impl SupplyVessel {
             check_positive(MN[i][i], m[i][i])?;
         }
         let mm = Matrix3::from_fn(|i, j| m[i][j]);
-        if mm.try_inverse().is_none() {
-            return Err(ParamError {
-                name: "m (determinant)",
-                value: mm.determinant(),
-                rule: "must be invertible",
-            });
-        }
+        require(
+            mm.try_inverse().is_some(),
+            "m (determinant)",
+            mm.determinant(),
+            "must be invertible",
+        )?;
         Ok(SupplyVessel {
             m,
             d,

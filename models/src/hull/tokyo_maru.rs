@@ -39,9 +39,9 @@
 //! [`TokyoMaruIntegration::Euler`] reproduces the report's fixed-step Euler (Δt′ = 0.005) for
 //! comparisons with its figures.
 
-use super::{check_positive, wrap_pi, KNOT};
+use super::{wrap_pi, KNOT};
+use crate::error::{check_positive, check_positive_or_infinite, ParamError};
 use crate::integrate::zoh_discretise;
-use crate::steering_gear::ParamError;
 use nalgebra::{SMatrix, SVector};
 use serde::{Deserialize, Serialize};
 
@@ -289,13 +289,7 @@ impl TokyoMaru {
     /// A ship on the track (all states 0) at depth ratio `depth_ratio` (≥ 1.30 or ∞ recommended;
     /// must be > 0).
     pub fn new(depth_ratio: f64) -> Result<Self, ParamError> {
-        if !(depth_ratio > 0.0) {
-            return Err(ParamError {
-                name: "depth_ratio",
-                value: depth_ratio,
-                rule: "must be > 0 (inf allowed)",
-            });
-        }
+        check_positive_or_infinite("depth_ratio", depth_ratio)?;
         Ok(TokyoMaru {
             depth_ratio,
             coefficients_override: None,
@@ -321,13 +315,7 @@ impl TokyoMaru {
 
     /// Checks the tunable parameters.
     pub fn validate(&self) -> Result<(), ParamError> {
-        if !(self.depth_ratio > 0.0) {
-            return Err(ParamError {
-                name: "depth_ratio",
-                value: self.depth_ratio,
-                rule: "must be > 0 (inf allowed)",
-            });
-        }
+        check_positive_or_infinite("depth_ratio", self.depth_ratio)?;
         check_positive("t_r", self.t_r)?;
         if let TokyoMaruIntegration::Euler { max_substep_prime } = self.integration {
             check_positive("max_substep_prime", max_substep_prime)?;

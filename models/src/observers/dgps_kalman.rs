@@ -23,6 +23,7 @@
 //!   recursion from P₀ is an option. A co-simulation step h is ⌈h/Δt⌉ filter cycles with the
 //!   measurement held.
 
+use crate::error::{check_non_negative, check_positive};
 use crate::hull::wrap_pi;
 use nalgebra::{Matrix2, SMatrix, SVector};
 use serde::{Deserialize, Serialize};
@@ -107,13 +108,9 @@ impl Default for DgpsKalmanParams {
 impl DgpsKalmanParams {
     pub fn validate(&self) -> Result<(), String> {
         for (n, v) in [("dt", self.dt), ("sp", self.sp), ("r", self.r)] {
-            if !(v > 0.0 && v.is_finite()) {
-                return Err(format!("{n} = {v} must be finite and > 0"));
-            }
+            check_positive(n, v)?;
         }
-        if !(self.p0 >= 0.0 && self.p0.is_finite()) {
-            return Err(format!("p0 = {} must be finite and >= 0", self.p0));
-        }
+        check_non_negative("p0", self.p0)?;
         Ok(())
     }
 }

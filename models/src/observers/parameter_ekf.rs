@@ -41,6 +41,7 @@
 //!   history is kept as prefix sums (32 bytes per update: 115 kB per hour at 1 s), which is
 //!   what makes the window exact; it grows by doubling, so no allocation happens on most steps.
 
+use crate::error::{check_finite, check_non_negative, check_positive, require};
 use crate::integrate::rk4_advance;
 use nalgebra::{Matrix2, SMatrix, SVector, Vector2};
 use serde::{Deserialize, Serialize};
@@ -125,9 +126,7 @@ impl ParameterEkfParams {
             ("sample_interval", self.sample_interval),
             ("max_substep", self.max_substep),
         ] {
-            if !(v > 0.0 && v.is_finite()) {
-                return Err(format!("{n} = {v} must be finite and > 0"));
-            }
+            check_positive(n, v)?;
         }
         for (n, v) in [
             ("initial_state_variance", self.initial_state_variance),
@@ -138,43 +137,38 @@ impl ParameterEkfParams {
             ("process_noise", self.process_noise),
             ("coefficient_noise", self.coefficient_noise),
         ] {
-            if !(v >= 0.0 && v.is_finite()) {
-                return Err(format!("{n} = {v} must be finite and >= 0"));
-            }
+            check_non_negative(n, v)?;
         }
-        if !(self.averaging_fraction > 0.0 && self.averaging_fraction <= 1.0) {
-            return Err(format!(
-                "averaging_fraction = {} must be in (0, 1]",
-                self.averaging_fraction
-            ));
-        }
+        require(
+            self.averaging_fraction > 0.0 && self.averaging_fraction <= 1.0,
+            "averaging_fraction",
+            self.averaging_fraction,
+            "must be in (0, 1]",
+        )?;
         let names = [["m11", "m12"], ["m21", "m22"]];
         for i in 0..2 {
             for j in 0..2 {
-                let v = self.mass[i][j];
-                if !v.is_finite() {
-                    return Err(format!("{} = {v} must be finite", names[i][j]));
-                }
+                check_finite(names[i][j], self.mass[i][j])?;
             }
         }
         let det = self.mass[0][0] * self.mass[1][1] - self.mass[0][1] * self.mass[1][0];
-        if !(det.abs() > 0.0) {
-            return Err(format!(
-                "mass matrix determinant = {det} must be non-zero (m11, m12, m21, m22)"
-            ));
-        }
+        require(
+            det.abs() > 0.0,
+            "m (determinant)",
+            det,
+            "mass matrix must be invertible",
+        )?;
         for (n, v) in [("b1", self.rudder[0]), ("b2", self.rudder[1])] {
-            if !v.is_finite() {
-                return Err(format!("{n} = {v} must be finite"));
-            }
+            check_finite(n, v)?;
         }
-        for (i, v) in self.initial_coefficients.iter().enumerate() {
-            if !v.is_finite() {
-                return Err(format!(
-                    "initial coefficient p{} = {v} must be finite",
-                    i + 1
-                ));
-            }
+        let names = [
+            "initial_neg_y_v",
+            "initial_m_minus_y_r",
+            "initial_neg_n_v",
+            "initial_mxg_minus_n_r",
+        ];
+        for (n, v) in names.iter().zip(self.initial_coefficients) {
+            check_finite(n, v)?;
         }
         Ok(())
     }

@@ -27,9 +27,9 @@
 //! * Integration: RK4 with sub-steps ≤ `max_substep` (default 0.1 s), measurements and τ held over
 //!   the step (the paper samples at 1 Hz).
 
+use crate::error::{check_finite, check_non_negative, check_positive, require, ParamError};
 use crate::hull::wrap_pi;
 use crate::integrate::rk4_advance;
-use crate::steering_gear::ParamError;
 use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 
@@ -93,53 +93,28 @@ impl PassiveObserverParams {
     }
 
     pub fn validate(&self) -> Result<(), ParamError> {
-        let pos = |name: &'static str, v: f64| {
-            if v > 0.0 && v.is_finite() {
-                Ok(())
-            } else {
-                Err(ParamError {
-                    name,
-                    value: v,
-                    rule: "must be finite and > 0",
-                })
-            }
-        };
         for i in 0..3 {
-            pos("t_bias", self.t_bias[i])?;
-            pos("zeta", self.zeta[i])?;
-            pos("omega0", self.omega0[i])?;
-            pos("zeta_n", self.zeta_n[i])?;
-            pos("omega_c", self.omega_c[i])?;
+            check_positive("t_bias", self.t_bias[i])?;
+            check_positive("zeta", self.zeta[i])?;
+            check_positive("omega0", self.omega0[i])?;
+            check_positive("zeta_n", self.zeta_n[i])?;
+            check_positive("omega_c", self.omega_c[i])?;
             for j in 0..3 {
-                if !self.m[i][j].is_finite() || !self.d[i][j].is_finite() {
-                    return Err(ParamError {
-                        name: "m/d",
-                        value: f64::NAN,
-                        rule: "must be finite",
-                    });
-                }
+                check_finite("m", self.m[i][j])?;
+                check_finite("d", self.d[i][j])?;
             }
-            if !(self.kappa[i] >= 0.0 && self.lambda[i] >= 0.0) {
-                return Err(ParamError {
-                    name: "kappa/lambda",
-                    value: self.kappa[i].min(self.lambda[i]),
-                    rule: "must be >= 0",
-                });
-            }
+            check_non_negative("kappa", self.kappa[i])?;
+            check_non_negative("lambda", self.lambda[i])?;
         }
-        pos("gamma", self.gamma)?;
-        pos("max_substep", self.max_substep)?;
-        if Matrix3::from_fn(|i, j| self.m[i][j])
-            .try_inverse()
-            .is_none()
-        {
-            return Err(ParamError {
-                name: "m",
-                value: 0.0,
-                rule: "must be invertible",
-            });
-        }
-        Ok(())
+        check_positive("gamma", self.gamma)?;
+        check_positive("max_substep", self.max_substep)?;
+        let m = Matrix3::from_fn(|i, j| self.m[i][j]);
+        require(
+            m.try_inverse().is_some(),
+            "m (determinant)",
+            m.determinant(),
+            "must be invertible",
+        )
     }
 
     /// Eq. 48 tuning rule 1/T ≪ λ/κ < ω₀ < ω_c per DOF ("≪" taken as a factor 10). The paper's own
@@ -174,7 +149,7 @@ fn rot(psi: f64) -> Matrix3<f64> {
 impl PassiveObserver {
     /// An observer with η̂(0) = `eta0`, the other states 0.
     pub fn new(params: PassiveObserverParams, eta0: [f64; 3]) -> Result<Self, String> {
-        params.validate().map_err(|e| e.to_string())?;
+        params.validate()?;
         let mut o = PassiveObserver {
             k1: [0.0; 3],
             k2: [0.0; 3],
@@ -191,7 +166,7 @@ impl PassiveObserver {
 
     /// Replaces the parameters (gain scheduling on ω₀, Remark 2); the state carries over.
     pub fn set_params(&mut self, params: PassiveObserverParams) -> Result<(), String> {
-        params.validate().map_err(|e| e.to_string())?;
+        params.validate()?;
         for i in 0..3 {
             let (a, b, c) = notch_gains(
                 params.zeta[i],

@@ -21,10 +21,10 @@
 
 use super::path_model::{DisturbanceModel, PathDesignModel, NX, NZ};
 use crate::control::riccati::RiccatiError;
+use crate::error::{check_positive, check_positive_or_infinite, require, ParamError};
 use crate::hull::tokyo_maru::TokyoMaruCoefficients;
 use crate::hull::tokyo_maru::{L, U};
 use crate::integrate::substeps;
-use crate::steering_gear::ParamError;
 use nalgebra::{SMatrix, SVector};
 use serde::{Deserialize, Serialize};
 
@@ -69,45 +69,26 @@ impl Default for PathKalmanConfig {
 impl PathKalmanConfig {
     /// Validates and builds the design model.
     pub fn design(&self) -> Result<PathDesignModel, ParamError> {
-        let pos = |name: &'static str, v: f64| {
-            if v > 0.0 {
-                Ok(())
-            } else {
-                Err(ParamError {
-                    name,
-                    value: v,
-                    rule: "must be > 0",
-                })
-            }
-        };
-        pos("design_depth_ratio", self.design_depth_ratio)?;
-        pos("t_r", self.t_r)?;
-        if self.adapted_depth_ratio.is_nan() {
-            return Err(ParamError {
-                name: "adapted_depth_ratio",
-                value: self.adapted_depth_ratio,
-                rule: "must be a number (<= 0: not used)",
-            });
-        }
+        check_positive_or_infinite("design_depth_ratio", self.design_depth_ratio)?;
+        check_positive("t_r", self.t_r)?;
+        require(
+            !self.adapted_depth_ratio.is_nan(),
+            "adapted_depth_ratio",
+            self.adapted_depth_ratio,
+            "must be a number (<= 0: not used)",
+        )?;
         for (name, v) in [
             ("r_heading", self.r[0]),
             ("r_yaw_rate", self.r[1]),
             ("r_cross_track", self.r[2]),
         ] {
-            pos(name, v)?;
-            if !v.is_finite() {
-                return Err(ParamError {
-                    name,
-                    value: v,
-                    rule: "must be finite",
-                });
-            }
+            check_positive(name, v)?;
         }
         let mut m = if self.random_walk {
-            pos("epsilon", self.epsilon)?;
+            check_positive("epsilon", self.epsilon)?;
             PathDesignModel::random_walk(self.design_depth_ratio)
         } else {
-            pos("shaping_time_constant", self.shaping_time_constant)?;
+            check_positive("shaping_time_constant", self.shaping_time_constant)?;
             PathDesignModel::shaping_filter(self.design_depth_ratio)
         };
         if self.random_walk {

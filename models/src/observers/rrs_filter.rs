@@ -54,45 +54,9 @@
 //! Eqs. 4.100-4.101 are [`second_order_speed_gains`].
 
 use crate::control::riccati::{self, RiccatiError};
-use crate::steering_gear::ParamError;
+use crate::error::{check_finite, check_non_negative, check_positive, require, ParamError};
 use nalgebra::{DMatrix, SMatrix, SVector};
 use serde::{Deserialize, Serialize};
-
-fn positive(name: &'static str, v: f64) -> Result<(), ParamError> {
-    if v > 0.0 && v.is_finite() {
-        Ok(())
-    } else {
-        Err(ParamError {
-            name,
-            value: v,
-            rule: "must be finite and > 0",
-        })
-    }
-}
-
-fn finite(name: &'static str, v: f64) -> Result<(), ParamError> {
-    if v.is_finite() {
-        Ok(())
-    } else {
-        Err(ParamError {
-            name,
-            value: v,
-            rule: "must be finite",
-        })
-    }
-}
-
-fn nonneg(name: &'static str, v: f64) -> Result<(), ParamError> {
-    if v >= 0.0 && v.is_finite() {
-        Ok(())
-    } else {
-        Err(ParamError {
-            name,
-            value: v,
-            rule: "must be finite and >= 0",
-        })
-    }
-}
 
 // ---------------------------------------------------------------------------------------------
 // Roll filter
@@ -132,14 +96,14 @@ impl RollFilterParams {
     }
 
     pub fn validate(&self) -> Result<(), ParamError> {
-        positive("omega_n", self.omega_n)?;
-        nonneg("z_n", self.z_n)?;
-        finite("k_dp", self.k_dp)?;
-        finite("k_vp", self.k_vp)?;
-        finite("k_dv", self.k_dv)?;
-        positive("tau_v", self.tau_v)?;
-        positive("roll_q1", self.q1)?;
-        positive("roll_q2", self.q2)?;
+        check_positive("omega_n", self.omega_n)?;
+        check_non_negative("z_n", self.z_n)?;
+        check_finite("k_dp", self.k_dp)?;
+        check_finite("k_vp", self.k_vp)?;
+        check_finite("k_dv", self.k_dv)?;
+        check_positive("tau_v", self.tau_v)?;
+        check_positive("roll_q1", self.q1)?;
+        check_positive("roll_q2", self.q2)?;
         Ok(())
     }
 }
@@ -177,7 +141,7 @@ pub struct RollFilter {
 
 impl RollFilter {
     pub fn new(params: RollFilterParams) -> Result<Self, String> {
-        params.validate().map_err(|e| e.to_string())?;
+        params.validate()?;
         let k = roll_filter_gains(params.omega_n, params.z_n, params.q1, params.q2)
             .map_err(|e| format!("roll-filter gains: {e}"))?;
         Ok(RollFilter {
@@ -301,27 +265,26 @@ impl YawFilterParams {
     }
 
     pub fn validate(&self) -> Result<(), ParamError> {
-        positive("tau_r", self.tau_r)?;
-        finite("k_dr", self.k_dr)?;
-        positive("a", self.a)?;
-        nonneg("e_w1", self.e_w1)?;
-        nonneg("e_w2", self.e_w2)?;
-        nonneg("e_v", self.e_v)?;
-        positive("e_w3", self.e_w3)?;
-        positive("ec_divisor", self.ec_divisor)?;
-        positive("variance_time_constant", self.variance_time_constant)?;
-        positive("e_w3_min", self.e_w3_min)?;
-        positive("e_w3_max", self.e_w3_max)?;
-        if self.e_w3_min > self.e_w3_max {
-            return Err(ParamError {
-                name: "e_w3_min",
-                value: self.e_w3_min,
-                rule: "must be <= e_w3_max",
-            });
-        }
-        finite("k_vr", self.k_vr)?;
-        finite("k_dv", self.k_dv)?;
-        positive("tau_v", self.tau_v)?;
+        check_positive("tau_r", self.tau_r)?;
+        check_finite("k_dr", self.k_dr)?;
+        check_positive("a", self.a)?;
+        check_non_negative("e_w1", self.e_w1)?;
+        check_non_negative("e_w2", self.e_w2)?;
+        check_non_negative("e_v", self.e_v)?;
+        check_positive("e_w3", self.e_w3)?;
+        check_positive("ec_divisor", self.ec_divisor)?;
+        check_positive("variance_time_constant", self.variance_time_constant)?;
+        check_positive("e_w3_min", self.e_w3_min)?;
+        check_positive("e_w3_max", self.e_w3_max)?;
+        require(
+            self.e_w3_min <= self.e_w3_max,
+            "e_w3_min",
+            self.e_w3_min,
+            "must be <= e_w3_max",
+        )?;
+        check_finite("k_vr", self.k_vr)?;
+        check_finite("k_dv", self.k_dv)?;
+        check_positive("tau_v", self.tau_v)?;
         Ok(())
     }
 }
@@ -389,7 +352,7 @@ pub struct YawFilter {
 impl YawFilter {
     /// Gains and P start at the CARE solution for the start E[w3²].
     pub fn new(params: YawFilterParams) -> Result<Self, String> {
-        params.validate().map_err(|e| e.to_string())?;
+        params.validate()?;
         let (k, p) = yaw_filter_gains(
             params.tau_r,
             params.tau_f(),
@@ -420,7 +383,7 @@ impl YawFilter {
     /// Replaces the model parameters (e.g. on-line τ_r, k_dr estimates or a new a); the state,
     /// P and the adaptation carry over.
     pub fn set_params(&mut self, params: YawFilterParams) -> Result<(), String> {
-        params.validate().map_err(|e| e.to_string())?;
+        params.validate()?;
         if params.adaptive != self.params.adaptive || !params.adaptive {
             self.e_w3 = params.e_w3;
         }
@@ -596,17 +559,16 @@ impl SpeedFilterParams {
     }
 
     pub fn validate(&self) -> Result<(), ParamError> {
-        positive("speed_tau0", self.tau0)?;
-        positive("speed_tau_min", self.tau_min)?;
-        if self.tau_min > self.tau0 {
-            return Err(ParamError {
-                name: "speed_tau_min",
-                value: self.tau_min,
-                rule: "must be <= speed_tau0",
-            });
-        }
-        nonneg("speed_c", self.c)?;
-        positive("speed_sigma_z", self.sigma_z)?;
+        check_positive("speed_tau0", self.tau0)?;
+        check_positive("speed_tau_min", self.tau_min)?;
+        require(
+            self.tau_min <= self.tau0,
+            "speed_tau_min",
+            self.tau_min,
+            "must be <= speed_tau0",
+        )?;
+        check_non_negative("speed_c", self.c)?;
+        check_positive("speed_sigma_z", self.sigma_z)?;
         Ok(())
     }
 
@@ -639,7 +601,7 @@ pub struct SpeedFilter {
 
 impl SpeedFilter {
     pub fn new(params: SpeedFilterParams, u0: f64) -> Result<Self, String> {
-        params.validate().map_err(|e| e.to_string())?;
+        params.validate()?;
         Ok(SpeedFilter {
             tau_f: params.tau0,
             params,
@@ -720,7 +682,7 @@ impl RrsFilter {
         sample_time: f64,
         u0: f64,
     ) -> Result<Self, String> {
-        positive("sample_time", sample_time).map_err(|e| e.to_string())?;
+        check_positive("sample_time", sample_time)?;
         Ok(RrsFilter {
             roll: RollFilter::new(roll)?,
             yaw: YawFilter::new(yaw)?,
