@@ -4,10 +4,10 @@
 //! `C = −B⁻¹GᵀS∞` (004 eq. 34), S∞ the stabilising solution of the steady-state Riccati
 //! equation `0 = −SF − FᵀS + SGB⁻¹GᵀS − A` (004 eq. 35), minimising
 //! `J = ½∫(xᵀAx + uᵀBu)dt` (004 eq. 30). Potter's eigenvector method (004 eqs. 36–38) and the
-//! sign-function CARE of [`crate::control::riccati::care`] give the same S∞ (004 §2.7: "any modern
+//! sign-function CARE of [`crate::riccati::care`] give the same S∞ (004 §2.7: "any modern
 //! CARE solver gives the same result"); this module uses the latter.
 
-use crate::control::riccati;
+use crate::riccati;
 use nalgebra::DMatrix;
 
 use super::ControlError;

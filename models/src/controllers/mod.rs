@@ -1,7 +1,7 @@
 //! Controllers: LQ designs and the autopilots the controller FMUs expose.
 //!
 //! * [`lq`]: continuous LQ state feedback in the sources' sign convention (u = C x), shared by
-//!   every LQ design here; the Riccati numerics themselves are [`crate::control::riccati`].
+//!   every LQ design here; the Riccati numerics themselves are [`crate::riccati`].
 //! * [`path`]: Parsons & Cuong (1980, source 004) optimal steady-state path controller of the
 //!   *Tokyo Maru* in restricted water, with gain scheduling over depth, the partial adaptation
 //!   of f23/f25 from a parameter estimator (Table 10 validity logic) and the open-loop dither.
@@ -33,8 +33,8 @@ impl fmt::Display for ControlError {
 
 impl std::error::Error for ControlError {}
 
-impl From<crate::control::riccati::RiccatiError> for ControlError {
-    fn from(e: crate::control::riccati::RiccatiError) -> Self {
+impl From<crate::riccati::RiccatiError> for ControlError {
+    fn from(e: crate::riccati::RiccatiError) -> Self {
         ControlError(format!("Riccati equation: {e}"))
     }
 }

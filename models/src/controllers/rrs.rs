@@ -31,9 +31,9 @@
 //!   [interpretation] shapes of rrs_controller_results §2.3, every breakpoint a parameter.
 
 use super::ControlError;
-use crate::control::riccati;
 use crate::error::{check_non_negative, check_positive, require};
 use crate::hull::rrs_ship::{RrsHullCoefficients, RrsSpeedLaws};
+use crate::riccati;
 use nalgebra::{DMatrix, SMatrix, SVector};
 use serde::{Deserialize, Serialize};
 

@@ -11,7 +11,7 @@
 //! | [`parameter_ekf::ParameterEkf`] | seed 000, spec `ddg51_ekf_autopilot.md` §2.10, §3.4: continuous-discrete state-augmented EKF identifying −Y_v, m − Y_r, −N_v, m x_G − N_r, running mean of the last 67 % |
 //! | [`path_model`] | seed 004, spec `adaptive_path_control.md` §2.7-2.9: Tokyo Maru 7-state design model (shared with the path controller) |
 //!
-//! Gains are computed at initialization (DMatrix Riccati solvers of [`crate::control::riccati`]);
+//! Gains are computed at initialization (DMatrix Riccati solvers of [`crate::riccati`]);
 //! the per-step updates use fixed-size nalgebra types and allocate nothing. Every filter is
 //! `Clone + Serialize + Deserialize` so an FMU state snapshot is a clone.
 

@@ -20,11 +20,11 @@
 //! mean square with forgetting time `innovation_window` (in t′).
 
 use super::path_model::{DisturbanceModel, PathDesignModel, NX, NZ};
-use crate::control::riccati::RiccatiError;
 use crate::error::{check_positive, check_positive_or_infinite, require, ParamError};
 use crate::hull::tokyo_maru::TokyoMaruCoefficients;
 use crate::hull::tokyo_maru::{L, U};
 use crate::integrate::substeps;
+use crate::riccati::RiccatiError;
 use nalgebra::{SMatrix, SVector};
 use serde::{Deserialize, Serialize};
 

@@ -24,8 +24,8 @@
 //!
 //! All quantities are nondimensional (t′ = tU/L, r′ = rL/U, η′ = η/L, angles in rad).
 
-use crate::control::riccati::{self, RiccatiError};
 use crate::hull::tokyo_maru::{TokyoMaruCoefficients, T_R};
+use crate::riccati::{self, RiccatiError};
 use nalgebra::{DMatrix, SMatrix};
 use serde::{Deserialize, Serialize};
 

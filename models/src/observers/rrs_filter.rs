@@ -53,8 +53,8 @@
 //! used τ0 = 100 s, τ_f,min = 10 s. The second-order (HF-coloured noise) gains of
 //! Eqs. 4.100-4.101 are [`second_order_speed_gains`].
 
-use crate::control::riccati::{self, RiccatiError};
 use crate::error::{check_finite, check_non_negative, check_positive, require, ParamError};
+use crate::riccati::{self, RiccatiError};
 use nalgebra::{DMatrix, SMatrix, SVector};
 use serde::{Deserialize, Serialize};
 
