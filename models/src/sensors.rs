@@ -110,17 +110,6 @@ impl SensorParams {
         }
     }
 
-    /// 004 Table 9 (parameter estimator): ψ, r, β (→ v), η; the rest as Table 3.
-    pub fn tokyo_maru_table9() -> Self {
-        let (u, l) = (TOKYO_MARU_U, TOKYO_MARU_L);
-        let mut p = Self::tokyo_maru_table3();
-        p.channels[ch::HEADING].sigma = 5.0943e-4;
-        p.channels[ch::YAW_RATE].sigma = 3.9298e-4 * u / l;
-        p.channels[ch::SWAY_VELOCITY].sigma = 4.0688e-4 * u;
-        p.channels[ch::CROSS_TRACK].sigma = 1.0065e-3 * l;
-        p
-    }
-
     /// 002 DGPS: north and east σ = 2 m at 1 s, everything else noise-free at 1 s.
     pub fn dgps_002() -> Self {
         let mut p = Self::tokyo_maru_table3();
@@ -252,11 +241,6 @@ impl Sensors {
     /// Measured (sampled, noisy) value of channel `i`.
     pub fn measured(&self, i: usize) -> f64 {
         self.state[i].held
-    }
-
-    /// Index of the latest sample of channel `i`.
-    pub fn sample_index(&self, i: usize) -> u64 {
-        self.state[i].k
     }
 }
 

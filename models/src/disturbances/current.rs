@@ -165,15 +165,6 @@ impl CurrentParams {
         }
     }
 
-    /// 004 Figs. 6-7 / 11-12: 4× passing ship beam-to-beam at t′ = 20.
-    pub fn parsons_passing_ship_4x() -> Self {
-        CurrentParams {
-            passing_factor: 4.0,
-            passing_time: 20.0,
-            ..Self::default()
-        }
-    }
-
     /// 004 Figs. 8-10 / 13-15: design lateral current of Fig. 4.
     pub fn parsons_design_current() -> Self {
         CurrentParams {

@@ -296,10 +296,6 @@ impl WhiteSequence {
         }
     }
 
-    pub fn set_sigma(&mut self, sigma: f64) {
-        self.sigma = sigma;
-    }
-
     /// Advances so that the held sample is the one of the last grid instant ≤ t. A grid
     /// instant within 1e-9·dt above `t` counts as reached (communication points computed by
     /// repeated addition land a few ulps off the grid).

@@ -600,16 +600,6 @@ impl Waves {
     pub fn wf_motion(&self) -> [f64; 3] {
         std::array::from_fn(|i| self.wf[i].value(self.time)[1])
     }
-
-    /// Target significant wave height [m].
-    pub fn target_hs(&self) -> f64 {
-        4.0 * self.m0.sqrt()
-    }
-
-    /// Number of sinusoids in use.
-    pub fn component_count(&self) -> usize {
-        self.comps.len()
-    }
 }
 
 #[cfg(test)]

@@ -161,18 +161,6 @@ impl Default for ContainerShipParams {
 }
 
 impl ContainerShipParams {
-    /// The plant of MSS `exRRD2.m` (§5.3): rudder limits 20° and 20°/s and the pre-2022
-    /// cos(v′) propeller inflow (its wave-roll state is left to the wave model, fed through
-    /// `roll_moment_ext`).
-    pub fn exrrd2() -> Self {
-        ContainerShipParams {
-            rudder_max: 20.0 * DEG,
-            rudder_rate_max: 20.0 * DEG,
-            propeller_inflow: PropellerInflow::Pre2022Cos,
-            ..Self::default()
-        }
-    }
-
     /// Checks every parameter; the error names the parameter and its value.
     pub fn validate(&self) -> Result<(), ParamError> {
         check_positive("rudder_max", self.rudder_max)?;

@@ -405,11 +405,6 @@ impl YawFilter {
         self.x = V4::from_row_slice(&x);
     }
 
-    /// Noise-free sway state x̂1 (third-order model).
-    pub fn sway_state(&self) -> f64 {
-        self.x1
-    }
-
     /// Prediction error z = y − (ψ̂ − x̂4) of the last sample.
     pub fn innovation(&self) -> f64 {
         self.innovation
@@ -503,28 +498,6 @@ pub enum SpeedAdaptation {
     Quadratic,
     /// n = ∞: S-filter, switches between τ0 and τ_f,min.
     Switch,
-}
-
-impl SpeedAdaptation {
-    /// 0 C, 1 L, 2 Q, 3 S (the FMU's integer parameter).
-    pub fn from_index(i: i32) -> Option<Self> {
-        match i {
-            0 => Some(Self::Constant),
-            1 => Some(Self::Linear),
-            2 => Some(Self::Quadratic),
-            3 => Some(Self::Switch),
-            _ => None,
-        }
-    }
-
-    pub fn index(self) -> i32 {
-        match self {
-            Self::Constant => 0,
-            Self::Linear => 1,
-            Self::Quadratic => 2,
-            Self::Switch => 3,
-        }
-    }
 }
 
 /// Speed-filter parameters.
