@@ -126,7 +126,8 @@ pub struct DpController {
     kp: [f64; 3],
     kd: [f64; 3],
     ki: [f64; 3],
-    z: [f64; 3],
+    /// ∫ error dt per axis (the integral action's state).
+    integral: [f64; 3],
     time: f64,
 }
 
@@ -150,7 +151,7 @@ impl DpController {
             kp,
             kd,
             ki,
-            z: [0.0; 3],
+            integral: [0.0; 3],
             time: start_time,
         })
     }
@@ -172,7 +173,7 @@ impl DpController {
     }
 
     pub fn integral(&self) -> [f64; 3] {
-        self.z
+        self.integral
     }
 
     pub fn time(&self) -> f64 {
@@ -189,7 +190,7 @@ impl DpController {
     pub fn tau(&self, u: &DpInputs) -> [f64; 3] {
         let e = body_error(u.eta, u.setpoint);
         std::array::from_fn(|i| {
-            -self.kp[i] * e[i] - self.kd[i] * u.nu[i] - self.ki[i] * self.z[i]
+            -self.kp[i] * e[i] - self.kd[i] * u.nu[i] - self.ki[i] * self.integral[i]
                 + self.params.test_amplitude[i] * (self.params.test_frequency[i] * self.time).sin()
         })
     }
@@ -199,7 +200,7 @@ impl DpController {
         let e = body_error(u.eta, u.setpoint);
         for i in 0..3 {
             if self.ki[i] != 0.0 {
-                self.z[i] += e[i] * h;
+                self.integral[i] += e[i] * h;
             }
         }
         self.time += h;

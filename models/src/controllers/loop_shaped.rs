@@ -525,8 +525,8 @@ fn wrap(a: f64) -> f64 {
 struct Sampler {
     /// Time since the start [s].
     time: f64,
-    /// τ of the current discretisation (t′).
-    tau: f64,
+    /// Tustin sample step τ of the current discretisation (t′).
+    sample_step: f64,
 }
 
 impl Sampler {
@@ -552,8 +552,10 @@ pub struct HeadingAutopilot {
     pub design: HeadingDesign,
     pub reference: HeadingReference,
     pub track_change: TrackChange,
-    tf: TransferFunction,
-    ctl: TustinController<2>,
+    /// The continuous controller C(s) of the design.
+    transfer_function: TransferFunction,
+    /// Its Tustin realisation at the current sample step.
+    discrete: TustinController<2>,
     sampler: Sampler,
     initial_heading: f64,
     last_reference: f64,
@@ -563,14 +565,14 @@ impl HeadingAutopilot {
     pub fn new(design: HeadingDesign) -> Result<Self, ControlError> {
         let tf = design.controller()?;
         Ok(HeadingAutopilot {
-            ctl: TustinController::new(&tf, design.common.sample_step, design.common.limit)?,
-            tf,
+            discrete: TustinController::new(&tf, design.common.sample_step, design.common.limit)?,
+            transfer_function: tf,
             design,
             reference: HeadingReference::External,
             track_change: TrackChange::default(),
             sampler: Sampler {
                 time: 0.0,
-                tau: design.common.sample_step,
+                sample_step: design.common.sample_step,
             },
             initial_heading: 0.0,
             last_reference: 0.0,
@@ -580,10 +582,10 @@ impl HeadingAutopilot {
     /// Re-discretises after a design change (controller state kept).
     pub fn set_design(&mut self, design: HeadingDesign) -> Result<(), ControlError> {
         let tf = design.controller()?;
-        self.ctl = self
-            .ctl
-            .rediscretised(&tf, self.sampler.tau, design.common.limit)?;
-        self.tf = tf;
+        self.discrete =
+            self.discrete
+                .rediscretised(&tf, self.sampler.sample_step, design.common.limit)?;
+        self.transfer_function = tf;
         self.design = design;
         Ok(())
     }
@@ -601,7 +603,7 @@ impl HeadingAutopilot {
 
     /// The Tustin step τ (t′) in use.
     pub fn sample_step(&self) -> f64 {
-        self.sampler.tau
+        self.sampler.sample_step
     }
 
     fn reference_at(&self, t: f64, external: f64) -> f64 {
@@ -613,12 +615,12 @@ impl HeadingAutopilot {
 
     /// Rudder command δ_c [rad] (held output of the last sample).
     pub fn command(&self) -> f64 {
-        self.ctl.output
+        self.discrete.output
     }
 
     /// Command before the ±limit.
     pub fn unlimited_command(&self) -> f64 {
-        self.ctl.unlimited
+        self.discrete.unlimited
     }
 
     /// Heading reference used at the last sample [rad].
@@ -634,23 +636,26 @@ impl HeadingAutopilot {
         let c = self.design.common;
         let scale = c.speed / c.length;
         let (n, tau) = Sampler::split(h * scale, c.sample_step);
-        if tau != self.sampler.tau {
-            if let Ok(ctl) = self.ctl.rediscretised(&self.tf, tau, c.limit) {
-                self.ctl = ctl;
-                self.sampler.tau = tau;
+        if tau != self.sampler.sample_step {
+            if let Ok(discrete) = self
+                .discrete
+                .rediscretised(&self.transfer_function, tau, c.limit)
+            {
+                self.discrete = discrete;
+                self.sampler.sample_step = tau;
             }
         }
         for i in 0..n {
             let t = self.sampler.time + i as f64 * h / n as f64;
             let r = self.reference_at(t, external_reference);
             self.last_reference = r;
-            self.ctl.sample(wrap(r - heading));
+            self.discrete.sample(wrap(r - heading));
         }
         self.sampler.time += h;
     }
 
     pub fn controller(&self) -> &TustinController<2> {
-        &self.ctl
+        &self.discrete
     }
 }
 
@@ -667,8 +672,10 @@ pub struct TrackController {
     pub design: TrackDesign,
     pub reference: TrackReference,
     pub lateral_offset: LateralOffset,
-    tf: TransferFunction,
-    ctl: TustinController<4>,
+    /// The continuous controller C(s) of the design.
+    transfer_function: TransferFunction,
+    /// Its Tustin realisation at the current sample step.
+    discrete: TustinController<4>,
     sampler: Sampler,
     last_reference: f64,
 }
@@ -677,14 +684,14 @@ impl TrackController {
     pub fn new(design: TrackDesign) -> Result<Self, ControlError> {
         let tf = design.controller()?;
         Ok(TrackController {
-            ctl: TustinController::new(&tf, design.common.sample_step, design.common.limit)?,
-            tf,
+            discrete: TustinController::new(&tf, design.common.sample_step, design.common.limit)?,
+            transfer_function: tf,
             design,
             reference: TrackReference::External,
             lateral_offset: LateralOffset::default(),
             sampler: Sampler {
                 time: 0.0,
-                tau: design.common.sample_step,
+                sample_step: design.common.sample_step,
             },
             last_reference: 0.0,
         })
@@ -692,10 +699,10 @@ impl TrackController {
 
     pub fn set_design(&mut self, design: TrackDesign) -> Result<(), ControlError> {
         let tf = design.controller()?;
-        self.ctl = self
-            .ctl
-            .rediscretised(&tf, self.sampler.tau, design.common.limit)?;
-        self.tf = tf;
+        self.discrete =
+            self.discrete
+                .rediscretised(&tf, self.sampler.sample_step, design.common.limit)?;
+        self.transfer_function = tf;
         self.design = design;
         Ok(())
     }
@@ -707,7 +714,7 @@ impl TrackController {
 
     /// The Tustin step τ (t′) in use.
     pub fn sample_step(&self) -> f64 {
-        self.sampler.tau
+        self.sampler.sample_step
     }
 
     pub fn start(&mut self, external_reference: f64) {
@@ -722,11 +729,11 @@ impl TrackController {
     }
 
     pub fn command(&self) -> f64 {
-        self.ctl.output
+        self.discrete.output
     }
 
     pub fn unlimited_command(&self) -> f64 {
-        self.ctl.unlimited
+        self.discrete.unlimited
     }
 
     /// Cross-track reference used at the last sample [m].
@@ -742,23 +749,26 @@ impl TrackController {
         let c = self.design.common;
         let scale = c.speed / c.length;
         let (n, tau) = Sampler::split(h * scale, c.sample_step);
-        if tau != self.sampler.tau {
-            if let Ok(ctl) = self.ctl.rediscretised(&self.tf, tau, c.limit) {
-                self.ctl = ctl;
-                self.sampler.tau = tau;
+        if tau != self.sampler.sample_step {
+            if let Ok(discrete) = self
+                .discrete
+                .rediscretised(&self.transfer_function, tau, c.limit)
+            {
+                self.discrete = discrete;
+                self.sampler.sample_step = tau;
             }
         }
         for i in 0..n {
             let t = self.sampler.time + i as f64 * h / n as f64;
             let r = self.reference_at(t, external_reference);
             self.last_reference = r;
-            self.ctl.sample((r - cross_track) / c.length);
+            self.discrete.sample((r - cross_track) / c.length);
         }
         self.sampler.time += h;
     }
 
     pub fn controller(&self) -> &TustinController<4> {
-        &self.ctl
+        &self.discrete
     }
 }
 
@@ -1024,11 +1034,11 @@ mod tests {
         ap.step(0.0, 0.1, 0.05);
         assert!((ap.sample_step() - 0.05 * c.speed / c.length).abs() < 1e-15);
         // generators
-        let tc = TrackChange::default();
-        assert_eq!(tc.heading(0.0), 0.0);
-        assert!((tc.heading(60.0 + 45.0) + 45f64.to_radians()).abs() < 1e-12);
-        assert_eq!(tc.heading(200.0), -std::f64::consts::FRAC_PI_2);
-        assert_eq!(tc.heading(2000.0), 0.0);
+        let track_change = TrackChange::default();
+        assert_eq!(track_change.heading(0.0), 0.0);
+        assert!((track_change.heading(60.0 + 45.0) + 45f64.to_radians()).abs() < 1e-12);
+        assert_eq!(track_change.heading(200.0), -std::f64::consts::FRAC_PI_2);
+        assert_eq!(track_change.heading(2000.0), 0.0);
         let lo = LateralOffset {
             duration: 100.0,
             ..Default::default()
@@ -1052,22 +1062,23 @@ mod tests {
             let mut ship = NomotoShip::ddg51();
             let c = LoopShapingCommon::default();
             let gear_tau = c.length / (c.gear_pole * c.speed);
-            let mut tc = TrackController::new(TrackDesign::default()).unwrap();
-            tc.reference = TrackReference::LateralOffset;
-            tc.lateral_offset = LateralOffset {
+            let mut controller = TrackController::new(TrackDesign::default()).unwrap();
+            controller.reference = TrackReference::LateralOffset;
+            controller.lateral_offset = LateralOffset {
                 start: 0.0,
                 offset: 0.142,
                 duration: 0.0,
             };
-            tc.start(0.0);
+            controller.start(0.0);
             let (mut delta, mut peak, mut max_cmd, mut y) = (0.0, 0.0f64, 0.0f64, 0.0);
             for _ in 0..(300.0 / h) as usize {
-                tc.step(y, 0.0, h);
-                max_cmd = max_cmd.max(tc.unlimited_command().abs());
+                controller.step(y, 0.0, h);
+                max_cmd = max_cmd.max(controller.unlimited_command().abs());
                 // exact first-order gear over the step for the held command, sub-stepped with the ship
                 let n = ((h / 0.005f64).ceil() as usize).max(1);
                 for _ in 0..n {
-                    delta += (tc.command() - delta) * (1.0 - (-(h / n as f64) / gear_tau).exp());
+                    delta +=
+                        (controller.command() - delta) * (1.0 - (-(h / n as f64) / gear_tau).exp());
                     ship.step(
                         &NomotoInputs {
                             rudder: delta,

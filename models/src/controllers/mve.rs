@@ -188,7 +188,7 @@ pub fn parameters_of(c: &TokyoMaruCoefficients) -> [f64; 6] {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Mve {
     pub params: MveParams,
-    m: MveMatrices,
+    matrices: MveMatrices,
     phi: M6,
     p_hat: V6,
     p_cov: M6,
@@ -200,9 +200,8 @@ pub struct Mve {
 impl Mve {
     /// Starts from the estimate `p0_hat` with covariance diag(params.p0).
     pub fn new(params: MveParams, p0_hat: [f64; 6]) -> Result<Self, ControlError> {
-        let m = params.matrices()?;
         Ok(Mve {
-            m,
+            matrices: params.matrices()?,
             phi: M6::from_diagonal(&V6::from(params.phi)),
             p_hat: V6::from(p0_hat),
             p_cov: M6::from_diagonal(&V6::from(params.p0)),
@@ -214,20 +213,20 @@ impl Mve {
     }
 
     pub fn matrices(&self) -> &MveMatrices {
-        &self.m
+        &self.matrices
     }
 
     /// Changes the sample step Δt′ (recomputes R_eq and G; p̂ and P carry over).
     pub fn set_dt(&mut self, dt: f64) -> Result<(), ControlError> {
         let params = MveParams { dt, ..self.params };
-        self.m = params.matrices()?;
+        self.matrices = params.matrices()?;
         self.params = params;
         Ok(())
     }
 
     /// Replaces the settings (recomputes the matrices; p̂ and P carry over).
     pub fn set_params(&mut self, params: MveParams) -> Result<(), ControlError> {
-        self.m = params.matrices()?;
+        self.matrices = params.matrices()?;
         self.phi = M6::from_diagonal(&V6::from(params.phi));
         self.params = params;
         Ok(())
@@ -283,14 +282,14 @@ impl Mve {
         );
         let z_tilde = z - d; // eq. 90
         let pc = self.p_cov;
-        let s = c * pc * c.transpose() + self.m.r_eq;
+        let s = c * pc * c.transpose() + self.matrices.r_eq;
         let Some(s_inv) = s.try_inverse() else {
             return;
         };
         let gain = pc * c.transpose() * s_inv; // eq. 102
         let p_new = pc + self.phi - gain * c * pc; // eq. 103
         let innovation = z_tilde - c * self.p_hat; // eq. 94
-        let bias = (p_new - self.phi) * self.m.g * self.p_hat;
+        let bias = (p_new - self.phi) * self.matrices.g * self.p_hat;
         self.p_hat += gain * innovation + bias; // eq. 114
         self.p_cov = (p_new + p_new.transpose()) * 0.5;
         self.estimates += 1;

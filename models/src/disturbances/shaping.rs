@@ -189,7 +189,8 @@ pub struct FirstOrderProcess {
     time_constant: f64,
     gain: f64,
     phi: f64,
-    sd: f64,
+    /// Standard deviation of the noise added per grid step.
+    step_std: f64,
     grid: Grid,
     now: f64,
     next: f64,
@@ -209,7 +210,7 @@ impl FirstOrderProcess {
             time_constant,
             gain,
             phi: 1.0,
-            sd: 0.0,
+            step_std: 0.0,
             grid: Grid { t0, dt, k: 0 },
             now: 0.0,
             next: 0.0,
@@ -246,18 +247,18 @@ impl FirstOrderProcess {
         let dt = self.grid.dt;
         if self.is_walk() {
             self.phi = 1.0;
-            self.sd = self.gain.abs() * dt.sqrt();
+            self.step_std = self.gain.abs() * dt.sqrt();
         } else {
             let phi = (-dt / self.time_constant).exp();
             let v = self.gain * self.gain * self.time_constant / 2.0;
             self.phi = phi;
             // 1 − φ² without cancellation: −expm1(−2 dt/T)
-            self.sd = (v * -(-2.0 * dt / self.time_constant).exp_m1()).sqrt();
+            self.step_std = (v * -(-2.0 * dt / self.time_constant).exp_m1()).sqrt();
         }
     }
 
     fn draw_next(&mut self) -> f64 {
-        self.phi * self.now + self.sd * self.rng.normal()
+        self.phi * self.now + self.step_std * self.rng.normal()
     }
 
     pub fn advance_to(&mut self, t: f64) {

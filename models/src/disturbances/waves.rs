@@ -387,10 +387,14 @@ impl WaveParams {
 /// One sinusoid: amplitude, wave frequency, encounter frequency in use, phase at `t_ref`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 struct Component {
-    a: f64,
-    w: f64,
-    we: f64,
-    theta: f64,
+    /// Amplitude [m] (the band energy while the set is built).
+    amplitude: f64,
+    /// Wave frequency ω [rad/s].
+    frequency: f64,
+    /// Encounter frequency ω_e [rad/s] at the current speed and heading.
+    encounter_frequency: f64,
+    /// Phase [rad] at the current time.
+    phase: f64,
 }
 
 /// The wave model (see the module documentation).
@@ -432,14 +436,14 @@ impl Waves {
                 let w = w0 + rng.uniform() * dw;
                 let phase = 2.0 * PI * rng.uniform();
                 comps.push(Component {
-                    a: e,
-                    w,
-                    we: w,
-                    theta: phase,
+                    amplitude: e,
+                    frequency: w,
+                    encounter_frequency: w,
+                    phase,
                 });
             }
             for c in &mut comps {
-                c.a = (2.0 * c.a * m0 / energy).sqrt();
+                c.amplitude = (2.0 * c.amplitude * m0 / energy).sqrt();
             }
         }
         let shaping_w = if params.shaping_frequency > 0.0 {
@@ -511,8 +515,8 @@ impl Waves {
         let dt = self.time - self.t_ref;
         let g = self.params.gravity;
         for c in &mut self.comps {
-            c.theta = (c.theta + c.we * dt).rem_euclid(2.0 * PI);
-            c.we = encounter_frequency(c.w, speed, gamma, g);
+            c.phase = (c.phase + c.encounter_frequency * dt).rem_euclid(2.0 * PI);
+            c.encounter_frequency = encounter_frequency(c.frequency, speed, gamma, g);
         }
         self.t_ref = self.time;
         self.speed = speed;
@@ -558,7 +562,7 @@ impl Waves {
                 let dt = self.time - self.t_ref;
                 self.comps
                     .iter()
-                    .map(|c| c.a * (c.theta + c.we * dt).cos())
+                    .map(|c| c.amplitude * (c.phase + c.encounter_frequency * dt).cos())
                     .sum()
             }
             Realisation::ShapingFilter => {
@@ -823,9 +827,9 @@ mod tests {
             let mut w = Waves::new(p.clone(), 0.0).unwrap();
             w.set_inputs(u, gamma);
             let c = &w.comps[0];
-            let we = encounter_frequency(c.w, u, gamma, GRAVITY);
-            let a = c.a;
-            let theta0 = c.theta;
+            let we = encounter_frequency(c.frequency, u, gamma, GRAVITY);
+            let a = c.amplitude;
+            let theta0 = c.phase;
             for k in 0..100 {
                 let t = k as f64 * 0.77;
                 w.advance_to(t);
