@@ -203,8 +203,8 @@ pub fn kalman_bucy(a: &M, c: &M, g: &M, qw: &M, rv: &M) -> Result<(M, M), Riccat
     Ok((&p * c.transpose() * rinv, p))
 }
 
-/// Steady-state Kalman–Bucy gain with correlated process and measurement noise (van der Klugt
-/// 1987 eqs. 4.16–4.17 and 4.78–4.79): process noise intensity `DQDᵀ` = `qd`, measurement noise
+/// Steady-state Kalman–Bucy gain with correlated process and measurement noise
+/// [Klugt1987, eqs. (4.16)–(4.17) and (4.78)–(4.79)]: process noise intensity `DQDᵀ` = `qd`, measurement noise
 /// intensity `rv`, cross intensity `n` = E[D w vᵀ] (n × p). `K = (PCᵀ + N) Rv⁻¹` with P the
 /// stabilising solution of `AP + PAᵀ + DQDᵀ − (PCᵀ + N) Rv⁻¹ (PCᵀ + N)ᵀ = 0`, solved as the
 /// standard problem with `Ā = A − N Rv⁻¹ C` and `Q̄ = DQDᵀ − N Rv⁻¹ Nᵀ`. Returns (K, P).
@@ -231,8 +231,8 @@ pub fn kalman_bucy_correlated(a: &M, c: &M, qd: &M, rv: &M, n: &M) -> Result<(M,
     Ok(((&p * c.transpose() + n) * rinv, p))
 }
 
-/// The differential Riccati equation integrated forward in time (van der Klugt's "innovation
-/// process", thesis Ch. 3, App. A–D): `Ṗ = AᵀP + PA − PBR⁻¹BᵀP + Q`.
+/// The differential Riccati equation integrated forward in time (the "innovation process" of
+/// [Klugt1987, ch. 3 and App. A–D]): `Ṗ = AᵀP + PA − PBR⁻¹BᵀP + Q`.
 #[derive(Clone, Debug)]
 pub struct RiccatiFlow {
     a: M,
@@ -421,14 +421,15 @@ mod tests {
         assert!(rel(&flow.p, &p_inf) < 1e-8, "{}", rel(&flow.p, &p_inf));
     }
 
-    /// Speed filter with high-pass coloured measurement noise (van der Klugt 1987 §4.5.2,
-    /// eqs. 4.91–4.101): x = (speed, x_v), A = [[0,0],[0,−1/τ]], D = [[1,0],[0,1/τ]],
+    /// Speed filter with high-pass coloured measurement noise [Klugt1987, sec. 4.5.2,
+    /// eqs. (4.91)–(4.101)]: x = (speed, x_v), A = [[0,0],[0,−1/τ]], D = [[1,0],[0,1/τ]],
     /// C = (1 −1), w = (w, v), R = E[v²], S = (0, E[v²])ᵀ. Closed form k1 = √(E[w²]/E[v²]),
-    /// k2 = (k1τ + 1 − √(k1²τ² + 2k1τ))/τ; spec rrs_models_filters.md §6.2 lists
+    /// k2 = (k1τ + 1 − √(k1²τ² + 2k1τ))/τ ([Klugt1987, eqs. (4.100)–(4.101)]); reference values
+    /// computed from that closed form (not printed in the thesis), rounded:
     /// (1e−4, 1, 20) ⇒ (0.01, 0.026834), (1e−2, 1, 5) ⇒ (0.1, 0.076393), (1, 0.5, 3) ⇒
     /// (1.41421, 0.032085).
     #[test]
-    // 1.41421 is the spec's printed value, not an approximation of √2 to be replaced
+    // 1.41421 is the rounded reference value, not an approximation of √2 to be replaced
     #[allow(clippy::approx_constant)]
     fn correlated_noise_speed_filter_gains() {
         for (ew, ev, tau, k1_ref, k2_ref) in [
@@ -450,13 +451,13 @@ mod tests {
                 (k[(0, 0)] - k1).abs() < 1e-10 && (k[(1, 0)] - k2).abs() < 1e-10,
                 "{k}"
             );
-            // the spec's printed values, to their last digit
+            // the rounded reference values, to their last digit
             assert!((k[(0, 0)] - k1_ref).abs() < 6e-6 && (k[(1, 0)] - k2_ref).abs() < 6e-7);
         }
     }
 
     /// A stable but uncontrollable mode at −ε puts Hamiltonian eigenvalues at ±ε (as the random
-    /// walk disturbance states of the 004 design do). Closed form: P = diag(1/(2ε), 1).
+    /// walk disturbance states of the design of [Parsons1980, sec. 3.3] do). Closed form: P = diag(1/(2ε), 1).
     #[test]
     fn care_with_hamiltonian_eigenvalues_near_the_axis() {
         for eps in [1e-2, 1e-4, 1e-6] {

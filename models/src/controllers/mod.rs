@@ -2,9 +2,10 @@
 //!
 //! * [`lq`]: continuous LQ state feedback in the sources' sign convention (u = C x), shared by
 //!   every LQ design here; the Riccati numerics themselves are [`crate::riccati`].
-//! * [`path`]: Parsons & Cuong (1980, source 004) optimal steady-state path controller of the
+//! * [`path`]: the optimal steady-state path controller of [Parsons1980] for the
 //!   *Tokyo Maru* in restricted water, with gain scheduling over depth, the partial adaptation
-//!   of f23/f25 from a parameter estimator (Table 10 validity logic) and the open-loop dither.
+//!   of f23/f25 from a parameter estimator (validity logic of [Parsons1980, Table 10]) and the
+//!   open-loop dither.
 //!
 //! Design computations (Riccati equations) run at initialization, on a parameter change or on
 //! an adaptation clock and may allocate; the per-step control laws use fixed-size nalgebra types
