@@ -1,19 +1,19 @@
 //! A simple dynamic-positioning (DP) controller: nonlinear PID on the observer's low-frequency
-//! estimates, in the body frame, for the 3-DOF DP models of seed 001 (Fossen & Strand 1999).
+//! estimates, in the body frame, for the 3-DOF DP models of [Fossen1999].
 //!
 //! # Why it exists
-//! Seed 001 gives an observer but no controller ("future work", spec `passive_observer_dp.md` §5
-//! item 13, §6.4); the DP simulation of issue 8 needs one to close the loop. This is the textbook
-//! DP law (Fossen, *Handbook of Marine Craft Hydrodynamics and Motion Control*, 2011, §12.2.6 and
-//! §13.3.3), kept deliberately small. It is fed with η̂ and ν̂ (never the raw measurement), so the
-//! first-order wave motion stays out of the feedback loop (001 Definition 1).
+//! [Fossen1999] gives an observer but no controller; the DP simulation of issue 8 needs one to
+//! close the loop. This is the textbook
+//! DP law (Fossen, *Handbook of Marine Craft Hydrodynamics and Motion Control*, 2011, sec. 12.2.6 and
+//! 13.3.3), kept deliberately small. It is fed with η̂ and ν̂ (never the raw measurement), so the
+//! first-order wave motion stays out of the feedback loop [Fossen1999, Definition 1].
 //!
 //! # Control law
 //! ```text
 //! e   = Jᵀ(ψ̂) (η̂ − η_d),  e₃ wrapped to (−π, π]   body-frame position/heading error
 //! ż   = e                                           integral state (body frame)
 //! τ   = −K_p e − K_d ν̂ − K_i z + τ_ff(t)            N, N, N·m
-//! τ_ff,i = A_i sin(ω_i t)                           open-loop test input (001 Eq. 61)
+//! τ_ff,i = A_i sin(ω_i t)                           open-loop test input [Fossen1999, eq. (61)]
 //! ```
 //! # Gains from the desired bandwidth (per DOF, diagonal m_i and d_i)
 //! The closed loop m ë + (d + K_d) ė + K_p e = 0 is placed at natural frequency ω_n and relative
@@ -28,7 +28,7 @@
 //! # Integration
 //! The inputs are held over a step; the integral state is advanced exactly for the held error
 //! (z += e h) and τ at the end of the step uses the held inputs. No thrust allocation or limits:
-//! B_u is not given for *Northern Clipper* (spec §3.1), so τ is the generalized force itself.
+//! B_u is not given for *Northern Clipper* [Fossen1999, eq. (4)], so τ is the generalized force itself.
 
 use super::ControlError;
 use crate::error::{check_finite, check_non_negative, check_positive};
@@ -54,7 +54,7 @@ pub struct DpParams {
 }
 
 impl DpParams {
-    /// Northern Clipper (001 Eqs. 56-57 diagonals), ω_b = 0.05 rad/s in every DOF, ζ = 0.9,
+    /// Northern Clipper ([Fossen1999, eqs. (56)-(57)] diagonals), ω_b = 0.05 rad/s in every DOF, ζ = 0.9,
     /// r = 10, no test input.
     pub fn northern_clipper() -> Self {
         DpParams {

@@ -1,26 +1,26 @@
-//! Loop-shaped heading autopilot and cross-track controller of the DDG-51 thesis (2000, source
-//! 000), discretised by Tustin at a fixed internal step in the nondimensional time base, with the
+//! Loop-shaped heading autopilot and cross-track controller of the DDG-51 thesis [Taylor2000, ch. 5],
+//! discretised by Tustin at a fixed internal step in the nondimensional time base, with the
 //! ±30° command limit and the reference generators of the thesis's manoeuvres.
 //!
 //! # Source
-//! Seed 000, spec `ddg51_ekf_autopilot.md`:
-//! * §2.14 plant: Nomoto P_ψ = K/(s(Ts+1)), T = 1.9287, K = 2.04 (eqs. 5.24–5.27), steering gear
-//!   6/(s+6) (eq. 5.28), |δ_c| ≤ 30° (L2192–2199), track plant P_y = P/s (eq. 5.39);
-//! * §2.16 heading autopilot: the loop L = ω_n²/(s(s² + 2ζω_n s + ω_n²)), ω_n = √60, ζ = 2
-//!   (eqs. 5.32–5.34), controller C = L/P (eq. 5.30) =
+//! [Taylor2000]:
+//! * plant [Taylor2000, sec. 5.2.1]: Nomoto P_ψ = K/(s(Ts+1)), T = 1.9287, K = 2.04 [Taylor2000, eqs. (5.24)–(5.27)], steering gear
+//!   6/(s+6) [Taylor2000, eq. (5.28)], |δ_c| ≤ 30° [Taylor2000, sec. 5.2.1], track plant P_y = P/s [Taylor2000, eq. (5.39)];
+//! * heading autopilot [Taylor2000, sec. 5.2.2]: the loop L = ω_n²/(s(s² + 2ζω_n s + ω_n²)), ω_n = √60, ζ = 2
+//!   [Taylor2000, eqs. (5.32)–(5.34)], controller C = L/P [Taylor2000, eq. (5.30)] =
 //!   ω_n²/(K·a) (Ts+1)(s+a)/(s² + 2ζω_n s + ω_n²) with a = 6;
-//! * §2.17 cross-track controller C_y = 20(s+0.5)²(s+6)(s+1000)/((s+11)(s+15)(s+30)²)
-//!   (L2637–2642);
-//! * §4.6, §4.9, §4.13: margins AT-1/AT-2, AT-5 low-frequency gain, step criteria AT-3/AT-4.
+//! * cross-track controller C_y = 20(s+0.5)²(s+6)(s+1000)/((s+11)(s+15)(s+30)²)
+//!   [Taylor2000, sec. 5.3.2];
+//! * the printed margins, the low-frequency gain criterion and the step criteria
+//!   [Taylor2000, sec. 5.1.4, 5.2.2 and 5.3.2] are tested.
 //!
 //! # Readings taken
-//! * OCR of eqs. 5.32–5.34 (`L=PC= / s(s 2 + 2(wn + n2)`, `Wn = 0/-0`, `(= 2`) read as
-//!   ω_n = √60, ζ = 2: the only reading that reproduces the printed margins exactly (spec §2.16;
-//!   the original seed 000 L2236–2245 is equally garbled).
+//! * OCR of [Taylor2000, eqs. (5.32)–(5.34)] (`L=PC= / s(s 2 + 2(wn + n2)`, `Wn = 0/-0`, `(= 2`) read as
+//!   ω_n = √60, ζ = 2: the only reading that reproduces the printed margins exactly.
 //! * Time base: everything in t′ = tU/L (L = 466 ft, U = 22 kn, L/U = 12.55 s): the printed margins
-//!   hold only when the 6/(s+6) gear is in the same time base as the Nomoto model (spec §6 items 3–4).
+//!   hold only when the 6/(s+6) gear is in the same time base as the Nomoto model.
 //!   The FMU interface is SI (s, rad, m) and converts.
-//! * Cross-track y′ = y/L (so that ẏ′ = ψ, eq. 5.37).
+//! * Cross-track y′ = y/L (so that ẏ′ = ψ, [Taylor2000, eq. (5.37)]).
 //!
 //! # Realisation
 //! The continuous controller is realised in controllable canonical form and discretised by Tustin
@@ -165,7 +165,7 @@ pub fn margins(l: &TransferFunction, w_lo: f64, w_hi: f64) -> Option<Margins> {
     })
 }
 
-/// Nomoto heading plant with the steering gear, P = K a / (s (T s + 1)(s + a)) (eqs. 5.27–5.29).
+/// Nomoto heading plant with the steering gear, P = K a / (s (T s + 1)(s + a)) [Taylor2000, eqs. (5.27)–(5.29)].
 pub fn heading_plant(k: f64, t: f64, gear_pole: f64) -> TransferFunction {
     TransferFunction {
         num: vec![k * gear_pole],
@@ -173,7 +173,7 @@ pub fn heading_plant(k: f64, t: f64, gear_pole: f64) -> TransferFunction {
     }
 }
 
-/// Track plant P_y = P/s (eq. 5.39).
+/// Track plant P_y = P/s [Taylor2000, eq. (5.39)].
 pub fn track_plant(k: f64, t: f64, gear_pole: f64) -> TransferFunction {
     let p = heading_plant(k, t, gear_pole);
     TransferFunction {
@@ -291,7 +291,7 @@ impl<const N: usize> TustinController<N> {
 /// The common frame of both FMUs: ship scale, Nomoto plant for the design, sample step, limit.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct LoopShapingCommon {
-    /// Nomoto K′ and T′ (eqs. 5.25–5.26) and the steering-gear pole a of a/(s+a) (eq. 5.28),
+    /// Nomoto K′ and T′ [Taylor2000, eqs. (5.25)–(5.26)] and the steering-gear pole a of a/(s+a) [Taylor2000, eq. (5.28)],
     /// all in t′ = tU/L.
     pub nomoto_k: f64,
     pub nomoto_t: f64,
@@ -336,7 +336,7 @@ impl LoopShapingCommon {
     }
 }
 
-/// Heading autopilot design parameters (§2.16).
+/// Heading autopilot design parameters [Taylor2000, sec. 5.2.2].
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct HeadingDesign {
     pub common: LoopShapingCommon,
@@ -356,7 +356,7 @@ impl Default for HeadingDesign {
 }
 
 impl HeadingDesign {
-    /// C = L/P = ω_n²/(K a) (T s + 1)(s + a)/(s² + 2ζω_n s + ω_n²) (eq. 5.30).
+    /// C = L/P = ω_n²/(K a) (T s + 1)(s + a)/(s² + 2ζω_n s + ω_n²) [Taylor2000, eq. (5.30)].
     pub fn controller(&self) -> Result<TransferFunction, ControlError> {
         let c = &self.common;
         c.validate()?;
@@ -382,7 +382,7 @@ impl HeadingDesign {
     }
 }
 
-/// Cross-track controller design parameters (§2.17): C_y = gain ∏(s + z_i)/∏(s + p_i).
+/// Cross-track controller design parameters [Taylor2000, sec. 5.3.2]: C_y = gain ∏(s + z_i)/∏(s + p_i).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct TrackDesign {
     pub common: LoopShapingCommon,
@@ -424,7 +424,7 @@ impl TrackDesign {
     }
 }
 
-/// Smooth 90° track-change heading profile of §4.8: steady, turn at `turn_rate` by `angle`,
+/// Smooth 90° track-change heading profile of [Taylor2000, sec. 5.2.3.2]: steady, turn at `turn_rate` by `angle`,
 /// steady leg of `leg` seconds, turn back. Times in seconds, angles in rad (negative angle = left).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct TrackChange {
@@ -877,7 +877,7 @@ mod tests {
         (100.0 * (peak - 1.0), settle)
     }
 
-    /// AT-1 (§4.13, L2273): margins of the implemented heading autopilot's loop: GM 29.82 dB at
+    /// Printed margins of the heading autopilot's loop [Taylor2000, sec. 5.2.2]: GM 29.82 dB at
     /// 7.746, PM 64.41° at 0.9146, within ±0.05 (computed 29.8226 dB, 64.406°).
     #[test]
     fn at1_heading_margins() {
@@ -890,7 +890,7 @@ mod tests {
         assert!((m.gain_crossover - 0.91463).abs() < 1e-4);
     }
 
-    /// AT-2 (L2662): track loop GM 21.57 dB at 7.277, PM 50.99° at 0.9514 (±0.05).
+    /// Printed margins of the track loop [Taylor2000, sec. 5.3.2]: GM 21.57 dB at 7.277, PM 50.99° at 0.9514 (±0.05).
     #[test]
     fn at2_track_margins() {
         let l = TrackDesign::default().open_loop().unwrap();
@@ -902,8 +902,9 @@ mod tests {
         assert!((m.gain_crossover - 0.95135).abs() < 1e-4);
     }
 
-    /// AT-5: |L(j0.01)| ≥ 40 dB. The loop gives 39.9999 dB (Appendix: "a test of ≥ 40 dB must
-    /// allow that rounding"): asserted ≥ 39.99 dB, and ≥ 40 dB for every ω ≤ 0.0099.
+    /// Low-frequency criterion [Taylor2000, sec. 5.2.2]: |L(j0.01)| ≥ 40 dB. The loop gives
+    /// 39.9999 dB (a test of ≥ 40 dB must allow that rounding): asserted ≥ 39.99 dB, and ≥ 40 dB
+    /// for every ω ≤ 0.0099.
     #[test]
     fn at5_low_frequency_gain() {
         let l = HeadingDesign::default().open_loop().unwrap();
@@ -918,10 +919,10 @@ mod tests {
         assert!((20.0 * ly.freq(0.01).norm().log10() - 72.3).abs() < 0.05);
     }
 
-    /// AT-3: heading step overshoot 4.81 % (printed "5 %", criterion ≤ 5 %), 2 % settling 4.20
-    /// ship lengths (< 5; printed "= 4"). AT-4: track step overshoot 28.46 % computed from the
-    /// documented controller and plant whose margins match exactly; the printed 25 % (Fig. 5-17,
-    /// L2682) is most likely a rounded read-off label, so the test accepts 25–29 % (spec §4.13) and
+    /// Heading step overshoot 4.81 % (printed "5 %", criterion ≤ 5 % [Taylor2000, sec. 5.2.2]),
+    /// 2 % settling 4.20 ship lengths (< 5; printed "= 4"). Track step overshoot 28.46 % computed
+    /// from the documented controller and plant whose margins match exactly; the printed 25 %
+    /// [Taylor2000, Fig. 5-17] is most likely a rounded read-off label, so the test accepts 25–29 % and
     /// asserts the computed value to ±0.05 %.
     #[test]
     fn at3_at4_step_criteria() {
@@ -997,7 +998,7 @@ mod tests {
         }
     }
 
-    /// The controller of §2.16 expands to the printed polynomial form; the track controller to
+    /// The controller of [Taylor2000, sec. 5.2.2] expands to the printed polynomial form; the track controller to
     /// its printed expansion.
     #[test]
     fn controller_polynomials() {
