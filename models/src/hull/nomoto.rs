@@ -396,7 +396,7 @@ mod tests {
                 o.yaw_rate
             );
             assert!((o.heading - psi_exp).abs() < 1e-9 * psi_exp);
-            assert!(o.yaw_rate > 0.0, "positive rudder → starboard turn (§2.1)");
+            assert!(o.yaw_rate > 0.0, "positive rudder → starboard turn (sign convention)");
         }
         // Steady turning rate K δ: after 10 T.
         let mut s = NomotoShip::ddg51();
