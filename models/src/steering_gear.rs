@@ -1,7 +1,7 @@
 //! Steering machine (rudder servo) with rudder-angle and rudder-rate limits.
 //!
 //! # Source and the reading taken
-//! [Klugt1987, sec. 2.3 and Fig. 2.8], [Klugt1987, sec. 5.2.1-5.2.2] and
+//! [Klugt1987, sec. 2.3 and Fig. 2.8, sec. 5.2.1-5.2.2] and
 //! [Klugt1987, sec. 6.5.2, eqs. (6.35)-(6.49)].
 //! Fig. 2.8 itself is lost in the OCR; the text says only that it holds "two limiters, one
 //! describing the limitation of the rudder angle and the other describing the limitation of the

@@ -22,7 +22,7 @@ pub enum Hull {
 /// Parameters, inputs and state of one container-ship instance.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct ContainerShipFmu {
-    /// 1: nonlinear (spec section 2), 2: linearised (section 4).
+    /// 1: nonlinear (MSS `container.m`), 2: linearised (MSS `Lcontainer.m`).
     variant: i32,
     params: ContainerShipParams,
     /// U0 of the linearised model [m/s].

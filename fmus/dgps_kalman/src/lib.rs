@@ -1,4 +1,4 @@
-//! `DgpsKalman` FMU: Artyszuk's 4-state DGPS position/velocity Kalman filter
+//! `DgpsKalman` FMU: the 4-state DGPS position/velocity Kalman filter of [Artyszuk2003, sec. 2]
 //! (`models::observers::dgps_kalman`). No physics here.
 
 use fmi2_export::FmuModel;
@@ -12,7 +12,7 @@ pub struct DgpsKalmanFmu {
     initial_estimate: [f64; 4],
     measured: [f64; 2],
     heading: f64,
-    /// Current speed [m/s] and the direction it flows toward [rad] (§2.1).
+    /// Current speed [m/s] and the direction it flows toward [rad] [Artyszuk2003, sec. 1].
     current: [f64; 2],
     filter: DgpsKalman,
 }

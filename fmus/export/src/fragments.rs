@@ -34,7 +34,7 @@ macro_rules! heading {
     };
 }
 
-/// The design frame shared by source 000's loop-shaped DDG-51 controllers (HeadingAutopilot,
+/// The design frame shared by the loop-shaped DDG-51 controllers of [Taylor2000, ch. 5] (HeadingAutopilot,
 /// TrackController): Nomoto plant K' and T', steering-gear pole, Tustin sample step, rudder
 /// command limit and the ship length and speed of the time base t' = tU/L, in that order, from
 /// a value with the fields of `models::controllers::loop_shaped::LoopShapingCommon` (e.g.
@@ -62,8 +62,8 @@ macro_rules! loop_shaping_common {
     };
 }
 
-/// The prime-system time base and the four measured path-model states of the Parsons-Cuong
-/// (1980) estimators (PathEstimator, PathWlsEstimator): `ship_length`, `ship_speed` (parameters)
+/// The prime-system time base and the four measured path-model states of the estimators of
+/// [Parsons1980, sec. 4-5] (PathEstimator, PathWlsEstimator): `ship_length`, `ship_speed` (parameters)
 /// and the inputs `heading`, `yaw_rate`, `drift_angle`, `cross_track` from the fields
 /// `ship_length`, `ship_speed` and `measured[0..4]` of the model.
 #[macro_export]

@@ -1,4 +1,4 @@
-//! `HeadingAutopilot` FMU: the loop-shaped DDG-51 heading autopilot (source 000) of
+//! `HeadingAutopilot` FMU: the loop-shaped DDG-51 heading autopilot [Taylor2000, sec. 5.2] of
 //! `models::controllers::loop_shaped`, Tustin-discretised in the nondimensional time base, with
 //! the +-30 deg command limit and the 90 deg track-change reference generator. No physics here.
 

@@ -8,11 +8,11 @@ use models::hull::KNOT;
 use models::observers::parameter_ekf::{ParameterEkf, ParameterEkfParams};
 use serde::{Deserialize, Serialize};
 
-/// Table 2.3 (Esso Osaka) coefficients; the default initial estimates are half of them.
+/// [Taylor2000, Table 2.3] (Esso Osaka) coefficients; the default initial estimates are half of them.
 pub const ESSO_OSAKA: [f64; 4] = [0.0244, 0.0138, 1.4578e-3, 8.093e-4];
 
 /// The default parameters: the Esso Osaka preset of `NomotoShip` (L = 1066.3 ft, U = 10 kn,
-/// assumed M and b), Table 4.1 noise, x̂₀ = 0.5 × Table 2.3, n₀ = 80 rpm.
+/// assumed M and b), [Taylor2000, Table 4.1] noise, x̂₀ = 0.5 × [Taylor2000, Table 2.3], n₀ = 80 rpm.
 pub fn default_params() -> ParameterEkfParams {
     let (m, b) = esso_osaka_assumed_m_b();
     ParameterEkfParams::table_4_1(

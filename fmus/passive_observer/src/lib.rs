@@ -1,4 +1,4 @@
-//! `PassiveObserver` FMU: Fossen & Strand's nonlinear passive DP observer with wave filtering and
+//! `PassiveObserver` FMU: the nonlinear passive DP observer of [Fossen1999] with wave filtering and
 //! bias estimation (`models::observers::passive_observer`). No physics here.
 
 use fmi2_export::FmuModel;

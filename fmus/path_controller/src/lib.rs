@@ -1,4 +1,4 @@
-//! `PathController` FMU: the Parsons & Cuong (1980, source 004) LQ path controller of
+//! `PathController` FMU: the LQ path controller of [Parsons1980, sec. 3] in
 //! `models::controllers::path` (gain design from the design depth and disturbance model, gain
 //! scheduling over depth, partial adaptation from a parameter estimator, dither) as an FMI 2.0
 //! co-simulation FMU. No physics here: the variable table maps the model onto FMI variables.
@@ -15,7 +15,7 @@ pub struct PathControllerFmu {
     params: PathControllerParams,
     /// Steering time constant [s] (T_r = 10 s full scale); T_r′ = T·U/L.
     steering_time_constant: f64,
-    /// 1: first-order shaping filter (Table 4); 2: random walk (Tables 5, 6, 8).
+    /// 1: first-order shaping filter [Parsons1980, Table 4]; 2: random walk [Parsons1980, Tables 5, 6, 8].
     disturbance_model: i32,
     epsilon: f64,
     /// Shaping-filter time constant T_N = T_Y [ship lengths].
@@ -161,7 +161,7 @@ fmi2_export::fmu! {
         output real "gain_updates" (|m| m.controller.updates() as f64),
             "Number of gain re-designs since the start";
         // ---- the rest of the current design (appended: earlier value references unchanged), for
-        // the PathKalmanFilter's f*_design inputs (004 Fig. 1: C, K and the filter model together)
+        // the PathKalmanFilter's f*_design inputs ([Parsons1980, Fig. 1]: C, K and the filter model together)
         output real "design_f22" (|m| m.controller.coefficients().f22), "f22 of the current design";
         output real "design_f32" (|m| m.controller.coefficients().f32), "f32 of the current design";
         output real "design_f33" (|m| m.controller.coefficients().f33), "f33 of the current design";

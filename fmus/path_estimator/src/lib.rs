@@ -1,5 +1,5 @@
-//! `PathEstimator` FMU: the Minimum-Variance parameter Estimator of Parsons & Cuong (1980,
-//! source 004, section 5) in `models::controllers::mve`, estimating f22, f23, f25, f32, f33, f35
+//! `PathEstimator` FMU: the Minimum-Variance parameter Estimator of [Parsons1980, sec. 5] in
+//! `models::controllers::mve`, estimating f22, f23, f25, f32, f33, f35
 //! of the Tokyo Maru from the measured states and the rudder angle; its outputs feed the
 //! PathController's estimate inputs. No physics here.
 

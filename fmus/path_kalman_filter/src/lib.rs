@@ -1,4 +1,4 @@
-//! `PathKalmanFilter` FMU: the steady-state Kalman-Bucy filter of Parsons & Cuong (1980) on the
+//! `PathKalmanFilter` FMU: the steady-state Kalman-Bucy filter of [Parsons1980, sec. 3] on the
 //! Tokyo Maru 7-state design model (`models::observers::path_kalman`). No physics here.
 
 use fmi2_export::FmuModel;

@@ -1,5 +1,5 @@
 //! `PathWlsEstimator` FMU: the moving-window Weighted Least-Squares parameter estimator of
-//! Parsons & Cuong (1980, source 004, section 4) in `models::controllers::wls`, estimating
+//! [Parsons1980, sec. 4] in `models::controllers::wls`, estimating
 //! f22, f23, f25, f32, f33, f35 of the Tokyo Maru and the window means of N′, Y′ from the
 //! measured states, the rudder angle and the control-loop filter's estimate at the window start;
 //! its f outputs feed the PathController's estimate inputs. No physics here.
@@ -18,7 +18,7 @@ pub struct PathWlsFmu {
     schedule: WlsSchedule,
     initial_depth_ratio: f64,
     gamma_depth_ratio: f64,
-    /// Table 9 PSDs r_jj of ψ′, r′, β′, η′; W = diag(1/r_jj).
+    /// PSDs r_jj of ψ′, r′, β′, η′ [Parsons1980, Table 9]; W = diag(1/r_jj).
     measurement_psd: [f64; 4],
     max_evaluations: i32,
     ship_length: f64,
@@ -48,7 +48,7 @@ impl PathWlsFmu {
     }
 }
 
-/// The Table 2 coefficients at H/T = `depth_ratio` with N′ = Y′ = 0.
+/// The [Parsons1980, Table 2] coefficients at H/T = `depth_ratio` with N′ = Y′ = 0.
 fn initial_estimate(depth_ratio: f64) -> [f64; 8] {
     let c = TokyoMaruCoefficients::at_depth_ratio(depth_ratio);
     [c.f22, c.f23, c.f25, c.f32, c.f33, c.f35, 0.0, 0.0]
@@ -62,7 +62,7 @@ impl Default for PathWlsFmu {
             update_cycle: 6.0,
         };
         // WlsSettings::default() is what settings() gives for the parameter defaults below
-        // (gammas at H/T = 1.89, Table 9 weights, 2000 evaluations); initialize rebuilds it.
+        // (gammas at H/T = 1.89, weights of [Parsons1980, Table 9], 2000 evaluations); initialize rebuilds it.
         PathWlsFmu {
             schedule,
             initial_depth_ratio: 1.89,

@@ -1,4 +1,4 @@
-//! `RrsAutopilot` FMU: the rudder roll stabilization autopilot of van der Klugt (1987, source 003)
+//! `RrsAutopilot` FMU: the rudder roll stabilization autopilot of [Klugt1987]
 //! in `models::controllers::rrs` (roll LQ via the innovation process, closed-form course
 //! controller, AGC, criterion adaptation, operator modes) as an FMI 2.0 co-simulation FMU. No
 //! physics here: the variable table maps the model onto FMI variables.

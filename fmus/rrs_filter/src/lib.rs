@@ -1,4 +1,4 @@
-//! `RrsFilter` FMU: van der Klugt's roll, yaw and adaptive speed filters
+//! `RrsFilter` FMU: the roll, yaw and adaptive speed filters of [Klugt1987, sec. 6.3]
 //! (`models::observers::rrs_filter`). No physics here.
 
 use fmi2_export::FmuModel;
@@ -27,7 +27,7 @@ impl RrsFilterFmu {
         RollFilterParams::table_2_4(self.design_speed, self.roll_q[0], self.roll_q[1])
     }
 
-    /// Yaw parameters with τ_r, k_dr, k_vr, k_dv, τ_v from Table 2.4 at the design speed.
+    /// Yaw parameters with τ_r, k_dr, k_vr, k_dv, τ_v from [Klugt1987, Table 2.4] at the design speed.
     fn yaw_params(&self) -> YawFilterParams {
         let base = YawFilterParams::realised(self.design_speed);
         YawFilterParams {

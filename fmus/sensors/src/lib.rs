@@ -1,5 +1,6 @@
 //! `Sensors` FMU: sample-and-hold plus Gaussian white measurement noise per channel
-//! (`models::sensors`), with the noise levels of 004 Tables 3/9 and 002's DGPS. No physics here.
+//! (`models::sensors`), with the noise levels of [Parsons1980, Tables 3, 9] and the DGPS of
+//! [Artyszuk2003, sec. 2]. No physics here.
 
 use fmi2_export::FmuModel;
 use models::sensors::{SensorParams, Sensors, CHANNELS};

@@ -1,5 +1,5 @@
 //! `SupplyVessel` FMU: the 3-DOF low-frequency DP model of the supply vessel Northern Clipper
-//! (`models::hull::supply_vessel`, Fossen & Strand 1999) as an FMI 2.0 co-simulation FMU. No
+//! (`models::hull::supply_vessel`, [Fossen1999, sec. 2]) as an FMI 2.0 co-simulation FMU. No
 //! physics here: the variable table maps the model onto FMI variables.
 
 use fmi2_export::FmuModel;

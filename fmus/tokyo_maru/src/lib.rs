@@ -1,4 +1,4 @@
-//! `TokyoMaru` FMU: the Parsons & Cuong (1980) linear path model of the Tokyo Maru in restricted
+//! `TokyoMaru` FMU: the linear path model of the Tokyo Maru [Parsons1980, sec. 2] in restricted
 //! water (`models::hull::tokyo_maru`) as an FMI 2.0 co-simulation FMU. No physics here: the
 //! variable table maps the model onto FMI variables.
 

@@ -1,4 +1,4 @@
-//! `TrackController` FMU: the loop-shaped DDG-51 cross-track controller (source 000) of
+//! `TrackController` FMU: the loop-shaped DDG-51 cross-track controller [Taylor2000, sec. 5.3] of
 //! `models::controllers::loop_shaped`, Tustin-discretised in the nondimensional time base, with
 //! the +-30 deg command limit and the lateral-offset reference generator. No physics here.
 

@@ -1,4 +1,4 @@
-//! `Wind` FMU: mean wind plus gusts and the roll/yaw moments of 003 eqs. 2.19-2.20
+//! `Wind` FMU: mean wind plus gusts and the roll/yaw moments of [Klugt1987, eqs. (2.19)-(2.20)]
 //! (`models::disturbances::wind`). No physics here.
 
 use fmi2_export::FmuModel;

@@ -260,12 +260,12 @@ impl RrsSpeedLaws {
 /// Which of the two models.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub enum RrsVariant {
-    /// [Klugt1987, Fig. 2.5], [Klugt1987, Tables 2.1, 2.2], 22 kn only, with wave-height filters.
+    /// [Klugt1987, Fig. 2.5, Tables 2.1, 2.2], 22 kn only, with wave-height filters.
     Simulation {
         hull: RrsHullCoefficients,
         waves: RrsWaveCoefficients,
     },
-    /// [Klugt1987, Fig. 2.6], [Klugt1987, Table 2.3] speed laws ([Klugt1987, Table 2.4] or 2.5 constants), no wave filters.
+    /// [Klugt1987, Fig. 2.6, Table 2.3] speed laws ([Klugt1987, Table 2.4] or 2.5 constants), no wave filters.
     Control { laws: RrsSpeedLaws },
 }
 
