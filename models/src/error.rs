@@ -10,6 +10,7 @@
 //! | [`check_non_negative`] | finite and ≥ 0 | `must be finite and >= 0` |
 //! | [`check_finite`] | finite | `must be finite` |
 //! | [`check_positive_or_infinite`] | > 0, +∞ included (a depth ratio of infinite depth) | `must be > 0 (inf allowed)` |
+//! | [`check_mass_matrix_2x2`] | finite entries, non-zero determinant | `must be finite`, `mass matrix must be invertible` |
 //! | [`require`] | whatever the caller states | the caller's rule |
 //!
 //! Models whose constructors report a `String` (the disturbances, the sensors, some observers)
@@ -102,6 +103,23 @@ pub fn check_positive_or_infinite(name: &str, value: f64) -> Result<(), ParamErr
     require(value > 0.0, name, value, "must be > 0 (inf allowed)")
 }
 
+/// The 2×2 sway-yaw mass matrix `m` (entries `m11` … `m22`) is finite and invertible.
+pub fn check_mass_matrix_2x2(m: &[[f64; 2]; 2]) -> Result<(), ParamError> {
+    let names = [["m11", "m12"], ["m21", "m22"]];
+    for i in 0..2 {
+        for j in 0..2 {
+            check_finite(names[i][j], m[i][j])?;
+        }
+    }
+    let det = m[0][0] * m[1][1] - m[0][1] * m[1][0];
+    require(
+        det.abs() > 0.0,
+        "m (determinant)",
+        det,
+        "mass matrix must be invertible",
+    )
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -143,6 +161,18 @@ mod tests {
         );
         let e = require(false, "e_w3_min", 2.0, "must be <= e_w3_max").unwrap_err();
         assert_eq!(e.to_string(), "parameter e_w3_min = 2 must be <= e_w3_max");
+    }
+
+    #[test]
+    fn mass_matrix_must_be_finite_and_invertible() {
+        assert!(check_mass_matrix_2x2(&[[1.0, 0.5], [0.5, 2.0]]).is_ok());
+        let e = check_mass_matrix_2x2(&[[1.0, 2.0], [2.0, 4.0]]).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "parameter m (determinant) = 0 mass matrix must be invertible"
+        );
+        let e = check_mass_matrix_2x2(&[[1.0, 0.0], [f64::NAN, 1.0]]).unwrap_err();
+        assert_eq!(e.name, "m21");
     }
 
     #[test]

@@ -535,6 +535,27 @@ impl Sampler {
         let n = ((h_prime / tau_max) * (1.0 - 1e-12)).ceil().max(1.0);
         (n as usize, h_prime / n)
     }
+
+    /// Splits a communication step of `h` seconds into n equal samples of at most the design's
+    /// sample step (in t′) and re-discretises `discrete` when the sample step changes (keeping
+    /// the old realisation if the new one cannot be built). Returns n.
+    fn prepare<const N: usize>(
+        &mut self,
+        discrete: &mut TustinController<N>,
+        transfer_function: &TransferFunction,
+        c: &LoopShapingCommon,
+        h: f64,
+    ) -> usize {
+        let scale = c.speed / c.length;
+        let (n, tau) = Sampler::split(h * scale, c.sample_step);
+        if tau != self.sample_step {
+            if let Ok(rediscretised) = discrete.rediscretised(transfer_function, tau, c.limit) {
+                *discrete = rediscretised;
+                self.sample_step = tau;
+            }
+        }
+        n
+    }
 }
 
 /// Reference source of the heading autopilot.
@@ -634,17 +655,9 @@ impl HeadingAutopilot {
             return;
         }
         let c = self.design.common;
-        let scale = c.speed / c.length;
-        let (n, tau) = Sampler::split(h * scale, c.sample_step);
-        if tau != self.sampler.sample_step {
-            if let Ok(discrete) = self
-                .discrete
-                .rediscretised(&self.transfer_function, tau, c.limit)
-            {
-                self.discrete = discrete;
-                self.sampler.sample_step = tau;
-            }
-        }
+        let n = self
+            .sampler
+            .prepare(&mut self.discrete, &self.transfer_function, &c, h);
         for i in 0..n {
             let t = self.sampler.time + i as f64 * h / n as f64;
             let r = self.reference_at(t, external_reference);
@@ -747,17 +760,9 @@ impl TrackController {
             return;
         }
         let c = self.design.common;
-        let scale = c.speed / c.length;
-        let (n, tau) = Sampler::split(h * scale, c.sample_step);
-        if tau != self.sampler.sample_step {
-            if let Ok(discrete) = self
-                .discrete
-                .rediscretised(&self.transfer_function, tau, c.limit)
-            {
-                self.discrete = discrete;
-                self.sampler.sample_step = tau;
-            }
-        }
+        let n = self
+            .sampler
+            .prepare(&mut self.discrete, &self.transfer_function, &c, h);
         for i in 0..n {
             let t = self.sampler.time + i as f64 * h / n as f64;
             let r = self.reference_at(t, external_reference);

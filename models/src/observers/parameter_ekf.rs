@@ -48,7 +48,9 @@
 //!   history is kept as prefix sums (32 bytes per update: 115 kB per hour at 1 s), which is
 //!   what makes the window exact; it grows by doubling, so no allocation happens on most steps.
 
-use crate::error::{check_finite, check_non_negative, check_positive, require};
+use crate::error::{
+    check_finite, check_mass_matrix_2x2, check_non_negative, check_positive, require,
+};
 use crate::integrate::rk4_advance;
 use nalgebra::{Matrix2, SMatrix, SVector, Vector2};
 use serde::{Deserialize, Serialize};
@@ -152,19 +154,7 @@ impl ParameterEkfParams {
             self.averaging_fraction,
             "must be in (0, 1]",
         )?;
-        let names = [["m11", "m12"], ["m21", "m22"]];
-        for i in 0..2 {
-            for j in 0..2 {
-                check_finite(names[i][j], self.mass[i][j])?;
-            }
-        }
-        let det = self.mass[0][0] * self.mass[1][1] - self.mass[0][1] * self.mass[1][0];
-        require(
-            det.abs() > 0.0,
-            "m (determinant)",
-            det,
-            "mass matrix must be invertible",
-        )?;
+        check_mass_matrix_2x2(&self.mass)?;
         for (n, v) in [("b1", self.rudder[0]), ("b2", self.rudder[1])] {
             check_finite(n, v)?;
         }
