@@ -15,7 +15,7 @@
 //!
 //! Nothing here allocates: states are fixed-size arrays or statically sized nalgebra matrices.
 
-use nalgebra::{SMatrix, SVector};
+use nalgebra::SMatrix;
 
 /// Number of equal sub-steps used to cover `h` with sub-steps no longer than `h_max`.
 /// Returns 0 for `h <= 0` (and for non-finite input), so a zero-length step is a no-op.
@@ -112,17 +112,6 @@ pub fn zoh_discretise<const N: usize, const M: usize>(
         phi = phi * phi;
     }
     (phi, gam)
-}
-
-/// Convenience: one step `x⁺ = Φ x + Γ u` of a ZOH-discretised linear system.
-#[inline]
-pub fn lti_step<const N: usize, const M: usize>(
-    phi: &SMatrix<f64, N, N>,
-    gam: &SMatrix<f64, N, M>,
-    x: &SVector<f64, N>,
-    u: &SVector<f64, M>,
-) -> SVector<f64, N> {
-    phi * x + gam * u
 }
 
 #[cfg(test)]

@@ -2,10 +2,10 @@
 //! and the metrics computed from a recorded run (turning circle and zig-zag).
 //!
 //! # Source
-//! Spec `container_ship.md` §6 (MSS `LIBRARY/maneuvering/turncircle.m`, `zigzag.m`,
-//! `mssExamples/exTurnCircle.m`, `exZigZag.m`; ITTC/IMO definitions) and §6.3 (IMO MSC.137(76)).
+//! The MSS toolbox (`LIBRARY/maneuvering/turncircle.m`, `zigzag.m`,
+//! `mssExamples/exTurnCircle.m`, `exZigZag.m`), the ITTC/IMO definitions and IMO MSC.137(76).
 //!
-//! # Definitions (§6.1, §6.2) and the readings taken
+//! # Definitions and the readings taken
 //! Let t_e be the execute time, (x_e, y_e, ψ_e) the position and heading there. The *original
 //! course* is ψ_e; "along" and "perpendicular" are measured in that direction, the heading change
 //! is Δψ = ψ − ψ_e (the heading is continuous, not wrapped).
@@ -28,7 +28,7 @@
 //!
 //! Zig-zag a/b: at t_e command +a (a may be negative for a port-first zig-zag, then the roles of
 //! ±b swap). Afterwards, when Δψ ≥ +b with r > 0 command −|a|, when Δψ ≤ −b with r < 0 command
-//! +|a| (§6.2, checked on the sampled heading and rate at the start of each step, as MSS does).
+//! +|a| (checked on the sampled heading and rate at the start of each step, as MSS `zigzag.m` does).
 //! Metrics (with s = sign(a), all angles as s·Δψ so that a port-first test reads like a
 //! starboard-first one):
 //! * **Second execute**: first time s·Δψ reaches +b (interpolated); **initial turning time** =
@@ -404,7 +404,7 @@ pub fn zigzag(
     })
 }
 
-/// IMO MSC.137(76) 10/10 first-overshoot limit [rad] for L/U [s] (§6.3).
+/// IMO MSC.137(76) 10/10 first-overshoot limit [rad] for L/U [s].
 pub fn imo_10_10_first_overshoot_limit(l_over_u: f64) -> f64 {
     let deg = if l_over_u < 10.0 {
         10.0
@@ -630,14 +630,14 @@ mod tests {
         2.0 * r
     }
 
-    /// Container ship manoeuvres (§6.1, §6.2) from the 80 rpm straight-line equilibrium
+    /// Container ship manoeuvres (turning circle, zig-zag) from the 80 rpm straight-line equilibrium
     /// (u = 8.37667 m/s), rudder executed at t_e = 10 s, RK4 sub-step 0.05 s, communication step
-    /// 0.1 s. Commands of 35° and 20° saturate at 10° (§2.6). No source publishes these numbers
-    /// (MSS computes but prints none in the spec), so they are stated here, not asserted as
+    /// 0.1 s. Commands of 35° and 20° saturate at 10° (MSS `container.m`). No source publishes these numbers
+    /// (MSS computes them but prints none), so they are stated here, not asserted as
     /// references; the test asserts what can be checked independently: the steady diameter
     /// against the geometric diameter of the recorded track (0.5 %), a forward-Euler h = 0.01 s
     /// integration written in the test (MSS's integrator; metrics within 0.5 %), independence
-    /// of the communication step, port/starboard symmetry, the §1 heel signs and IMO criteria.
+    /// of the communication step, port/starboard symmetry, the heel signs of MSS `exRRD3.m` and IMO criteria.
     ///
     /// Results (printed with `--nocapture`):
     /// * turning circle, 35° command (10° effective), starboard: advance 983.1 m (5.62 L),
@@ -678,7 +678,7 @@ mod tests {
         let (mp, _) = run_tc(-35.0 * DEG, 0.1);
         assert!((mp.tactical_diameter - m.tactical_diameter).abs() < 1e-9 * m.tactical_diameter);
         assert!((mp.steady_heel + m.steady_heel).abs() < 1e-12);
-        // Physics checks (§1, §5.4).
+        // Physics checks (sign conventions, inverse initial roll).
         assert!(m.steady_heel < 0.0, "outward heel in a starboard turn");
         assert!(m.initial_inward_heel > 0.0, "inverse initial roll");
         assert!(m.speed_loss > 0.0 && m.speed_loss < 0.5);
@@ -760,7 +760,7 @@ mod tests {
             }
             let z = res[0];
             print_zz(name, &z);
-            // The switching instant is quantised by the communication step (§6.2: checked at
+            // The switching instant is quantised by the communication step (as in MSS `zigzag.m`: checked at
             // the start of each step), so h = 0.1 vs 0.05 s differ slightly.
             assert!((z.first_overshoot - res[1].first_overshoot).abs() < 0.05 * DEG);
             assert!((z.initial_turning_time - res[1].initial_turning_time).abs() < 0.02);
@@ -776,8 +776,8 @@ mod tests {
         }
     }
 
-    /// Mariner manoeuvres (§3, §6) from the trimmed straight course at 15 kn (the trim input
-    /// u_i ≈ −1.108° of §3.3 held before execute at t_e = 10 s), 35° starboard turning circle,
+    /// Mariner manoeuvres (MSS `mariner.m`) from the trimmed straight course at 15 kn (the trim input
+    /// u_i ≈ −1.108° held before execute at t_e = 10 s), 35° starboard turning circle,
     /// 10/10 and 20/20 zig-zags with heading measured from the execute heading (0). Stated and
     /// checked as for the container ship.
     ///

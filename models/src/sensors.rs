@@ -12,21 +12,23 @@
 //! reached (communication points computed by repeated addition land a few ulps off the grid).
 //!
 //! # Noise levels of the sources
-//! * **004 (Parsons & Cuong) Table 3** (control loop) and **Table 9** (parameter estimator):
-//!   per-sample σ′ = √(r_jj/Δt′) (eqs. 15-16) at Δt′ = 0.005 (Δt = 0.2349 s for Tokyo Maru at
+//! * **[Parsons1980, Table 3]** (control loop) and **[Parsons1980, Table 9]** (parameter estimator):
+//!   per-sample σ′ = √(r_jj/Δt′) [Parsons1980, eqs. (15)-(16)] at Δt′ = 0.005 (Δt = 0.2349 s for Tokyo Maru at
 //!   12 kn, L = 290 m). Dimensional per-sample values: ψ σ′ rad; r σ′·U/L rad/s; η σ′·L m;
 //!   v = −U β′ so σ_v = σ′_β·U m/s. [`per_sample_sigma`] computes σ′ from (σ, τ, Δt).
-//!   **Reading taken, Table 3 β′ row**: the original (seed 004, Table 3) prints σ′ = 1.459e-3,
-//!   but its own r_jj = 1.118e-8 gives √(r/Δt′) = 1.495e-3, as does σ = 0.01 m/s with eq. 15;
+//!   **Reading taken, Table 3 β′ row**: [Parsons1980, Table 3] prints σ′ = 1.459e-3,
+//!   but its own r_jj = 1.118e-8 gives √(r/Δt′) = 1.495e-3, as does σ = 0.01 m/s with
+//!   [Parsons1980, eq. (15)];
 //!   the printed value is taken as transposed digits and **1.495e-3** is used.
-//! * **002 (Artyszuk) DGPS**: σ = 2 m per axis at 1 s ([`SensorParams::dgps_002`]).
-//! * **000 (DDG-51)**: "noisy measurements" of heading and y, level not given; use the 004 compass
+//! * **DGPS [Artyszuk2003, sec. 2]**: σ = 2 m per axis at 1 s ([`SensorParams::dgps_002`]).
+//! * **DDG-51 [Taylor2000, sec. 5.2.3.1]**: "noisy measurements" of heading and y, level not given; use the [Parsons1980] compass
 //!   channel (0.1° class) or set σ.
-//! * **003**: roll and speed noise levels not given (speed variance "1" in §5.5.3 has no unit);
+//! * **[Klugt1987]**: roll and speed noise levels not given (speed variance "1" in [Klugt1987, sec. 5.5.3] has no unit);
 //!   default 0.
 //!
-//! A global `noise_scale` multiplies every σ (004 uses 1, 0.001 and 0).
+//! A global `noise_scale` multiplies every σ ([Parsons1980] uses 1, 0.001 and 0).
 
+use crate::error::{check_non_negative, check_positive};
 use crate::random::{channel, NoiseStream};
 use serde::{Deserialize, Serialize};
 
@@ -59,15 +61,15 @@ pub mod ch {
     pub const SWAY_VELOCITY: usize = 8;
 }
 
-/// 004 reference conditions: Tokyo Maru, U = 12 kn, L = 290 m.
+/// Reference conditions of [Parsons1980, Table 1]: Tokyo Maru, U = 12 kn, L = 290 m.
 pub const TOKYO_MARU_U: f64 = 12.0 * 1852.0 / 3600.0;
 pub const TOKYO_MARU_L: f64 = 290.0;
-/// 004 simulation step Δt′ = 0.005 → seconds.
+/// Simulation step Δt′ = 0.005 of [Parsons1980, sec. 2.2] → seconds.
 pub const TOKYO_MARU_DT: f64 = 0.005 * TOKYO_MARU_L / TOKYO_MARU_U;
 
 /// Per-sample standard deviation of the white sequence equivalent to exponentially correlated
-/// noise (RMS σ, correlation time τ) sampled every Δt: `√(2 σ² τ / Δt)` (004 eqs. 15-16).
-/// Any consistent units (004 uses nondimensional τ′ = τU/L and Δt′).
+/// noise (RMS σ, correlation time τ) sampled every Δt: `√(2 σ² τ / Δt)` [Parsons1980, eqs. (15)-(16)].
+/// Any consistent units ([Parsons1980] uses nondimensional τ′ = τU/L and Δt′).
 pub fn per_sample_sigma(sigma: f64, tau: f64, dt: f64) -> f64 {
     (2.0 * sigma * sigma * tau / dt).sqrt()
 }
@@ -87,7 +89,7 @@ pub struct SensorParams {
 }
 
 impl SensorParams {
-    /// 004 Table 3 (control loop) for ψ, r, η, v at Δt = 0.2349 s; 002 DGPS for north/east;
+    /// [Parsons1980, Table 3] (control loop) for ψ, r, η, v at Δt = 0.2349 s; DGPS of [Artyszuk2003] for north/east;
     /// roll, roll rate and speed noise-free (no source value), sampled at 0.1, 0.1 and 1 s.
     pub fn tokyo_maru_table3() -> Self {
         let (u, l, dt) = (TOKYO_MARU_U, TOKYO_MARU_L, TOKYO_MARU_DT);
@@ -109,18 +111,7 @@ impl SensorParams {
         }
     }
 
-    /// 004 Table 9 (parameter estimator): ψ, r, β (→ v), η; the rest as Table 3.
-    pub fn tokyo_maru_table9() -> Self {
-        let (u, l) = (TOKYO_MARU_U, TOKYO_MARU_L);
-        let mut p = Self::tokyo_maru_table3();
-        p.channels[ch::HEADING].sigma = 5.0943e-4;
-        p.channels[ch::YAW_RATE].sigma = 3.9298e-4 * u / l;
-        p.channels[ch::SWAY_VELOCITY].sigma = 4.0688e-4 * u;
-        p.channels[ch::CROSS_TRACK].sigma = 1.0065e-3 * l;
-        p
-    }
-
-    /// 002 DGPS: north and east σ = 2 m at 1 s, everything else noise-free at 1 s.
+    /// DGPS of [Artyszuk2003, sec. 2]: north and east σ = 2 m at 1 s, everything else noise-free at 1 s.
     pub fn dgps_002() -> Self {
         let mut p = Self::tokyo_maru_table3();
         for (i, c) in p.channels.iter_mut().enumerate() {
@@ -136,16 +127,10 @@ impl SensorParams {
 
     pub fn validate(&self) -> Result<(), String> {
         for (c, (name, _)) in self.channels.iter().zip(CHANNEL_NAMES) {
-            if !(c.sigma >= 0.0 && c.sigma.is_finite()) {
-                return Err(format!("{name}_sigma = {} must be >= 0", c.sigma));
-            }
-            if !(c.interval > 0.0 && c.interval.is_finite()) {
-                return Err(format!("{name}_interval = {} must be > 0", c.interval));
-            }
+            check_non_negative(&format!("{name}_sigma"), c.sigma)?;
+            check_positive(&format!("{name}_interval"), c.interval)?;
         }
-        if !(self.noise_scale >= 0.0 && self.noise_scale.is_finite()) {
-            return Err(format!("noise_scale = {} must be >= 0", self.noise_scale));
-        }
+        check_non_negative("noise_scale", self.noise_scale)?;
         Ok(())
     }
 }
@@ -258,11 +243,6 @@ impl Sensors {
     pub fn measured(&self, i: usize) -> f64 {
         self.state[i].held
     }
-
-    /// Index of the latest sample of channel `i`.
-    pub fn sample_index(&self, i: usize) -> u64 {
-        self.state[i].k
-    }
 }
 
 #[cfg(test)]
@@ -278,7 +258,7 @@ mod tests {
         let dt = 0.005;
         assert!((TOKYO_MARU_DT - 0.2349).abs() < 1e-4);
         let rel = |a: f64, b: f64| (a / b - 1.0).abs();
-        // Table 3, τ = 0.1 s
+        // [Parsons1980, Table 3], τ = 0.1 s
         assert!(rel(per_sample_sigma(0.1 * d, tau(0.1), dt), 1.611e-3) < 1e-3);
         assert!(rel(per_sample_sigma(0.01 * d / ul, tau(0.1), dt), 7.563e-3) < 1e-3);
         assert!(rel(per_sample_sigma(3.0 / TOKYO_MARU_L, tau(0.1), dt), 9.549e-3) < 1e-3);
@@ -286,7 +266,7 @@ mod tests {
         let b = per_sample_sigma(0.01 / TOKYO_MARU_U, tau(0.1), dt);
         assert!(rel(b, 1.495e-3) < 1e-3, "{b}");
         assert!(rel(b, 1.459e-3) > 0.02);
-        // Table 9, τ = 0.01 s
+        // [Parsons1980, Table 9], τ = 0.01 s
         assert!(rel(per_sample_sigma(0.1 * d, tau(0.01), dt), 5.0943e-4) < 1e-3);
         assert!(
             rel(
@@ -347,7 +327,7 @@ mod tests {
         let (_, v) = mean_variance(&n);
         assert!((v.sqrt() - 2.0).abs() < 0.02, "{}", v.sqrt());
         assert!(correlation(&n, &e).abs() < 0.05);
-        // dimensional Table 3 values
+        // dimensional [Parsons1980, Table 3] values
         assert!((sig[ch::YAW_RATE] - 1.6100e-4).abs() < 1e-7);
         assert!((sig[ch::CROSS_TRACK] - 2.7692).abs() < 1e-3);
     }

@@ -1,34 +1,34 @@
 //! Steering machine (rudder servo) with rudder-angle and rudder-rate limits.
 //!
 //! # Source and the reading taken
-//! Van der Klugt (1987), *Rudder Roll Stabilization* (seed 003), §2.3 Fig. 2.8, §5.2.1-5.2.2 and
-//! §6.5.2 (eqs. 6.35-6.49); spec `rrs_models_filters.md` §2.5 and `rrs_controller_results.md` §2.1.
+//! [Klugt1987, sec. 2.3 and Fig. 2.8, sec. 5.2.1-5.2.2] and
+//! [Klugt1987, sec. 6.5.2, eqs. (6.35)-(6.49)].
 //! Fig. 2.8 itself is lost in the OCR; the text says only that it holds "two limiters, one
 //! describing the limitation of the rudder angle and the other describing the limitation of the
 //! rudder speed", the angle limit being "the rudder-angle constraints of the autopilot, or ... the
-//! mechanical constraints". The two spec extracts place the angle limiter differently (on the set
-//! point vs. as integrator clamping). This model applies **both**, with the same limit δ_max:
+//! mechanical constraints". The text admits two places for the angle limiter (on the set point,
+//! or as clamping of the integrator). This model applies **both**, with the same limit δ_max:
 //!
 //! ```text
 //! δ_c  = sat(δ_g, ±δ_max)                         set-point (autopilot) limit
-//! e_δ  = δ_c − δ_w                                servo error (eq. 6.38, read as e_δ = τ_δ δ̇_w)
+//! e_δ  = δ_c − δ_w                                servo error ([Klugt1987, eq. (6.38)], read as e_δ = τ_δ δ̇_w)
 //! δ̇_w = sat(e_δ / τ_δ, ±δ̇_max)                   gain 1/τ_δ, then the rate limiter
 //! δ_w  = sat(∫ δ̇_w dt, ±δ_max)                    mechanical stop
 //! ```
 //!
 //! For the first-order servo the two readings give identical δ_w (a first-order lag of a signal
 //! bounded by δ_max stays within δ_max); the stop only matters for the second-order servo.
-//! Small-signal transfer: δ_w/δ_g = 1/(τ_δ s + 1) (eq. 6.35).
+//! Small-signal transfer: δ_w/δ_g = 1/(τ_δ s + 1) [Klugt1987, eq. (6.35)].
 //!
-//! Second-order servo (§6.5.2, eqs. 6.41-6.42): the gain 1/τ_δ is replaced by the main-servo
+//! Second-order servo [Klugt1987, sec. 6.5.2, eqs. (6.41)-(6.42)]: the gain 1/τ_δ is replaced by the main-servo
 //! dynamics K/(τ s + 1), giving H = ω0²/(s² + 2 z0 ω0 s + ω0²) with ω0² = K/τ, 2 z0 ω0 = 1/τ.
 //! The rate limiter acts on the main-servo output (the rudder speed).
 //!
 //! The other sources use special cases of the first-order servo:
-//! * DDG-51 thesis (seed 000, eq. 5.28): δ/δ_c = 6/(s + 6) in nondimensional time t' = tU/L, with a
+//! * DDG-51 [Taylor2000, eq. (5.28)]: δ/δ_c = 6/(s + 6) in nondimensional time t' = tU/L, with a
 //!   ±30° command limit and no rate limit: τ_δ = L/(6U) s (≈ 2.09 s at 22 kn).
-//! * Parsons & Cuong (seed 004, eq. 10): dδ'/dt' = (δ'_c − δ')/T_r with the [DERIVED]
-//!   T_r = 0.212874 nondimensional = 10 s full scale, no rate limit.
+//! * Tokyo Maru [Parsons1980, eq. (10)]: dδ'/dt' = (δ'_c − δ')/T_r with T_r = 10 s full scale,
+//!   T_r = 0.212874 nondimensional (derived here, not printed in the source), no rate limit.
 //!
 //! # Integration
 //! The command is held constant over a step (zero-order hold, as every FMI master delivers it).
@@ -37,15 +37,15 @@
 //! not depend on the step size. The second-order servo uses classical RK4 on a fixed sub-step of at
 //! most [`SteeringGearParams::max_substep`].
 
+use crate::error::{check_positive, ParamError};
 use serde::{Deserialize, Serialize};
-use std::fmt;
 
 /// Order of the servo loop.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub enum ServoOrder {
-    /// Gain 1/τ_δ followed by the rate limiter (Fig. 2.8, eq. 6.35).
+    /// Gain 1/τ_δ followed by the rate limiter [Klugt1987, Fig. 2.8, eq. (6.35)].
     First,
-    /// Main servo K/(τ s + 1) followed by the rate limiter (eqs. 6.41-6.42).
+    /// Main servo K/(τ s + 1) followed by the rate limiter [Klugt1987, eqs. (6.41)-(6.42)].
     Second,
 }
 
@@ -56,15 +56,15 @@ pub struct SteeringGearParams {
     pub angle_max: f64,
     /// Rudder-rate limit δ̇_max [rad/s].
     pub rate_max: f64,
-    /// Whether the rate limiter is present (false for the 000 and 004 gears).
+    /// Whether the rate limiter is present (false for the gears of [Taylor2000] and [Parsons1980]).
     pub rate_limited: bool,
     /// Servo time constant τ_δ [s] of the first-order servo.
     pub time_constant: f64,
     /// First- or second-order servo.
     pub order: ServoOrder,
-    /// Natural frequency ω0 [rad/s] of the second-order servo (eq. 6.42).
+    /// Natural frequency ω0 [rad/s] of the second-order servo [Klugt1987, eq. (6.42)].
     pub omega0: f64,
-    /// Relative damping z0 [-] of the second-order servo (eq. 6.44 requires z0 ≥ 1).
+    /// Relative damping z0 [-] of the second-order servo ([Klugt1987, eq. (6.44)] requires z0 ≥ 1).
     pub zeta0: f64,
     /// Largest RK4 sub-step [s] for the second-order servo.
     pub max_substep: f64,
@@ -73,9 +73,10 @@ pub struct SteeringGearParams {
 const DEG: f64 = std::f64::consts::PI / 180.0;
 
 impl SteeringGearParams {
-    /// The RRS steering machine of seed 003: δ_max = 22°, δ̇_max = 15 deg/s (the settings of the
-    /// Table 7.1 trials), τ_δ = 0.2 s (within the rule τ_δ ≤ 0.2/ω_n of eq. 6.37 for
-    /// ω_n = 0.63-0.75 rad/s; the thesis prints no single value), first-order servo.
+    /// The RRS steering machine of [Klugt1987]: δ_max = 22°, δ̇_max = 15 deg/s (the settings of the
+    /// trials of [Klugt1987, Table 7.1]), τ_δ = 0.2 s (within the rule τ_δ ≤ 0.2/ω_n of
+    /// [Klugt1987, eq. (6.37)] for ω_n = 0.63-0.75 rad/s; the thesis prints no single value),
+    /// first-order servo.
     pub fn rrs_003() -> Self {
         SteeringGearParams {
             angle_max: 22.0 * DEG,
@@ -89,7 +90,7 @@ impl SteeringGearParams {
         }
     }
 
-    /// The DDG-51 gear of seed 000 (eq. 5.28): 6/(s+6) in nondimensional time, i.e.
+    /// The DDG-51 gear [Taylor2000, eq. (5.28)]: 6/(s+6) in nondimensional time, i.e.
     /// τ = L/(6U) seconds, ±30° command limit, no rate limit.
     pub fn ddg51_000(length_m: f64, speed_m_s: f64) -> Self {
         SteeringGearParams {
@@ -100,8 +101,8 @@ impl SteeringGearParams {
         }
     }
 
-    /// The Tokyo Maru gear of seed 004 (eq. 10): first-order lag T_r = 10 s full scale
-    /// ([DERIVED] T_r' = 0.212874), no rate limit; δ_max is not given there and is left at 35°.
+    /// The Tokyo Maru gear [Parsons1980, eq. (10)]: first-order lag T_r = 10 s full scale
+    /// (T_r' = 0.212874, derived here), no rate limit; δ_max is not given there and is left at 35°.
     pub fn tokyo_maru_004() -> Self {
         SteeringGearParams {
             angle_max: 35.0 * DEG,
@@ -113,23 +114,12 @@ impl SteeringGearParams {
 
     /// Checks every parameter; the message names the parameter and its value.
     pub fn validate(&self) -> Result<(), ParamError> {
-        fn positive(name: &'static str, v: f64) -> Result<(), ParamError> {
-            if v.is_finite() && v > 0.0 {
-                Ok(())
-            } else {
-                Err(ParamError {
-                    name,
-                    value: v,
-                    rule: "must be finite and > 0",
-                })
-            }
-        }
-        positive("angle_max", self.angle_max)?;
-        positive("rate_max", self.rate_max)?;
-        positive("time_constant", self.time_constant)?;
-        positive("omega0", self.omega0)?;
-        positive("zeta0", self.zeta0)?;
-        positive("max_substep", self.max_substep)?;
+        check_positive("angle_max", self.angle_max)?;
+        check_positive("rate_max", self.rate_max)?;
+        check_positive("time_constant", self.time_constant)?;
+        check_positive("omega0", self.omega0)?;
+        check_positive("zeta0", self.zeta0)?;
+        check_positive("max_substep", self.max_substep)?;
         Ok(())
     }
 }
@@ -139,22 +129,6 @@ impl Default for SteeringGearParams {
         Self::rrs_003()
     }
 }
-
-/// A parameter outside its legal range.
-#[derive(Clone, Debug, PartialEq)]
-pub struct ParamError {
-    pub name: &'static str,
-    pub value: f64,
-    pub rule: &'static str,
-}
-
-impl fmt::Display for ParamError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "parameter {} = {} {}", self.name, self.value, self.rule)
-    }
-}
-
-impl std::error::Error for ParamError {}
 
 /// The steering machine's state.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -356,7 +330,7 @@ mod tests {
         assert_eq!(SteeringGear::new(p, 0.0).unwrap_err().name, "rate_max");
     }
 
-    /// T1 (rrs_controller_results.md §4.1, thesis §5.2.1): with a negligible servo time constant and
+    /// Angle limit [Klugt1987, sec. 5.2.1]: with a negligible servo time constant and
     /// an unlimited rate, the angle limit clips the amplitude with no phase shift, and has no
     /// effect for u_δ ≤ δ_max.
     #[test]
@@ -413,7 +387,7 @@ mod tests {
         }
     }
 
-    /// T2 (thesis §5.2.2, eq. 5.2): δ_g = a sin(bt) with ab = 3 δ̇_max. The rate limiter causes a
+    /// Rate limit [Klugt1987, sec. 5.2.2, eq. (5.2)]: δ_g = a sin(bt) with ab = 3 δ̇_max. The rate limiter causes a
     /// considerable phase lag and a low-frequency component that decays asymptotically.
     ///
     /// Expected values derived here from the limiter alone (τ_δ → 0): the settled output is a
@@ -474,7 +448,7 @@ mod tests {
         );
     }
 
-    /// Classification rule (thesis §2.3): 35° port to 35° starboard within 30 s needs 2.5 deg/s.
+    /// Classification rule [Klugt1987, sec. 2.3]: 35° port to 35° starboard within 30 s needs 2.5 deg/s.
     /// Expected time to come within ε of the target, from the piecewise solution:
     /// (70° − δ̇τ)/δ̇ + τ ln(δ̇τ/ε).
     #[test]
@@ -504,14 +478,14 @@ mod tests {
         assert!((g.rate_saturated_time() - (70.0 * DEG - rate * tau) / rate).abs() < 1e-9);
     }
 
-    /// Seed 000 gear (eq. 5.28): 6/(s+6) in t' = tU/L with a ±30° command limit. A 40° command
+    /// DDG-51 gear [Taylor2000, eq. (5.28)]: 6/(s+6) in t' = tU/L with a ±30° command limit. A 40° command
     /// is clipped to 30°, and the response is 30°(1 − e^(−t/τ)), τ = L/(6U).
     #[test]
     fn ddg51_gear_step_response() {
         let (l, u) = (142.0, 22.0 * 1852.0 / 3600.0);
         let p = SteeringGearParams::ddg51_000(l, u);
         let tau = l / (6.0 * u);
-        assert!((tau - 2.0913).abs() < 1e-3); // ≈ 2.09 s at 22 kn (spec §4.13 note)
+        assert!((tau - 2.0913).abs() < 1e-3); // ≈ 2.09 s at 22 kn (derived: L/(6U))
         let mut g = gear(p);
         for k in 1..=2000 {
             g.step(40.0 * DEG, 0.01);
@@ -521,7 +495,7 @@ mod tests {
         }
     }
 
-    /// Seed 004 gear (eq. 10): first-order lag T_r = 10 s full scale; 63.2 % at t = T_r, and the
+    /// Tokyo Maru gear [Parsons1980, eq. (10)]: first-order lag T_r = 10 s full scale; 63.2 % at t = T_r, and the
     /// same answer whatever the step size (exact integration).
     #[test]
     fn tokyo_maru_gear_step_response_is_step_size_independent() {
@@ -551,8 +525,8 @@ mod tests {
         assert!((one.rate_saturated_time() - many.rate_saturated_time()).abs() < 1e-12);
     }
 
-    /// Second-order servo (eq. 6.42) with z0 = 1 and no rate limit: the step response is
-    /// 1 − (1 + ω0 t) e^(−ω0 t), and its −3 dB bandwidth is ω0·√(√2 − 1) = 0.6436 ω0 (App. H).
+    /// Second-order servo [Klugt1987, eq. (6.42)] with z0 = 1 and no rate limit: the step response is
+    /// 1 − (1 + ω0 t) e^(−ω0 t), and its −3 dB bandwidth is ω0·√(√2 − 1) = 0.6436 ω0 [Klugt1987, App. H].
     #[test]
     fn second_order_servo_matches_critically_damped_response() {
         let p = SteeringGearParams {
@@ -591,7 +565,7 @@ mod tests {
             "gain {}",
             amp / 0.01
         );
-        // eq. 6.49: phase −2 atan(B/ω0) = −65.5°
+        // [Klugt1987, eq. (6.49)]: phase −2 atan(B/ω0) = −65.5°
         assert!((phase / DEG + 65.5).abs() < 0.2, "phase {}", phase / DEG);
     }
 

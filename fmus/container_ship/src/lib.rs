@@ -3,12 +3,12 @@
 //! co-simulation FMU. No physics here: the variable table maps the model onto FMI variables.
 
 use fmi2_export::FmuModel;
+use models::error::{check_finite, check_positive, ParamError};
 use models::hull::container_ship::{
     ContainerShip, ContainerShipInputs, ContainerShipOutputs, ContainerShipParams,
     LinearContainerShip, LinearContainerShipInputs, PropellerInflow,
 };
 use models::hull::DEG;
-use models::steering_gear::ParamError;
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 
@@ -22,7 +22,7 @@ pub enum Hull {
 /// Parameters, inputs and state of one container-ship instance.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct ContainerShipFmu {
-    /// 1: nonlinear (spec section 2), 2: linearised (section 4).
+    /// 1: nonlinear (MSS `container.m`), 2: linearised (MSS `Lcontainer.m`).
     variant: i32,
     params: ContainerShipParams,
     /// U0 of the linearised model [m/s].
@@ -66,13 +66,12 @@ impl Default for ContainerShipFmu {
 
 /// A model error with the model's parameter name replaced by the FMU variable's name.
 fn param_error(e: ParamError) -> String {
-    let name = match e.name {
-        "u" => "initial_surge_velocity",
-        "n_rpm" => "initial_shaft_speed",
-        "u0" => "nominal_speed",
-        other => other,
-    };
-    format!("parameter {name} = {} {}", e.value, e.rule)
+    e.renamed(&[
+        ("u", "initial_surge_velocity"),
+        ("n_rpm", "initial_shaft_speed"),
+        ("u0", "nominal_speed"),
+    ])
+    .to_string()
 }
 
 impl ContainerShipFmu {
@@ -90,22 +89,14 @@ impl ContainerShipFmu {
         match self.variant {
             1 => {
                 let n = self.initial_shaft_speed;
-                if !(n.is_finite() && n > 0.0) {
-                    return Err(format!(
-                        "parameter initial_shaft_speed = {n} must be finite and > 0"
-                    ));
-                }
+                check_positive("initial_shaft_speed", n)?;
                 let u = if self.start_at_equilibrium {
                     ContainerShip::straight_line_speed(n)
                 } else {
                     self.initial_surge_velocity
                 };
                 let v = self.initial_sway_velocity;
-                if !v.is_finite() {
-                    return Err(format!(
-                        "parameter initial_sway_velocity = {v} must be finite"
-                    ));
-                }
+                check_finite("initial_sway_velocity", v)?;
                 let ship = ContainerShip::new(
                     self.params.clone(),
                     [u, v, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, n],

@@ -1,5 +1,6 @@
 //! `Current` FMU: currents and slowly varying disturbances of `models::disturbances::current`
-//! (000's 5-kn current, 004's N'/Y' design disturbances, 001's bias). No physics here.
+//! (the 5-kn current of [Taylor2000, sec. 5.2.3.1], the N'/Y' design disturbances of
+//! [Parsons1980, sec. 2.3 and 3.2-3.3], the bias of [Fossen1999, eq. (7)]). No physics here.
 
 use fmi2_export::FmuModel;
 use models::disturbances::current::{Current, CurrentParams};

@@ -1,4 +1,4 @@
-//! `DgpsKalman` FMU: Artyszuk's 4-state DGPS position/velocity Kalman filter
+//! `DgpsKalman` FMU: the 4-state DGPS position/velocity Kalman filter of [Artyszuk2003, sec. 2]
 //! (`models::observers::dgps_kalman`). No physics here.
 
 use fmi2_export::FmuModel;
@@ -9,10 +9,10 @@ use serde::{Deserialize, Serialize};
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct DgpsKalmanFmu {
     params: DgpsKalmanParams,
-    x0: [f64; 4],
-    z: [f64; 2],
+    initial_estimate: [f64; 4],
+    measured: [f64; 2],
     heading: f64,
-    /// Current speed [m/s] and the direction it flows toward [rad] (§2.1).
+    /// Current speed [m/s] and the direction it flows toward [rad] [Artyszuk2003, sec. 1].
     current: [f64; 2],
     filter: DgpsKalman,
 }
@@ -21,8 +21,8 @@ impl Default for DgpsKalmanFmu {
     fn default() -> Self {
         DgpsKalmanFmu {
             params: DgpsKalmanParams::default(),
-            x0: [0.0; 4],
-            z: [0.0; 2],
+            initial_estimate: [0.0; 4],
+            measured: [0.0; 2],
             heading: 0.0,
             current: [0.0; 2],
             filter: DgpsKalman::new(DgpsKalmanParams::default(), [0.0; 4]).expect("preset"),
@@ -58,12 +58,12 @@ fmi2_export::fmu! {
         fixed bool "full_recursion" (params.full_recursion),
             "true: time-varying Kalman recursion from P0 = p0 I; false: the steady-state form of eq. 5 (the paper's results)";
         fixed real "initial_covariance" (params.p0).min(0.0), "p0 of P0 = p0 I for the full recursion";
-        fixed real "initial_velocity_north" ["m/s"] (x0[0]), "Initial v_NS estimate";
-        fixed real "initial_velocity_east" ["m/s"] (x0[1]), "Initial v_EW estimate";
-        fixed real "initial_north" ["m"] (x0[2]), "Initial north position estimate";
-        fixed real "initial_east" ["m"] (x0[3]), "Initial east position estimate";
-        input real "north_measured" ["m"] (z[0]), "DGPS north position fix";
-        input real "east_measured" ["m"] (z[1]), "DGPS east position fix";
+        fixed real "initial_velocity_north" ["m/s"] (initial_estimate[0]), "Initial v_NS estimate";
+        fixed real "initial_velocity_east" ["m/s"] (initial_estimate[1]), "Initial v_EW estimate";
+        fixed real "initial_north" ["m"] (initial_estimate[2]), "Initial north position estimate";
+        fixed real "initial_east" ["m"] (initial_estimate[3]), "Initial east position estimate";
+        input real "north_measured" ["m"] (measured[0]), "DGPS north position fix";
+        input real "east_measured" ["m"] (measured[1]), "DGPS east position fix";
         input real "heading" ["rad"] (heading), "Gyro heading psi (for the drift angle, eq. 7)";
         output real "velocity_north_estimate" ["m/s"] (|m| m.filter.estimate()[0]).depends_on(&[]),
             "Estimated v_NS";
@@ -106,12 +106,12 @@ fmi2_export::fmu! {
 
 impl FmuModel for DgpsKalmanFmu {
     fn initialize(&mut self, _start_time: f64) -> Result<(), String> {
-        self.filter = DgpsKalman::new(self.params, self.x0)?;
+        self.filter = DgpsKalman::new(self.params, self.initial_estimate)?;
         Ok(())
     }
 
     fn do_step(&mut self, _t: f64, h: f64) -> Result<(), String> {
-        self.filter.step(self.z[0], self.z[1], h);
+        self.filter.step(self.measured[0], self.measured[1], h);
         Ok(())
     }
 }

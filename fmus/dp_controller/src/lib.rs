@@ -11,14 +11,15 @@ use serde::{Deserialize, Serialize};
 pub struct DpControllerFmu {
     params: DpParams,
     inputs: DpInputs,
-    ctrl: DpController,
+    controller: DpController,
 }
 
 impl Default for DpControllerFmu {
     fn default() -> Self {
         let params = DpParams::northern_clipper();
         DpControllerFmu {
-            ctrl: DpController::new(params.clone(), 0.0).expect("preset parameters are valid"),
+            controller: DpController::new(params.clone(), 0.0)
+                .expect("preset parameters are valid"),
             params,
             inputs: DpInputs::default(),
         }
@@ -27,7 +28,7 @@ impl Default for DpControllerFmu {
 
 impl DpControllerFmu {
     fn tau(&self, i: usize) -> f64 {
-        self.ctrl.tau(&self.inputs)[i]
+        self.controller.tau(&self.inputs)[i]
     }
     fn error(&self, i: usize) -> f64 {
         body_error(self.inputs.eta, self.inputs.setpoint)[i]
@@ -123,34 +124,34 @@ fmi2_export::fmu! {
             "Body-frame position error, sway";
         output real "error_yaw" ["rad"] (|m| m.error(2)).depends_on(ERR_DEPS),
             "Heading error, wrapped to (-pi, pi]";
-        calculated real "kp_surge" (|m| m.ctrl.gains().0[0]), "Kp surge [N/m]";
-        calculated real "kp_sway" (|m| m.ctrl.gains().0[1]), "Kp sway [N/m]";
-        calculated real "kp_yaw" (|m| m.ctrl.gains().0[2]), "Kp yaw [N m/rad]";
-        calculated real "kd_surge" (|m| m.ctrl.gains().1[0]), "Kd surge [N s/m]";
-        calculated real "kd_sway" (|m| m.ctrl.gains().1[1]), "Kd sway [N s/m]";
-        calculated real "kd_yaw" (|m| m.ctrl.gains().1[2]), "Kd yaw [N m s/rad]";
-        calculated real "ki_surge" (|m| m.ctrl.gains().2[0]), "Ki surge [N/(m s)]";
-        calculated real "ki_sway" (|m| m.ctrl.gains().2[1]), "Ki sway [N/(m s)]";
-        calculated real "ki_yaw" (|m| m.ctrl.gains().2[2]), "Ki yaw [N m/(rad s)]";
+        calculated real "kp_surge" (|m| m.controller.gains().0[0]), "Kp surge [N/m]";
+        calculated real "kp_sway" (|m| m.controller.gains().0[1]), "Kp sway [N/m]";
+        calculated real "kp_yaw" (|m| m.controller.gains().0[2]), "Kp yaw [N m/rad]";
+        calculated real "kd_surge" (|m| m.controller.gains().1[0]), "Kd surge [N s/m]";
+        calculated real "kd_sway" (|m| m.controller.gains().1[1]), "Kd sway [N s/m]";
+        calculated real "kd_yaw" (|m| m.controller.gains().1[2]), "Kd yaw [N m s/rad]";
+        calculated real "ki_surge" (|m| m.controller.gains().2[0]), "Ki surge [N/(m s)]";
+        calculated real "ki_sway" (|m| m.controller.gains().2[1]), "Ki sway [N/(m s)]";
+        calculated real "ki_yaw" (|m| m.controller.gains().2[2]), "Ki yaw [N m/(rad s)]";
     }
 }
 
 impl FmuModel for DpControllerFmu {
     fn initialize(&mut self, start_time: f64) -> Result<(), String> {
-        self.ctrl = DpController::new(self.params.clone(), quantise_time(start_time))
+        self.controller = DpController::new(self.params.clone(), quantise_time(start_time))
             .map_err(|e| e.to_string())?;
         Ok(())
     }
 
     fn parameters_changed(&mut self) -> Result<(), String> {
-        self.ctrl
+        self.controller
             .set_params(self.params.clone())
             .map_err(|e| e.to_string())
     }
 
     fn do_step(&mut self, t: f64, h: f64) -> Result<(), String> {
-        self.ctrl.step(&self.inputs, h);
-        self.ctrl.set_time(quantise_time(t + h));
+        self.controller.step(&self.inputs, h);
+        self.controller.set_time(quantise_time(t + h));
         Ok(())
     }
 }

@@ -358,7 +358,7 @@ unsafe fn get_values<M: FmuModel, T>(
         }
         if inst.core.state == LifeState::InitializationMode && inst.dirty {
             // In Initialization Mode the outputs (InitialUnknowns) must reflect the parameters
-            // and start values set so far (FMI 2.0 §3.2.3/§4.2.4): rebuild the model from them.
+            // and start values set so far (FMI 2.0 sections 3.2.3 and 4.2.4): rebuild the model from them.
             // `initialize` is idempotent; an error is reported by fmi2ExitInitializationMode.
             if inst.model.initialize(inst.core.start_time).is_ok() {
                 inst.model.calculate_outputs();

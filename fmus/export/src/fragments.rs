@@ -34,11 +34,11 @@ macro_rules! heading {
     };
 }
 
-/// The design frame shared by source 000's loop-shaped DDG-51 controllers (HeadingAutopilot,
+/// The design frame shared by the loop-shaped DDG-51 controllers of [Taylor2000, ch. 5] (HeadingAutopilot,
 /// TrackController): Nomoto plant K' and T', steering-gear pole, Tustin sample step, rudder
 /// command limit and the ship length and speed of the time base t' = tU/L, in that order, from
 /// a value with the fields of `models::controllers::loop_shaped::LoopShapingCommon` (e.g.
-/// `loop_shaping_common!(d.common);` reads and writes `m.d.common.nomoto_k`, ...).
+/// `loop_shaping_common!(design.common);` reads and writes `m.design.common.nomoto_k`, ...).
 #[macro_export]
 macro_rules! loop_shaping_common {
     (@fragment [$model:ty] [$($done:tt)*] ($($path:tt)*) $($rest:tt)*) => {
@@ -62,10 +62,10 @@ macro_rules! loop_shaping_common {
     };
 }
 
-/// The prime-system time base and the four measured path-model states of the Parsons-Cuong
-/// (1980) estimators (PathEstimator, PathWlsEstimator): `ship_length`, `ship_speed` (parameters)
+/// The prime-system time base and the four measured path-model states of the estimators of
+/// [Parsons1980, sec. 4-5] (PathEstimator, PathWlsEstimator): `ship_length`, `ship_speed` (parameters)
 /// and the inputs `heading`, `yaw_rate`, `drift_angle`, `cross_track` from the fields
-/// `ship_length`, `ship_speed` and `z[0..4]` of the model.
+/// `ship_length`, `ship_speed` and `measured[0..4]` of the model.
 #[macro_export]
 macro_rules! path_measurements {
     (@fragment [$model:ty] [$($done:tt)*] () $($rest:tt)*) => {
@@ -74,12 +74,12 @@ macro_rules! path_measurements {
                 "Ship length L of the prime system (290 m)";
             fixed real "ship_speed" ["m/s"] (ship_speed).min(0.0),
                 "Ship speed U of the prime system (12 kn)";
-            input real "heading" ["rad"] (z[0]),
+            input real "heading" ["rad"] (measured[0]),
                 "Measured heading psi relative to the track direction";
-            input real "yaw_rate" ["rad/s"] (z[1]), "Measured yaw rate r";
-            input real "drift_angle" ["rad"] (z[2]),
+            input real "yaw_rate" ["rad/s"] (measured[1]), "Measured yaw rate r";
+            input real "drift_angle" ["rad"] (measured[2]),
                 "Measured drift angle beta (Doppler sonar, v = -U beta)";
-            input real "cross_track" ["m"] (z[3]), "Measured lateral offset eta";
+            input real "cross_track" ["m"] (measured[3]), "Measured lateral offset eta";
             $($rest)*
         )
     };

@@ -9,7 +9,7 @@
 //! `cargo xtask build-fmus`). [`testing`] drives an FMU through those symbols by variable name;
 //! `docs/ADDING_AN_FMU.md` walks through a new FMU.
 //!
-//! What the layer guarantees, for every FMU (spec `fmi_ecosystem.md` §2.4, modelled on the
+//! What the layer guarantees, for every FMU (the rules of the FMI 2.0 standard, modelled on the
 //! Modelica Reference FMUs' `fmi2Functions.c`):
 //! * a call-sequence state machine: a call that is illegal in the current state returns
 //!   `fmi2Error` and logs "Illegal call sequence";

@@ -208,7 +208,7 @@ pub const UNITS: &[UnitDef] = &[
         display: &[],
     },
     UnitDef {
-        // wind moment coefficient: moment per dynamic pressure-like term (003 eqs. 2.19-2.20)
+        // wind moment coefficient: moment per dynamic pressure-like term ([Klugt1987, eqs. (2.19)-(2.20)])
         name: "N.m.s2/m2",
         exponents: [1, 0, 0, 0, 0, 0, 0, 0],
         factor: 1.0,

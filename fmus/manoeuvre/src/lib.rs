@@ -10,6 +10,7 @@
 //! `fmi2DoStep(t, h)` commits the generator's decision at t with the inputs held over the step.
 
 use fmi2_export::FmuModel;
+use models::error::{check_finite, check_non_negative, check_positive};
 use models::hull::DEG;
 use models::manoeuvre::{ManoeuvreGenerator, ManoeuvreKind};
 use serde::{Deserialize, Serialize};
@@ -72,20 +73,18 @@ impl ManoeuvreFmu {
             ("execute_time", self.execute_time),
             ("initial_command", self.initial_command),
         ] {
-            if !v.is_finite() {
-                return Err(format!("parameter {name} = {v} must be finite"));
-            }
+            check_finite(name, v)?;
         }
         let kind = match self.kind {
             1 => ManoeuvreKind::TurningCircle { rudder },
-            2 if check.is_finite() && check > 0.0 => ManoeuvreKind::ZigZag { rudder, check },
-            2 => Err(format!(
-                "parameter check_angle = {check} must be finite and > 0"
-            ))?,
-            3 if hold.is_finite() && hold >= 0.0 => ManoeuvreKind::PullOut { rudder, hold },
-            3 => Err(format!(
-                "parameter hold_time = {hold} must be finite and >= 0"
-            ))?,
+            2 => {
+                check_positive("check_angle", check)?;
+                ManoeuvreKind::ZigZag { rudder, check }
+            }
+            3 => {
+                check_non_negative("hold_time", hold)?;
+                ManoeuvreKind::PullOut { rudder, hold }
+            }
             v => Err(format!("parameter kind = {v} must be 1, 2 or 3"))?,
         };
         let (execute, initial) = (self.execute_time, self.initial_command);

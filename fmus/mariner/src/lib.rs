@@ -3,9 +3,9 @@
 //! maps the model onto FMI variables.
 
 use fmi2_export::FmuModel;
+use models::error::ParamError;
 use models::hull::mariner::{Mariner, MarinerInputs, MarinerOutputs, MarinerParams, U0_DEFAULT};
 use models::hull::DEG;
-use models::steering_gear::ParamError;
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 
@@ -39,11 +39,7 @@ impl Default for MarinerFmu {
 
 /// A model error with the model's parameter name replaced by the FMU variable's name.
 fn param_error(e: ParamError) -> String {
-    let name = match e.name {
-        "u0" => "nominal_speed",
-        other => other,
-    };
-    format!("parameter {name} = {} {}", e.value, e.rule)
+    e.renamed(&[("u0", "nominal_speed")]).to_string()
 }
 
 impl MarinerFmu {

@@ -4,9 +4,9 @@
 //! table maps the model onto FMI variables.
 
 use fmi2_export::FmuModel;
+use models::error::{check_positive, ParamError};
 use models::hull::nomoto::{NomotoInputs, NomotoModel, NomotoOutputs, NomotoShip};
 use models::hull::DEG;
-use models::steering_gear::ParamError;
 use serde::{Deserialize, Serialize};
 
 /// Parameters, inputs and state of one instance.
@@ -16,9 +16,9 @@ pub struct NomotoShipFmu {
     model: i32,
     t_prime: f64,
     k_prime: f64,
-    m: [[f64; 2]; 2],
-    n: [[f64; 2]; 2],
-    b: [f64; 2],
+    mass: [[f64; 2]; 2],
+    damping: [[f64; 2]; 2],
+    rudder: [f64; 2],
     /// 0: the preset's value.
     length: f64,
     /// 0: the preset's value.
@@ -38,7 +38,7 @@ impl Default for NomotoShipFmu {
             NomotoModel::FirstOrder { t, k } => (t, k),
             NomotoModel::SwayYaw { .. } => unreachable!("ddg51 is first order"),
         };
-        let (m, n, b) = match NomotoShip::esso_osaka().model {
+        let (mass, damping, rudder) = match NomotoShip::esso_osaka().model {
             NomotoModel::SwayYaw { m, n, b } => (m, n, b),
             NomotoModel::FirstOrder { .. } => unreachable!("esso_osaka is sway-yaw"),
         };
@@ -46,9 +46,9 @@ impl Default for NomotoShipFmu {
             model: 1,
             t_prime,
             k_prime,
-            m,
-            n,
-            b,
+            mass,
+            damping,
+            rudder,
             length: 0.0,
             speed: 0.0,
             max_substep: ddg.max_substep,
@@ -63,12 +63,7 @@ impl Default for NomotoShipFmu {
 
 /// A model error with the model's parameter name replaced by the FMU variable's name.
 fn param_error(e: ParamError) -> String {
-    let name = match e.name {
-        "t" => "t_prime",
-        "k" => "k_prime",
-        other => other,
-    };
-    format!("parameter {name} = {} {}", e.value, e.rule)
+    e.renamed(&[("t", "t_prime"), ("k", "k_prime")]).to_string()
 }
 
 impl NomotoShipFmu {
@@ -89,9 +84,9 @@ impl NomotoShipFmu {
             2 => (
                 NomotoShip::esso_osaka(),
                 NomotoModel::SwayYaw {
-                    m: self.m,
-                    n: self.n,
-                    b: self.b,
+                    m: self.mass,
+                    n: self.damping,
+                    b: self.rudder,
                 },
             ),
             v => return Err(format!("parameter model = {v} must be 1 or 2")),
@@ -107,12 +102,7 @@ impl NomotoShipFmu {
             self.speed
         };
         let mut ship = NomotoShip::new(model, length, speed).map_err(param_error)?;
-        if !(self.max_substep.is_finite() && self.max_substep > 0.0) {
-            return Err(format!(
-                "parameter max_substep = {} must be finite and > 0",
-                self.max_substep
-            ));
-        }
+        check_positive("max_substep", self.max_substep)?;
         ship.max_substep = self.max_substep;
         Ok(ship)
     }
@@ -135,24 +125,24 @@ fmi2_export::fmu! {
         fixed real "t_prime" (t_prime),
             "Model 1: nondimensional Nomoto time constant T' (eq. 5.25: 1.9287)";
         fixed real "k_prime" (k_prime), "Model 1: nondimensional Nomoto gain K' (eq. 5.26: 2.04)";
-        fixed real "m11" (m[0][0]),
+        fixed real "m11" (mass[0][0]),
             "Model 2: mass matrix M, entry m11 = m' - Y'_vdot (prime system)";
-        fixed real "m12" (m[0][1]),
+        fixed real "m12" (mass[0][1]),
             "Model 2: mass matrix M, entry m12 = m'x'_G - Y'_rdot (prime system)";
-        fixed real "m21" (m[1][0]),
+        fixed real "m21" (mass[1][0]),
             "Model 2: mass matrix M, entry m21 = m'x'_G - N'_vdot (prime system)";
-        fixed real "m22" (m[1][1]),
+        fixed real "m22" (mass[1][1]),
             "Model 2: mass matrix M, entry m22 = I'_z - N'_rdot (prime system)";
-        fixed real "n11" (n[0][0]),
+        fixed real "n11" (damping[0][0]),
             "Model 2: damping matrix N (one of the four hull coefficients of Table 2.3), entry n11 = -Y'_v (prime system)";
-        fixed real "n12" (n[0][1]),
+        fixed real "n12" (damping[0][1]),
             "Model 2: damping matrix N (one of the four hull coefficients of Table 2.3), entry n12 = m' - Y'_r (prime system)";
-        fixed real "n21" (n[1][0]),
+        fixed real "n21" (damping[1][0]),
             "Model 2: damping matrix N (one of the four hull coefficients of Table 2.3), entry n21 = -N'_v (prime system)";
-        fixed real "n22" (n[1][1]),
+        fixed real "n22" (damping[1][1]),
             "Model 2: damping matrix N (one of the four hull coefficients of Table 2.3), entry n22 = m'x'_G - N'_r (prime system)";
-        fixed real "b1" (b[0]), "Model 2: rudder vector entry b1 = Y'_delta (prime system, per rad)";
-        fixed real "b2" (b[1]), "Model 2: rudder vector entry b2 = N'_delta (prime system, per rad)";
+        fixed real "b1" (rudder[0]), "Model 2: rudder vector entry b1 = Y'_delta (prime system, per rad)";
+        fixed real "b2" (rudder[1]), "Model 2: rudder vector entry b2 = N'_delta (prime system, per rad)";
         fixed real "length" ["m"] (length).min(0.0),
             "Reference length L; 0 (default): the preset's (model 1: 466 ft = 142.04 m; model 2: \
              1066.3 ft = 325.01 m)";
@@ -210,7 +200,7 @@ mod tests {
         assert!(e.contains("t_prime = -1"), "{e}");
         let mut m = NomotoShipFmu {
             model: 2,
-            m: [[0.0; 2]; 2],
+            mass: [[0.0; 2]; 2],
             ..Default::default()
         };
         let e = m.initialize(0.0).unwrap_err();

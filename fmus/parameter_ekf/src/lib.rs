@@ -8,11 +8,11 @@ use models::hull::KNOT;
 use models::observers::parameter_ekf::{ParameterEkf, ParameterEkfParams};
 use serde::{Deserialize, Serialize};
 
-/// Table 2.3 (Esso Osaka) coefficients; the default initial estimates are half of them.
+/// [Taylor2000, Table 2.3] (Esso Osaka) coefficients; the default initial estimates are half of them.
 pub const ESSO_OSAKA: [f64; 4] = [0.0244, 0.0138, 1.4578e-3, 8.093e-4];
 
 /// The default parameters: the Esso Osaka preset of `NomotoShip` (L = 1066.3 ft, U = 10 kn,
-/// assumed M and b), Table 4.1 noise, x̂₀ = 0.5 × Table 2.3, n₀ = 80 rpm.
+/// assumed M and b), [Taylor2000, Table 4.1] noise, x̂₀ = 0.5 × [Taylor2000, Table 2.3], n₀ = 80 rpm.
 pub fn default_params() -> ParameterEkfParams {
     let (m, b) = esso_osaka_assumed_m_b();
     ParameterEkfParams::table_4_1(
@@ -30,7 +30,7 @@ pub fn default_params() -> ParameterEkfParams {
 pub struct ParameterEkfFmu {
     params: ParameterEkfParams,
     /// Measured u [m/s], v [m/s], r [rad/s], n [rpm].
-    z: [f64; 4],
+    measured: [f64; 4],
     rudder: f64,
     filter: ParameterEkf,
 }
@@ -41,7 +41,7 @@ impl Default for ParameterEkfFmu {
         ParameterEkfFmu {
             filter: ParameterEkf::new(params.clone(), 0.0).expect("preset"),
             params,
-            z: [10.0 * KNOT, 0.0, 0.0, 80.0],
+            measured: [10.0 * KNOT, 0.0, 0.0, 80.0],
             rudder: 0.0,
         }
     }
@@ -97,10 +97,10 @@ fmi2_export::fmu! {
         fixed real "max_substep" ["s"] (params.max_substep).min(0.0),
             "Largest RK4 sub-step of the propagation of the estimate and covariance";
         // ---- inputs ----
-        input real "surge_velocity_measured" ["m/s"] (z[0]), "Measured surge u";
-        input real "sway_velocity_measured" ["m/s"] (z[1]), "Measured sway v";
-        input real "yaw_rate_measured" ["rad/s"] (z[2]), "Measured yaw rate r";
-        input real "shaft_speed_measured" ["rpm"] (z[3]), "Measured shaft speed n";
+        input real "surge_velocity_measured" ["m/s"] (measured[0]), "Measured surge u";
+        input real "sway_velocity_measured" ["m/s"] (measured[1]), "Measured sway v";
+        input real "yaw_rate_measured" ["rad/s"] (measured[2]), "Measured yaw rate r";
+        input real "shaft_speed_measured" ["rpm"] (measured[3]), "Measured shaft speed n";
         input real "rudder_angle" ["rad"] (rudder),
             "Rudder angle applied over the step (positive: starboard turn)";
         // ---- outputs ----
@@ -150,7 +150,7 @@ impl FmuModel for ParameterEkfFmu {
     }
 
     fn do_step(&mut self, t: f64, h: f64) -> Result<(), String> {
-        self.filter.step(t, h, self.z, self.rudder);
+        self.filter.step(t, h, self.measured, self.rudder);
         Ok(())
     }
 }

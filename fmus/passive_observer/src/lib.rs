@@ -1,4 +1,4 @@
-//! `PassiveObserver` FMU: Fossen & Strand's nonlinear passive DP observer with wave filtering and
+//! `PassiveObserver` FMU: the nonlinear passive DP observer of [Fossen1999] with wave filtering and
 //! bias estimation (`models::observers::passive_observer`). No physics here.
 
 use fmi2_export::FmuModel;
@@ -9,21 +9,21 @@ use serde::{Deserialize, Serialize};
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct PassiveObserverFmu {
     params: PassiveObserverParams,
-    eta0: [f64; 3],
-    y: [f64; 3],
-    tau: [f64; 3],
-    obs: PassiveObserver,
+    initial_estimate: [f64; 3],
+    measured: [f64; 3],
+    thrust: [f64; 3],
+    observer: PassiveObserver,
 }
 
 impl Default for PassiveObserverFmu {
     fn default() -> Self {
         let params = PassiveObserverParams::northern_clipper();
         PassiveObserverFmu {
-            obs: PassiveObserver::new(params.clone(), [0.0; 3]).expect("preset"),
+            observer: PassiveObserver::new(params.clone(), [0.0; 3]).expect("preset"),
             params,
-            eta0: [0.0; 3],
-            y: [0.0; 3],
-            tau: [0.0; 3],
+            initial_estimate: [0.0; 3],
+            measured: [0.0; 3],
+            thrust: [0.0; 3],
         }
     }
 }
@@ -89,61 +89,61 @@ fmi2_export::fmu! {
         tunable int "injection" (params.injection => { 1: Injection::Literal, 2: Injection::MassNormalised }),
             "1: eq. 25 literally with SI M, D (bias in N, N.m; the paper's gains then give almost no velocity/bias injection); 2: injection as an acceleration, bias state in m/s2 (normalised-model reading, default)";
         fixed real "max_substep" ["s"] (params.max_substep).min(0.0), "Largest RK4 sub-step";
-        fixed real "initial_north" ["m"] (eta0[0]), "Initial LF position/heading estimate";
-        fixed real "initial_east" ["m"] (eta0[1]), "Initial LF position/heading estimate";
-        fixed real "initial_heading" ["rad"] (eta0[2]), "Initial LF position/heading estimate";
-        input real "north_measured" ["m"] (y[0]), "Measured north position y1 = x + WF motion (DGPS)";
-        input real "east_measured" ["m"] (y[1]), "Measured east position y2";
-        input real "heading_measured" ["rad"] (y[2]), "Measured heading y3 (gyrocompass)";
-        input real "tau_surge" ["N"] (tau[0]), "Commanded thrust surge (body frame)";
-        input real "tau_sway" ["N"] (tau[1]), "Commanded thrust sway (body frame)";
-        input real "tau_yaw" ["N.m"] (tau[2]), "Commanded thrust yaw (body frame)";
-        output real "north_estimate" ["m"] (|m| m.obs.eta()[0]),
+        fixed real "initial_north" ["m"] (initial_estimate[0]), "Initial LF position/heading estimate";
+        fixed real "initial_east" ["m"] (initial_estimate[1]), "Initial LF position/heading estimate";
+        fixed real "initial_heading" ["rad"] (initial_estimate[2]), "Initial LF position/heading estimate";
+        input real "north_measured" ["m"] (measured[0]), "Measured north position y1 = x + WF motion (DGPS)";
+        input real "east_measured" ["m"] (measured[1]), "Measured east position y2";
+        input real "heading_measured" ["rad"] (measured[2]), "Measured heading y3 (gyrocompass)";
+        input real "tau_surge" ["N"] (thrust[0]), "Commanded thrust surge (body frame)";
+        input real "tau_sway" ["N"] (thrust[1]), "Commanded thrust sway (body frame)";
+        input real "tau_yaw" ["N.m"] (thrust[2]), "Commanded thrust yaw (body frame)";
+        output real "north_estimate" ["m"] (|m| m.observer.eta()[0]),
             "LF estimate eta_hat (wave-frequency motion removed)";
-        output real "east_estimate" ["m"] (|m| m.obs.eta()[1]),
+        output real "east_estimate" ["m"] (|m| m.observer.eta()[1]),
             "LF estimate eta_hat (wave-frequency motion removed)";
-        output real "heading_estimate" ["rad"] (|m| m.obs.eta()[2]),
+        output real "heading_estimate" ["rad"] (|m| m.observer.eta()[2]),
             "LF estimate eta_hat (wave-frequency motion removed)";
-        output real "surge_velocity_estimate" ["m/s"] (|m| m.obs.nu()[0]),
+        output real "surge_velocity_estimate" ["m/s"] (|m| m.observer.nu()[0]),
             "LF velocity estimate nu_hat (body)";
-        output real "sway_velocity_estimate" ["m/s"] (|m| m.obs.nu()[1]),
+        output real "sway_velocity_estimate" ["m/s"] (|m| m.observer.nu()[1]),
             "LF velocity estimate nu_hat (body)";
-        output real "yaw_rate_estimate" ["rad/s"] (|m| m.obs.nu()[2]),
+        output real "yaw_rate_estimate" ["rad/s"] (|m| m.observer.nu()[2]),
             "LF velocity estimate nu_hat (body)";
-        output real "north_wf_estimate" ["m"] (|m| m.obs.eta_w()[0]),
+        output real "north_wf_estimate" ["m"] (|m| m.observer.eta_w()[0]),
             "Wave-frequency motion estimate eta_w_hat = xi2_hat";
-        output real "east_wf_estimate" ["m"] (|m| m.obs.eta_w()[1]),
+        output real "east_wf_estimate" ["m"] (|m| m.observer.eta_w()[1]),
             "Wave-frequency motion estimate eta_w_hat = xi2_hat";
-        output real "heading_wf_estimate" ["rad"] (|m| m.obs.eta_w()[2]),
+        output real "heading_wf_estimate" ["rad"] (|m| m.observer.eta_w()[2]),
             "Wave-frequency motion estimate eta_w_hat = xi2_hat";
-        output real "bias_north_estimate" ["N"] (|m| m.obs.bias_force()[0]),
+        output real "bias_north_estimate" ["N"] (|m| m.observer.bias_force()[0]),
             "Earth-fixed bias force estimate (J M J^T b_hat when mass-normalised)";
-        output real "bias_east_estimate" ["N"] (|m| m.obs.bias_force()[1]),
+        output real "bias_east_estimate" ["N"] (|m| m.observer.bias_force()[1]),
             "Earth-fixed bias force estimate (J M J^T b_hat when mass-normalised)";
-        output real "bias_yaw_estimate" ["N.m"] (|m| m.obs.bias_force()[2]),
+        output real "bias_yaw_estimate" ["N.m"] (|m| m.observer.bias_force()[2]),
             "Earth-fixed bias force estimate (J M J^T b_hat when mass-normalised)";
-        output real "innovation_north" ["m"] (|m| m.obs.innovation()[0]), "Innovation y - y_hat";
-        output real "innovation_east" ["m"] (|m| m.obs.innovation()[1]), "Innovation y - y_hat";
-        output real "innovation_heading" ["rad"] (|m| m.obs.innovation()[2]), "Innovation y - y_hat";
-        output real "k1_surge" (|m| m.obs.gains().0[0]),
+        output real "innovation_north" ["m"] (|m| m.observer.innovation()[0]), "Innovation y - y_hat";
+        output real "innovation_east" ["m"] (|m| m.observer.innovation()[1]), "Innovation y - y_hat";
+        output real "innovation_heading" ["rad"] (|m| m.observer.innovation()[2]), "Innovation y - y_hat";
+        output real "k1_surge" (|m| m.observer.gains().0[0]),
             "Notch gain k1 = -2 (zeta_n - zeta) omega_c / omega0 (eq. 45; -2.2059 for the paper's set)";
-        output real "k2_surge" ["rad/s"] (|m| m.obs.gains().1[0]),
+        output real "k2_surge" ["rad/s"] (|m| m.observer.gains().1[0]),
             "Notch gain k2 = 2 omega0 (zeta_n - zeta) (eq. 46; 1.6157)";
     }
 }
 
 impl FmuModel for PassiveObserverFmu {
     fn initialize(&mut self, _start_time: f64) -> Result<(), String> {
-        self.obs = PassiveObserver::new(self.params.clone(), self.eta0)?;
+        self.observer = PassiveObserver::new(self.params.clone(), self.initial_estimate)?;
         Ok(())
     }
 
     fn parameters_changed(&mut self) -> Result<(), String> {
-        self.obs.set_params(self.params.clone())
+        self.observer.set_params(self.params.clone())
     }
 
     fn do_step(&mut self, _t: f64, h: f64) -> Result<(), String> {
-        self.obs.step(self.y, self.tau, h);
+        self.observer.step(self.measured, self.thrust, h);
         Ok(())
     }
 }

@@ -1,4 +1,4 @@
-//! `PathController` FMU: the Parsons & Cuong (1980, source 004) LQ path controller of
+//! `PathController` FMU: the LQ path controller of [Parsons1980, sec. 3] in
 //! `models::controllers::path` (gain design from the design depth and disturbance model, gain
 //! scheduling over depth, partial adaptation from a parameter estimator, dither) as an FMI 2.0
 //! co-simulation FMU. No physics here: the variable table maps the model onto FMI variables.
@@ -15,13 +15,13 @@ pub struct PathControllerFmu {
     params: PathControllerParams,
     /// Steering time constant [s] (T_r = 10 s full scale); T_r′ = T·U/L.
     steering_time_constant: f64,
-    /// 1: first-order shaping filter (Table 4); 2: random walk (Tables 5, 6, 8).
+    /// 1: first-order shaping filter [Parsons1980, Table 4]; 2: random walk [Parsons1980, Tables 5, 6, 8].
     disturbance_model: i32,
     epsilon: f64,
     /// Shaping-filter time constant T_N = T_Y [ship lengths].
     shaping_time_constant: f64,
     inputs: PathInputs,
-    ctl: PathController,
+    controller: PathController,
 }
 
 impl PathControllerFmu {
@@ -55,7 +55,7 @@ impl Default for PathControllerFmu {
                 depth_ratio: params.design_depth_ratio,
                 ..PathInputs::default()
             },
-            ctl: PathController::new(params).expect("default design solves"),
+            controller: PathController::new(params).expect("default design solves"),
             params,
         }
     }
@@ -144,45 +144,47 @@ fmi2_export::fmu! {
         input real "f33_estimate" (inputs.estimates[4]), "Estimator output f33 (adaptation = 2)";
         input real "f35_estimate" (inputs.estimates[5]), "Estimator output f35 (adaptation = 2)";
         // ---- outputs (38..49)
-        output real "rudder_command" ["rad"] (|m| m.ctl.command(&m.inputs)),
+        output real "rudder_command" ["rad"] (|m| m.controller.command(&m.inputs)),
             "Rudder command delta_c = C x' (control loop) or the dither square wave";
-        output bool "dithering" (|m| m.ctl.dithering()),
+        output bool "dithering" (|m| m.controller.dithering()),
             "Inside a dither window (control loop off)";
-        output real "gain_heading" (|m| m.ctl.gains().c[0]), "c11: gain on psi' [rad/rad]";
-        output real "gain_yaw_rate" (|m| m.ctl.gains().c[1]), "c12: gain on r' = rL/U";
-        output real "gain_drift_angle" (|m| m.ctl.gains().c[2]), "c13: gain on beta'";
-        output real "gain_cross_track" (|m| m.ctl.gains().c[3]),
+        output real "gain_heading" (|m| m.controller.gains().c[0]), "c11: gain on psi' [rad/rad]";
+        output real "gain_yaw_rate" (|m| m.controller.gains().c[1]), "c12: gain on r' = rL/U";
+        output real "gain_drift_angle" (|m| m.controller.gains().c[2]), "c13: gain on beta'";
+        output real "gain_cross_track" (|m| m.controller.gains().c[3]),
             "c14: gain on eta' = eta/L (sqrt(a44/b11) = 2.4252)";
-        output real "gain_rudder" (|m| m.ctl.gains().c[4]), "c15: gain on delta'";
-        output real "gain_yaw_moment" (|m| m.ctl.gains().c[5]), "c16: feedforward gain on N'";
-        output real "gain_sway_force" (|m| m.ctl.gains().c[6]), "c17: feedforward gain on Y'";
-        output real "design_f23" (|m| m.ctl.coefficients().f23), "f23 of the current design";
-        output real "design_f25" (|m| m.ctl.coefficients().f25), "f25 of the current design";
-        output real "gain_updates" (|m| m.ctl.updates() as f64),
+        output real "gain_rudder" (|m| m.controller.gains().c[4]), "c15: gain on delta'";
+        output real "gain_yaw_moment" (|m| m.controller.gains().c[5]), "c16: feedforward gain on N'";
+        output real "gain_sway_force" (|m| m.controller.gains().c[6]), "c17: feedforward gain on Y'";
+        output real "design_f23" (|m| m.controller.coefficients().f23), "f23 of the current design";
+        output real "design_f25" (|m| m.controller.coefficients().f25), "f25 of the current design";
+        output real "gain_updates" (|m| m.controller.updates() as f64),
             "Number of gain re-designs since the start";
         // ---- the rest of the current design (appended: earlier value references unchanged), for
-        // the PathKalmanFilter's f*_design inputs (004 Fig. 1: C, K and the filter model together)
-        output real "design_f22" (|m| m.ctl.coefficients().f22), "f22 of the current design";
-        output real "design_f32" (|m| m.ctl.coefficients().f32), "f32 of the current design";
-        output real "design_f33" (|m| m.ctl.coefficients().f33), "f33 of the current design";
-        output real "design_f35" (|m| m.ctl.coefficients().f35), "f35 of the current design";
+        // the PathKalmanFilter's f*_design inputs ([Parsons1980, Fig. 1]: C, K and the filter model together)
+        output real "design_f22" (|m| m.controller.coefficients().f22), "f22 of the current design";
+        output real "design_f32" (|m| m.controller.coefficients().f32), "f32 of the current design";
+        output real "design_f33" (|m| m.controller.coefficients().f33), "f33 of the current design";
+        output real "design_f35" (|m| m.controller.coefficients().f35), "f35 of the current design";
     }
 }
 
 impl FmuModel for PathControllerFmu {
     fn initialize(&mut self, _start_time: f64) -> Result<(), String> {
-        self.ctl = PathController::new(self.model_params()).map_err(|e| e.to_string())?;
-        self.ctl.start(&self.inputs);
+        self.controller = PathController::new(self.model_params()).map_err(|e| e.to_string())?;
+        self.controller.start(&self.inputs);
         Ok(())
     }
 
     fn parameters_changed(&mut self) -> Result<(), String> {
-        self.ctl
+        self.controller
             .set_params(self.model_params())
             .map_err(|e| e.to_string())
     }
 
     fn do_step(&mut self, _t: f64, h: f64) -> Result<(), String> {
-        self.ctl.step(&self.inputs, h).map_err(|e| e.to_string())
+        self.controller
+            .step(&self.inputs, h)
+            .map_err(|e| e.to_string())
     }
 }

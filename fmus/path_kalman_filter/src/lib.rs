@@ -1,7 +1,8 @@
-//! `PathKalmanFilter` FMU: the steady-state Kalman-Bucy filter of Parsons & Cuong (1980) on the
+//! `PathKalmanFilter` FMU: the steady-state Kalman-Bucy filter of [Parsons1980, sec. 3] on the
 //! Tokyo Maru 7-state design model (`models::observers::path_kalman`). No physics here.
 
 use fmi2_export::FmuModel;
+use models::error::check_positive;
 use models::hull::tokyo_maru::{TokyoMaruCoefficients, L, U};
 use models::observers::path_kalman::{PathKalmanConfig, PathKalmanFilter};
 use serde::{Deserialize, Serialize};
@@ -15,9 +16,9 @@ pub struct PathKalmanFilterFmu {
     euler_step_prime: f64,
     innovation_window: f64,
     /// Initial estimate, SI: ψ, r, β, η, δ, N′, Y′.
-    x0: [f64; 7],
+    initial_estimate: [f64; 7],
     /// Inputs: ψ, r, η measured; δ_c.
-    z: [f64; 3],
+    measured: [f64; 3],
     command: f64,
     /// Follow the design-coefficient inputs (the gain update of an adaptive loop).
     follow_design_inputs: bool,
@@ -37,8 +38,8 @@ impl Default for PathKalmanFilterFmu {
             steering_time_constant: 10.0,
             euler_step_prime: 0.005,
             innovation_window: 1.0,
-            x0: [0.0; 7],
-            z: [0.0; 3],
+            initial_estimate: [0.0; 7],
+            measured: [0.0; 3],
             command: 0.0,
             follow_design_inputs: false,
             design_inputs,
@@ -58,9 +59,7 @@ impl PathKalmanFilterFmu {
             ("euler_step_prime", self.euler_step_prime),
             ("innovation_window", self.innovation_window),
         ] {
-            if !(v > 0.0) {
-                return Err(format!("{name} = {v} must be > 0"));
-            }
+            check_positive(name, v)?;
         }
         self.config.t_r = self.steering_time_constant * U / L;
         Ok(())
@@ -115,20 +114,20 @@ fmi2_export::fmu! {
             "Largest forward-Euler sub-step dt' of the filter (004: 0.005 = 0.2349 s); a communication step is covered by ceil(h'/dt') equal sub-steps";
         tunable real "innovation_window" (innovation_window).min(0.0),
             "Forgetting time (ship lengths) of the innovation mean square";
-        fixed real "initial_heading" ["rad"] (x0[0]), "Initial heading estimate";
-        fixed real "initial_yaw_rate" ["rad/s"] (x0[1]), "Initial yaw-rate estimate";
-        fixed real "initial_drift_angle" ["rad"] (x0[2]),
+        fixed real "initial_heading" ["rad"] (initial_estimate[0]), "Initial heading estimate";
+        fixed real "initial_yaw_rate" ["rad/s"] (initial_estimate[1]), "Initial yaw-rate estimate";
+        fixed real "initial_drift_angle" ["rad"] (initial_estimate[2]),
             "Initial drift-angle estimate beta (v = -U beta)";
-        fixed real "initial_cross_track" ["m"] (x0[3]), "Initial cross-track estimate eta";
-        fixed real "initial_rudder" ["rad"] (x0[4]), "Initial rudder-angle estimate";
-        fixed real "initial_yaw_moment_prime" (x0[5]),
+        fixed real "initial_cross_track" ["m"] (initial_estimate[3]), "Initial cross-track estimate eta";
+        fixed real "initial_rudder" ["rad"] (initial_estimate[4]), "Initial rudder-angle estimate";
+        fixed real "initial_yaw_moment_prime" (initial_estimate[5]),
             "Initial N' estimate (nondimensional, 2N/(rho L^3 U^2))";
-        fixed real "initial_sway_force_prime" (x0[6]),
+        fixed real "initial_sway_force_prime" (initial_estimate[6]),
             "Initial Y' estimate (nondimensional, 2Y/(rho L^2 U^2))";
-        input real "heading_measured" ["rad"] (z[0]),
+        input real "heading_measured" ["rad"] (measured[0]),
             "Measured heading psi (compass), deviation from the track direction";
-        input real "yaw_rate_measured" ["rad/s"] (z[1]), "Measured yaw rate r (rate gyro)";
-        input real "cross_track_measured" ["m"] (z[2]),
+        input real "yaw_rate_measured" ["rad/s"] (measured[1]), "Measured yaw rate r (rate gyro)";
+        input real "cross_track_measured" ["m"] (measured[2]),
             "Measured lateral deviation eta from the track (DECCA Hi-Fix / radar)";
         input real "rudder_command" ["rad"] (command),
             "Rudder command delta_c actually applied (controller output or dither)";
@@ -188,7 +187,7 @@ impl FmuModel for PathKalmanFilterFmu {
     fn initialize(&mut self, _start_time: f64) -> Result<(), String> {
         self.rebuild_config()?;
         let design = self.config.design().map_err(|e| e.to_string())?;
-        let x0 = self.x0;
+        let x0 = self.initial_estimate;
         let xp = [x0[0], x0[1] / UL, x0[2], x0[3] / L, x0[4], x0[5], x0[6]];
         self.filter = PathKalmanFilter::new(design, xp)
             .map_err(|e| format!("Kalman gain design failed: {e}"))?;
@@ -222,8 +221,13 @@ impl FmuModel for PathKalmanFilterFmu {
                 })?;
             }
         }
-        self.filter
-            .step(self.z[0], self.z[1], self.z[2], self.command, h);
+        self.filter.step(
+            self.measured[0],
+            self.measured[1],
+            self.measured[2],
+            self.command,
+            h,
+        );
         Ok(())
     }
 }

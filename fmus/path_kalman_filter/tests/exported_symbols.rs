@@ -33,7 +33,7 @@ fn exported_api_reproduces_the_model() {
         let x = model.estimate();
         assert_eq!(fmu.reals(&outputs), [x[0], x[3] * L, x[5], x[6]]);
     }
-    // gain-update event: the Table 5 K(eta', eta') = 4.0000 -> Table 6 (deep water) 4.6587
+    // gain-update event: the [Parsons1980, Table 5] K(eta', eta') = 4.0000 -> [Parsons1980, Table 6] (deep water) 4.6587
     let g = fmu.real("gain_cross_track_cross_track");
     assert!((g - 4.0000).abs() < 1e-4);
     fmu.set("design_depth_ratio", 1e12);
@@ -42,8 +42,8 @@ fn exported_api_reproduces_the_model() {
     assert_eq!(fmu.terminate(), fmi2OK);
 }
 
-/// follow_design_inputs: the f*_design inputs of deep water (Table 2, H/T = inf) re-design the
-/// filter at the next step: K(eta', eta') moves from Table 5's 4.0000 to 4.1330 (the f's of inf with
+/// follow_design_inputs: the f*_design inputs of deep water ([Parsons1980, Table 2], H/T = inf) re-design the
+/// filter at the next step: K(eta', eta') moves from [Parsons1980, Table 5]'s 4.0000 to 4.1330 (the f's of inf with
 /// the gammas of 1.89 kept, as in the adaptive loop), equal to the model filter with that design;
 /// unchanged inputs leave the gain alone; a non-finite input is refused.
 #[test]

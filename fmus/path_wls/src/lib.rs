@@ -1,5 +1,5 @@
 //! `PathWlsEstimator` FMU: the moving-window Weighted Least-Squares parameter estimator of
-//! Parsons & Cuong (1980, source 004, section 4) in `models::controllers::wls`, estimating
+//! [Parsons1980, sec. 4] in `models::controllers::wls`, estimating
 //! f22, f23, f25, f32, f33, f35 of the Tokyo Maru and the window means of N′, Y′ from the
 //! measured states, the rudder angle and the control-loop filter's estimate at the window start;
 //! its f outputs feed the PathController's estimate inputs. No physics here.
@@ -7,6 +7,7 @@
 use fmi2_export::FmuModel;
 use models::controllers::path::UpdateDecision;
 use models::controllers::wls::{WlsEstimator, WlsSchedule, WlsSettings};
+use models::error::check_positive;
 use models::hull::tokyo_maru::TokyoMaruCoefficients;
 use models::observers::path_model::states_prime;
 use serde::{Deserialize, Serialize};
@@ -17,18 +18,18 @@ pub struct PathWlsFmu {
     schedule: WlsSchedule,
     initial_depth_ratio: f64,
     gamma_depth_ratio: f64,
-    /// Table 9 PSDs r_jj of ψ′, r′, β′, η′; W = diag(1/r_jj).
-    r: [f64; 4],
+    /// PSDs r_jj of ψ′, r′, β′, η′ [Parsons1980, Table 9]; W = diag(1/r_jj).
+    measurement_psd: [f64; 4],
     max_evaluations: i32,
     ship_length: f64,
     ship_speed: f64,
     /// Measured ψ [rad], r [rad/s], β [rad], η [m]; rudder δ [rad].
-    z: [f64; 4],
+    measured: [f64; 4],
     rudder: f64,
     /// Filter estimate ψ̂, r̂, β̂, η̂ (SI).
-    xhat: [f64; 4],
+    filter_estimate: [f64; 4],
     start_time: f64,
-    est: WlsEstimator,
+    estimator: WlsEstimator,
 }
 
 impl PathWlsFmu {
@@ -37,7 +38,7 @@ impl PathWlsFmu {
         WlsSettings {
             dt: 0.005,
             gamma: [g.g21, g.g22, g.g31, g.g32],
-            weight: self.r.map(|r| 1.0 / r),
+            weight: self.measurement_psd.map(|r| 1.0 / r),
             max_evaluations: self.max_evaluations.max(0) as usize,
         }
     }
@@ -47,7 +48,7 @@ impl PathWlsFmu {
     }
 }
 
-/// The Table 2 coefficients at H/T = `depth_ratio` with N′ = Y′ = 0.
+/// The [Parsons1980, Table 2] coefficients at H/T = `depth_ratio` with N′ = Y′ = 0.
 fn initial_estimate(depth_ratio: f64) -> [f64; 8] {
     let c = TokyoMaruCoefficients::at_depth_ratio(depth_ratio);
     [c.f22, c.f23, c.f25, c.f32, c.f33, c.f35, 0.0, 0.0]
@@ -61,20 +62,20 @@ impl Default for PathWlsFmu {
             update_cycle: 6.0,
         };
         // WlsSettings::default() is what settings() gives for the parameter defaults below
-        // (gammas at H/T = 1.89, Table 9 weights, 2000 evaluations); initialize rebuilds it.
+        // (gammas at H/T = 1.89, weights of [Parsons1980, Table 9], 2000 evaluations); initialize rebuilds it.
         PathWlsFmu {
             schedule,
             initial_depth_ratio: 1.89,
             gamma_depth_ratio: 1.89,
-            r: [1.2976e-9, 7.7215e-10, 8.2777e-10, 5.0651e-9],
+            measurement_psd: [1.2976e-9, 7.7215e-10, 8.2777e-10, 5.0651e-9],
             max_evaluations: 2000,
             ship_length: models::hull::tokyo_maru::L,
             ship_speed: models::hull::tokyo_maru::U,
-            z: [0.0; 4],
+            measured: [0.0; 4],
             rudder: 0.0,
-            xhat: [0.0; 4],
+            filter_estimate: [0.0; 4],
             start_time: 0.0,
-            est: WlsEstimator::new(WlsSettings::default(), schedule, initial_estimate(1.89))
+            estimator: WlsEstimator::new(WlsSettings::default(), schedule, initial_estimate(1.89))
                 .expect("default settings are valid"),
         }
     }
@@ -102,66 +103,60 @@ fmi2_export::fmu! {
             "H/T whose Table 2 coefficients start the first search (1.89; 1e300: deep water); N', Y' start at 0";
         fixed real "gamma_depth_ratio" (gamma_depth_ratio).min(1.0),
             "H/T of the fixed gamma~_ij of the model eq. 75 (1.89)";
-        fixed real "r_heading" (r[0]).min(0.0),
+        fixed real "r_heading" (measurement_psd[0]).min(0.0),
             "PSD r_jj of psi' for the weight W = R^-1 of eq. 77 (Table 9: 1.2976e-9)";
-        fixed real "r_yaw_rate" (r[1]).min(0.0), "PSD r_jj of r' (Table 9: 7.7215e-10)";
-        fixed real "r_drift_angle" (r[2]).min(0.0), "PSD r_jj of beta' (Table 9: 8.2777e-10)";
-        fixed real "r_cross_track" (r[3]).min(0.0), "PSD r_jj of eta' (Table 9: 5.0651e-9)";
+        fixed real "r_yaw_rate" (measurement_psd[1]).min(0.0), "PSD r_jj of r' (Table 9: 7.7215e-10)";
+        fixed real "r_drift_angle" (measurement_psd[2]).min(0.0), "PSD r_jj of beta' (Table 9: 8.2777e-10)";
+        fixed real "r_cross_track" (measurement_psd[3]).min(0.0), "PSD r_jj of eta' (Table 9: 5.0651e-9)";
         fixed int(10, 1_000_000) "max_evaluations" (max_evaluations),
             "Largest number of cost evaluations per fit (Levenberg-Marquardt with a forward-difference Jacobian)";
         // ship_length, ship_speed, then the inputs (12..21)
         path_measurements!();
         input real "rudder_angle" ["rad"] (rudder),
             "Rudder angle delta (known exactly), sampled with the states";
-        input real "heading_estimate" ["rad"] (xhat[0]),
+        input real "heading_estimate" ["rad"] (filter_estimate[0]),
             "Control-loop filter estimate of psi (its value at the window start is the model's initial state)";
-        input real "yaw_rate_estimate" ["rad/s"] (xhat[1]), "Filter estimate of r";
-        input real "drift_angle_estimate" ["rad"] (xhat[2]), "Filter estimate of beta";
-        input real "cross_track_estimate" ["m"] (xhat[3]), "Filter estimate of eta";
+        input real "yaw_rate_estimate" ["rad/s"] (filter_estimate[1]), "Filter estimate of r";
+        input real "drift_angle_estimate" ["rad"] (filter_estimate[2]), "Filter estimate of beta";
+        input real "cross_track_estimate" ["m"] (filter_estimate[3]), "Filter estimate of eta";
         // ---- outputs (21..35)
-        output real "f22_estimate" (|m| m.est.estimate()[0]), "Estimate of f22 (last fit)";
-        output real "f23_estimate" (|m| m.est.estimate()[1]), "Estimate of f23 (last fit)";
-        output real "f25_estimate" (|m| m.est.estimate()[2]), "Estimate of f25 (last fit)";
-        output real "f32_estimate" (|m| m.est.estimate()[3]), "Estimate of f32 (last fit)";
-        output real "f33_estimate" (|m| m.est.estimate()[4]), "Estimate of f33 (last fit)";
-        output real "f35_estimate" (|m| m.est.estimate()[5]), "Estimate of f35 (last fit)";
-        output real "yaw_moment_prime_estimate" (|m| m.est.estimate()[6]),
+        output real "f22_estimate" (|m| m.estimator.estimate()[0]), "Estimate of f22 (last fit)";
+        output real "f23_estimate" (|m| m.estimator.estimate()[1]), "Estimate of f23 (last fit)";
+        output real "f25_estimate" (|m| m.estimator.estimate()[2]), "Estimate of f25 (last fit)";
+        output real "f32_estimate" (|m| m.estimator.estimate()[3]), "Estimate of f32 (last fit)";
+        output real "f33_estimate" (|m| m.estimator.estimate()[4]), "Estimate of f33 (last fit)";
+        output real "f35_estimate" (|m| m.estimator.estimate()[5]), "Estimate of f35 (last fit)";
+        output real "yaw_moment_prime_estimate" (|m| m.estimator.estimate()[6]),
             "p7: window mean of N' = 2N/(rho L^3 U^2) seen through the fixed gamma~ (a by-product)";
-        output real "sway_force_prime_estimate" (|m| m.est.estimate()[7]),
+        output real "sway_force_prime_estimate" (|m| m.estimator.estimate()[7]),
             "p8: window mean of Y' = 2Y/(rho L^2 U^2) seen through the fixed gamma~ (a by-product)";
-        output bool "estimate_valid" (|m| m.est.decision() != UpdateDecision::None),
+        output bool "estimate_valid" (|m| m.estimator.decision() != UpdateDecision::None),
             "f23 and f25 estimates within their Table 10 ranges (the controller would update)";
-        output real "validity" (|m| match m.est.decision() {
+        output real "validity" (|m| match m.estimator.decision() {
             UpdateDecision::None => 0.0, UpdateDecision::F23F25 => 1.0, UpdateDecision::All => 2.0 }),
             "Table 10 branch of the estimate: 0 no update (f23 or f25 out of range), 1 f23/f25 only, 2 all";
-        output real "evaluations" (|m| m.est.evaluations() as f64),
+        output real "evaluations" (|m| m.estimator.evaluations() as f64),
             "Cost evaluations of the last fit (Levenberg-Marquardt; the report's DUD counts differ)";
-        output real "final_cost" (|m| m.est.cost()),
+        output real "final_cost" (|m| m.estimator.cost()),
             "Cost J of eq. 77 at the last fit's minimum, W = R^-1 (dimensionless)";
-        output real "residual_sum_of_squares" (|m| m.est.sum_of_squares()),
+        output real "residual_sum_of_squares" (|m| m.estimator.sum_of_squares()),
             "Sum over the window of |z'_k - x_m,k|^2 at the last fit's minimum (W = I, no 1/2: the scale of the report's printed J)";
-        output real "updates" (|m| m.est.updates() as f64), "Number of fits since the start";
-        output bool "loading" (|m| m.est.loading()), "A data window is being loaded";
+        output real "updates" (|m| m.estimator.updates() as f64), "Number of fits since the start";
+        output bool "loading" (|m| m.estimator.loading()), "A data window is being loaded";
     }
 }
 
 impl FmuModel for PathWlsFmu {
     fn initialize(&mut self, start_time: f64) -> Result<(), String> {
-        if !(self.ship_length > 0.0 && self.ship_speed > 0.0) {
-            return Err(format!(
-                "ship_length = {} and ship_speed = {} must be > 0",
-                self.ship_length, self.ship_speed
-            ));
-        }
-        for (i, r) in self.r.iter().enumerate() {
-            if !(*r > 0.0 && r.is_finite()) {
-                let n = ["r_heading", "r_yaw_rate", "r_drift_angle", "r_cross_track"][i];
-                return Err(format!("parameter {n} = {r} must be > 0"));
-            }
+        check_positive("ship_length", self.ship_length)?;
+        check_positive("ship_speed", self.ship_speed)?;
+        let names = ["r_heading", "r_yaw_rate", "r_drift_angle", "r_cross_track"];
+        for (n, r) in names.iter().zip(self.measurement_psd) {
+            check_positive(n, r)?;
         }
         self.start_time = start_time;
         let x0 = initial_estimate(self.initial_depth_ratio);
-        self.est =
+        self.estimator =
             WlsEstimator::new(self.settings(), self.schedule, x0).map_err(|e| e.to_string())?;
         Ok(())
     }
@@ -170,8 +165,11 @@ impl FmuModel for PathWlsFmu {
         // one sample per communication step, at its start
         let ul = self.ship_speed / self.ship_length;
         let (tp, dt) = ((t - self.start_time) * ul, h * ul);
-        let (z, xhat) = (self.prime(&self.z), self.prime(&self.xhat));
-        self.est
+        let (z, xhat) = (
+            self.prime(&self.measured),
+            self.prime(&self.filter_estimate),
+        );
+        self.estimator
             .sample(tp, dt, z, self.rudder, xhat)
             .map(|_| ())
             .map_err(|e| format!("WLS fit at t = {t} s: {e}"))

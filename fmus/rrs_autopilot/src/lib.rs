@@ -1,4 +1,4 @@
-//! `RrsAutopilot` FMU: the rudder roll stabilization autopilot of van der Klugt (1987, source 003)
+//! `RrsAutopilot` FMU: the rudder roll stabilization autopilot of [Klugt1987]
 //! in `models::controllers::rrs` (roll LQ via the innovation process, closed-form course
 //! controller, AGC, criterion adaptation, operator modes) as an FMI 2.0 co-simulation FMU. No
 //! physics here: the variable table maps the model onto FMI variables.
@@ -10,21 +10,21 @@ use serde::{Deserialize, Serialize};
 /// Parameters, inputs and state of one autopilot instance.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct RrsAutopilotFmu {
-    p: RrsAutopilotParams,
+    params: RrsAutopilotParams,
     inputs: RrsInputs,
-    ap: RrsAutopilot,
+    autopilot: RrsAutopilot,
 }
 
 impl Default for RrsAutopilotFmu {
     fn default() -> Self {
-        let p = RrsAutopilotParams::default();
+        let params = RrsAutopilotParams::default();
         RrsAutopilotFmu {
             inputs: RrsInputs {
                 speed: 11.0,
                 ..RrsInputs::default()
             },
-            ap: RrsAutopilot::new(p).expect("default parameters are valid"),
-            p,
+            autopilot: RrsAutopilot::new(params).expect("default parameters are valid"),
+            params,
         }
     }
 }
@@ -37,62 +37,62 @@ fmi2_export::fmu! {
     experiment: (0.0, 600.0, 0.1),
     documentation: "documentation.html",
     variables: {
-        tunable bool "agc_enabled" (p.agc_enabled),
+        tunable bool "agc_enabled" (params.agc_enabled),
             "Automatic Gain Controller on (003 section 5.3)";
-        tunable int "agc_target" (p.agc_target => { 1: AgcTarget::Total, 2: AgcTarget::RollOnly }),
+        tunable int "agc_target" (params.agc_target => { 1: AgcTarget::Total, 2: AgcTarget::RollOnly }),
             "1: A*(delta_psi + delta_phi) (literal Fig. 5.5); 2: delta_psi + A*delta_phi (default, course changes do not attenuate the course loop)";
-        tunable int "roll_mode" (p.roll_mode => { 0: RollMode::Off, 1: RollMode::On, 2: RollMode::Forced }),
+        tunable int "roll_mode" (params.roll_mode => { 0: RollMode::Off, 1: RollMode::On, 2: RollMode::Forced }),
             "Roll stabilisation 0 OFF (gains computed, not applied: course only), 1 ON, 2 forced roll (inverted roll feedback) [operator]";
-        tunable bool "course_auto" (p.course_auto),
+        tunable bool "course_auto" (params.course_auto),
             "Automatic course control (false: manual, the wheel input is the course rudder)";
-        tunable bool "adaptation_enabled" (p.adaptation.enabled),
+        tunable bool "adaptation_enabled" (params.adaptation.enabled),
             "On-line criterion adaptation of q_phi (eqs. 6.27-6.28)";
-        tunable real "lambda" (p.lambda).min(0.0),
+        tunable real "lambda" (params.lambda).min(0.0),
             "Course criterion weight lambda of J = E[psi^2]/lambda + E[delta^2] (1 accurate ... 10 economic)";
-        tunable real "angle_max" ["rad"] (p.angle_max).min(0.0),
+        tunable real "angle_max" ["rad"] (params.angle_max).min(0.0),
             "Allowed maximum rudder angle delta_max (operator; 003 RRS gear 22 deg)";
-        tunable real "rate_max" ["rad/s"] (p.rate_max).min(0.0),
+        tunable real "rate_max" ["rad/s"] (params.rate_max).min(0.0),
             "Maximum rudder rate of the steering machine for the AGC (003: 15 deg/s)";
-        tunable real "agc_memory_time" ["s"] (p.agc_memory_time).min(0.0),
+        tunable real "agc_memory_time" ["s"] (params.agc_memory_time).min(0.0),
             "AGC memory forgetting time constant [interpretation; thesis gives none]";
-        tunable real "q_phi_initial" (p.adaptation.q_initial).min(0.0),
+        tunable real "q_phi_initial" (params.adaptation.q_initial).min(0.0),
             "Roll weight q_phi (initial value when adaptation is on)";
-        tunable real "roll_q2" (p.roll_q2).min(0.0), "Roll-rate weight q2 (realization: 0)";
-        tunable real "roll_q3" (p.roll_q3).min(0.0), "v_delta weight q3 (realization: 0)";
-        tunable real "r" (p.r).min(0.0), "Rudder weight r";
-        tunable real "alpha" ["1/s"] (p.adaptation.alpha).min(0.0),
+        tunable real "roll_q2" (params.roll_q2).min(0.0), "Roll-rate weight q2 (realization: 0)";
+        tunable real "roll_q3" (params.roll_q3).min(0.0), "v_delta weight q3 (realization: 0)";
+        tunable real "r" (params.r).min(0.0), "Rudder weight r";
+        tunable real "alpha" ["1/s"] (params.adaptation.alpha).min(0.0),
             "Adaptation speed alpha (q_phi moves at most alpha*q_max per second)";
-        tunable real "q_max" (p.adaptation.q_max).min(0.0), "Rule 3: upper limit q_phi(max)";
-        tunable real "q_operator" (p.adaptation.q_operator).min(0.0),
+        tunable real "q_max" (params.adaptation.q_max).min(0.0), "Rule 3: upper limit q_phi(max)";
+        tunable real "q_operator" (params.adaptation.q_operator).min(0.0),
             "Rule 10: operator limit q_phi0 (much/little roll reduction)";
-        tunable real "roll_variance_target" (p.adaptation.roll_variance_target).min(0.0),
+        tunable real "roll_variance_target" (params.adaptation.roll_variance_target).min(0.0),
             "Rule 7: target roll variance sigma_phi^2 [rad^2]";
-        tunable real "roll_variance_time" ["s"] (p.adaptation.roll_variance_time).min(0.0),
+        tunable real "roll_variance_time" ["s"] (params.adaptation.roll_variance_time).min(0.0),
             "Time constant of the roll-variance low-pass (Fig. 6.10)";
-        tunable real "heading_error_max" ["rad"] (p.adaptation.heading_error_max).min(0.0),
+        tunable real "heading_error_max" ["rad"] (params.adaptation.heading_error_max).min(0.0),
             "Rule 8: heading-error limit psi_max";
-        tunable real "rate_ratio_start" (p.adaptation.rate_ratio_start).min(0.0),
+        tunable real "rate_ratio_start" (params.adaptation.rate_ratio_start).min(0.0),
             "Rule 2 breakpoint rho_0 (Delta q2 = 0 below, -1 at required rate = rate_max)";
-        tunable real "angle_ratio_start" (p.adaptation.angle_ratio_start).min(0.0),
+        tunable real "angle_ratio_start" (params.adaptation.angle_ratio_start).min(0.0),
             "Rule 6 breakpoint (Delta q6 = 0 below this fraction of angle_max)";
-        tunable real "q_beta" (p.adaptation.q_beta).min(0.0),
+        tunable real "q_beta" (params.adaptation.q_beta).min(0.0),
             "Rule 3 breakpoint beta (Delta q3 = 0 below beta*q_max)";
-        tunable real "min_speed" ["m/s"] (p.min_speed).min(0.0),
+        tunable real "min_speed" ["m/s"] (params.min_speed).min(0.0),
             "Lowest speed used in the speed laws";
-        tunable real "max_substep" ["s"] (p.max_substep).min(0.0),
+        tunable real "max_substep" ["s"] (params.max_substep).min(0.0),
             "Largest Euler sub-step of the innovation process";
-        tunable real "innovation_scale" (p.innovation_scale).min(0.0),
+        tunable real "innovation_scale" (params.innovation_scale).min(0.0),
             "Time scaling l of the innovation process (L of eq. 3.15)";
-        fixed real "k_dp0" (p.laws.k_dp0), "Speed law k_dp = K_dp0 U^2 (Table 2.4: -0.0014)";
-        fixed real "k_dv0" (p.laws.k_dv0), "k_dv = K_dv0 U (0.01)";
-        fixed real "k_dr0" (p.laws.k_dr0), "k_dr = K_dr0 U (-0.0027)";
-        fixed real "k_vp0" (p.laws.k_vp0), "k_vp = K_vp0 U (0.21)";
-        fixed real "t_v0" ["m"] (p.laws.t_v0).min(0.0), "tau_v = T_v0 / U (78 m)";
-        fixed real "z_n0" (p.laws.z_n0), "z_n = z_n0 + z_n1 U (0.064)";
-        fixed real "z_n1" (p.laws.z_n1), "z_n1 (0.0038 s/m) [s/m]";
-        fixed real "k_vr0" (p.laws.k_vr0), "k_vr = K_vr0 (-0.46)";
-        fixed real "omega_n0" ["rad/s"] (p.laws.omega_n0).min(0.0), "omega_n (0.63 rad/s)";
-        fixed real "t_r0" ["m"] (p.laws.t_r0).min(0.0), "tau_r = T_r0 / U (13 m)";
+        fixed real "k_dp0" (params.laws.k_dp0), "Speed law k_dp = K_dp0 U^2 (Table 2.4: -0.0014)";
+        fixed real "k_dv0" (params.laws.k_dv0), "k_dv = K_dv0 U (0.01)";
+        fixed real "k_dr0" (params.laws.k_dr0), "k_dr = K_dr0 U (-0.0027)";
+        fixed real "k_vp0" (params.laws.k_vp0), "k_vp = K_vp0 U (0.21)";
+        fixed real "t_v0" ["m"] (params.laws.t_v0).min(0.0), "tau_v = T_v0 / U (78 m)";
+        fixed real "z_n0" (params.laws.z_n0), "z_n = z_n0 + z_n1 U (0.064)";
+        fixed real "z_n1" (params.laws.z_n1), "z_n1 (0.0038 s/m) [s/m]";
+        fixed real "k_vr0" (params.laws.k_vr0), "k_vr = K_vr0 (-0.46)";
+        fixed real "omega_n0" ["rad/s"] (params.laws.omega_n0).min(0.0), "omega_n (0.63 rad/s)";
+        fixed real "t_r0" ["m"] (params.laws.t_r0).min(0.0), "tau_r = T_r0 / U (13 m)";
         input real "roll" ["rad"] (inputs.roll), "Roll-filter estimate phi";
         input real "roll_rate" ["rad/s"] (inputs.roll_rate), "Roll-filter estimate d(phi)/dt";
         input real "sway_rudder" ["m/s"] (inputs.sway_rudder),
@@ -107,42 +107,44 @@ fmi2_export::fmu! {
             "Manual steering wheel rudder (course_auto = false)";
         input real "rudder_angle" ["rad"] (inputs.rudder),
             "Measured rudder angle (criterion rule 6)";
-        output real "rudder_command" ["rad"] (|m| m.ap.outputs(&m.inputs).rudder_command),
+        output real "rudder_command" ["rad"] (|m| m.autopilot.outputs(&m.inputs).rudder_command),
             "Rudder set point delta_g to the steering machine (course + AGC-attenuated roll rudder, limited to angle_max)";
-        output real "roll_rudder" ["rad"] (|m| m.ap.outputs(&m.inputs).roll_rudder),
+        output real "roll_rudder" ["rad"] (|m| m.autopilot.outputs(&m.inputs).roll_rudder),
             "Roll-controller rudder delta_phi = -(k1 phi + k2 phi_dot + k3 v_delta) before the AGC (0 with RRS off)";
-        output real "course_rudder" ["rad"] (|m| m.ap.outputs(&m.inputs).course_rudder),
+        output real "course_rudder" ["rad"] (|m| m.autopilot.outputs(&m.inputs).course_rudder),
             "Course-controller rudder delta_psi (or the wheel in manual)";
-        output real "attenuation" (|m| m.ap.outputs(&m.inputs).attenuation),
+        output real "attenuation" (|m| m.autopilot.outputs(&m.inputs).attenuation),
             "AGC attenuation A = rate_max / max(rate_max, |du/dt|, memory), 0 < A <= 1";
-        output real "q_phi" (|m| m.ap.q_phi()), "Current roll weight q_phi (criterion adaptation)";
-        output real "roll_variance" (|m| m.ap.roll_variance()),
+        output real "q_phi" (|m| m.autopilot.q_phi()), "Current roll weight q_phi (criterion adaptation)";
+        output real "roll_variance" (|m| m.autopilot.roll_variance()),
             "Low-passed roll variance estimate [rad^2]";
-        output real "roll_gain_1" (|m| m.ap.roll_gains(m.inputs.speed)[0]),
+        output real "roll_gain_1" (|m| m.autopilot.roll_gains(m.inputs.speed)[0]),
             "k1 (rad/rad) from the innovation process at the input speed";
-        output real "roll_gain_2" ["s"] (|m| m.ap.roll_gains(m.inputs.speed)[1]),
+        output real "roll_gain_2" ["s"] (|m| m.autopilot.roll_gains(m.inputs.speed)[1]),
             "k2 (rad per rad/s)";
-        output real "roll_gain_3" (|m| m.ap.roll_gains(m.inputs.speed)[2]),
+        output real "roll_gain_3" (|m| m.autopilot.roll_gains(m.inputs.speed)[2]),
             "k3 (rad per m/s) [s/m]";
-        output real "course_gain_1" (|m| m.ap.course_gains(m.inputs.speed)[0]),
+        output real "course_gain_1" (|m| m.autopilot.course_gains(m.inputs.speed)[0]),
             "Course k1 = sign(k_dr) sqrt(1/lambda)";
-        output real "course_gain_2" ["s"] (|m| m.ap.course_gains(m.inputs.speed)[1]),
+        output real "course_gain_2" ["s"] (|m| m.autopilot.course_gains(m.inputs.speed)[1]),
             "Course k2 = (sqrt(1 + 2 tau_r k_dr k1) - 1)/k_dr";
     }
 }
 
 impl FmuModel for RrsAutopilotFmu {
     fn initialize(&mut self, _start_time: f64) -> Result<(), String> {
-        self.ap = RrsAutopilot::new(self.p).map_err(|e| e.to_string())?;
+        self.autopilot = RrsAutopilot::new(self.params).map_err(|e| e.to_string())?;
         Ok(())
     }
 
     fn parameters_changed(&mut self) -> Result<(), String> {
-        self.ap.set_params(self.p).map_err(|e| e.to_string())
+        self.autopilot
+            .set_params(self.params)
+            .map_err(|e| e.to_string())
     }
 
     fn do_step(&mut self, _t: f64, h: f64) -> Result<(), String> {
-        self.ap.step(&self.inputs, h);
+        self.autopilot.step(&self.inputs, h);
         Ok(())
     }
 }

@@ -1,7 +1,8 @@
-//! `RrsFilter` FMU: van der Klugt's roll, yaw and adaptive speed filters
+//! `RrsFilter` FMU: the roll, yaw and adaptive speed filters of [Klugt1987, sec. 6.3]
 //! (`models::observers::rrs_filter`). No physics here.
 
 use fmi2_export::FmuModel;
+use models::error::check_positive;
 use models::observers::rrs_filter::{
     RollFilter, RollFilterParams, RrsFilter, RrsFilterInputs, SpeedAdaptation, SpeedFilter,
     SpeedFilterParams, YawFilterParams,
@@ -26,7 +27,7 @@ impl RrsFilterFmu {
         RollFilterParams::table_2_4(self.design_speed, self.roll_q[0], self.roll_q[1])
     }
 
-    /// Yaw parameters with τ_r, k_dr, k_vr, k_dv, τ_v from Table 2.4 at the design speed.
+    /// Yaw parameters with τ_r, k_dr, k_vr, k_dv, τ_v from [Klugt1987, Table 2.4] at the design speed.
     fn yaw_params(&self) -> YawFilterParams {
         let base = YawFilterParams::realised(self.design_speed);
         YawFilterParams {
@@ -40,9 +41,7 @@ impl RrsFilterFmu {
     }
 
     fn build(&self) -> Result<RrsFilter, String> {
-        if !(self.design_speed > 0.0) {
-            return Err(format!("design_speed = {} must be > 0", self.design_speed));
-        }
+        check_positive("design_speed", self.design_speed)?;
         RrsFilter::new(
             self.roll_params(),
             self.yaw_params(),
@@ -176,9 +175,7 @@ impl FmuModel for RrsFilterFmu {
     }
 
     fn parameters_changed(&mut self) -> Result<(), String> {
-        if !(self.design_speed > 0.0) {
-            return Err(format!("design_speed = {} must be > 0", self.design_speed));
-        }
+        check_positive("design_speed", self.design_speed)?;
         let roll_params = self.roll_params();
         if roll_params != *self.filter.roll.params() {
             let mut roll = RollFilter::new(roll_params)?;

@@ -1,8 +1,9 @@
-//! `RrsShip` FMU: van der Klugt's RRS ship (`models::hull::rrs_ship`), the 22-knot simulation
+//! `RrsShip` FMU: the RRS ship of [Klugt1987] (`models::hull::rrs_ship`), the 22-knot simulation
 //! model and the speed-dependent fifth-order control model, as an FMI 2.0 co-simulation FMU.
 //! No physics here: the variable table maps the model onto FMI variables.
 
 use fmi2_export::FmuModel;
+use models::error::check_positive;
 use models::hull::rrs_ship::{RrsShip, RrsShipInputs, RrsShipOutputs, U_22KN};
 use models::hull::DEG;
 use serde::{Deserialize, Serialize};
@@ -10,14 +11,14 @@ use serde::{Deserialize, Serialize};
 /// Parameters, inputs and state of one RRS-ship instance.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct RrsShipFmu {
-    /// 1: simulation model (Tables 2.1/2.2); 2: control model, Table 2.4; 3: control model,
-    /// Table 2.5.
+    /// 1: simulation model [Klugt1987, Tables 2.1, 2.2]; 2: control model, [Klugt1987, Table 2.4];
+    /// 3: control model, [Klugt1987, Table 2.5].
     model: i32,
     min_speed: f64,
     max_substep: f64,
     inputs: RrsShipInputs,
-    /// Second disturbance channel (e.g. wind, eqs. 2.19-2.20), added to the first: w_φ and w_ψ
-    /// of eq. 3.29 are the sums of all rudder-equivalent disturbances.
+    /// Second disturbance channel (e.g. wind, [Klugt1987, eqs. (2.19)-(2.20)]), added to the first:
+    /// w_φ and w_ψ of [Klugt1987, eq. (3.29)] are the sums of all rudder-equivalent disturbances.
     wind_roll: f64,
     wind_yaw: f64,
     ship: RrsShip,
@@ -55,9 +56,7 @@ impl RrsShipFmu {
             ("min_speed", self.min_speed),
             ("max_substep", self.max_substep),
         ] {
-            if !(v.is_finite() && v > 0.0) {
-                return Err(format!("parameter {name} = {v} must be finite and > 0"));
-            }
+            check_positive(name, v)?;
         }
         Ok(())
     }

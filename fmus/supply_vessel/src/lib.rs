@@ -1,8 +1,9 @@
 //! `SupplyVessel` FMU: the 3-DOF low-frequency DP model of the supply vessel Northern Clipper
-//! (`models::hull::supply_vessel`, Fossen & Strand 1999) as an FMI 2.0 co-simulation FMU. No
+//! (`models::hull::supply_vessel`, [Fossen1999, sec. 2]) as an FMI 2.0 co-simulation FMU. No
 //! physics here: the variable table maps the model onto FMI variables.
 
 use fmi2_export::FmuModel;
+use models::error::check_positive;
 use models::hull::supply_vessel::{
     SupplyVessel, SupplyVesselInputs, SupplyVesselOutputs, NORTHERN_CLIPPER_D, NORTHERN_CLIPPER_M,
 };
@@ -11,8 +12,8 @@ use serde::{Deserialize, Serialize};
 /// Parameters, inputs and state of one instance.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct SupplyVesselFmu {
-    m: [[f64; 3]; 3],
-    d: [[f64; 3]; 3],
+    mass: [[f64; 3]; 3],
+    damping: [[f64; 3]; 3],
     max_substep: f64,
     inputs: SupplyVesselInputs,
     vessel: SupplyVessel,
@@ -26,8 +27,8 @@ impl Default for SupplyVesselFmu {
     fn default() -> Self {
         let vessel = SupplyVessel::northern_clipper();
         SupplyVesselFmu {
-            m: NORTHERN_CLIPPER_M,
-            d: NORTHERN_CLIPPER_D,
+            mass: NORTHERN_CLIPPER_M,
+            damping: NORTHERN_CLIPPER_D,
             max_substep: vessel.max_substep,
             inputs: SupplyVesselInputs {
                 tau: [DEFAULT_SURGE_FORCE, 0.0, 0.0],
@@ -54,41 +55,41 @@ fmi2_export::fmu! {
     direct_feedthrough: false,
     documentation: "documentation.html",
     variables: {
-        fixed real "m11" (m[0][0]),
+        fixed real "m11" (mass[0][0]),
             "Inertia matrix M (eq. 56), entry (1, 1), SI (kg, kg.m, kg.m2 by row/column)";
-        fixed real "m12" (m[0][1]),
+        fixed real "m12" (mass[0][1]),
             "Inertia matrix M (eq. 56), entry (1, 2), SI (kg, kg.m, kg.m2 by row/column)";
-        fixed real "m13" (m[0][2]),
+        fixed real "m13" (mass[0][2]),
             "Inertia matrix M (eq. 56), entry (1, 3), SI (kg, kg.m, kg.m2 by row/column)";
-        fixed real "m21" (m[1][0]),
+        fixed real "m21" (mass[1][0]),
             "Inertia matrix M (eq. 56), entry (2, 1), SI (kg, kg.m, kg.m2 by row/column)";
-        fixed real "m22" (m[1][1]),
+        fixed real "m22" (mass[1][1]),
             "Inertia matrix M (eq. 56), entry (2, 2), SI (kg, kg.m, kg.m2 by row/column)";
-        fixed real "m23" (m[1][2]),
+        fixed real "m23" (mass[1][2]),
             "Inertia matrix M (eq. 56), entry (2, 3), SI (kg, kg.m, kg.m2 by row/column)";
-        fixed real "m31" (m[2][0]),
+        fixed real "m31" (mass[2][0]),
             "Inertia matrix M (eq. 56), entry (3, 1), SI (kg, kg.m, kg.m2 by row/column)";
-        fixed real "m32" (m[2][1]),
+        fixed real "m32" (mass[2][1]),
             "Inertia matrix M (eq. 56), entry (3, 2), SI (kg, kg.m, kg.m2 by row/column)";
-        fixed real "m33" (m[2][2]),
+        fixed real "m33" (mass[2][2]),
             "Inertia matrix M (eq. 56), entry (3, 3), SI (kg, kg.m, kg.m2 by row/column)";
-        fixed real "d11" (d[0][0]),
+        fixed real "d11" (damping[0][0]),
             "Damping matrix D (eq. 57), entry (1, 1), SI (N.s/m, N.s, N.m.s by row/column)";
-        fixed real "d12" (d[0][1]),
+        fixed real "d12" (damping[0][1]),
             "Damping matrix D (eq. 57), entry (1, 2), SI (N.s/m, N.s, N.m.s by row/column)";
-        fixed real "d13" (d[0][2]),
+        fixed real "d13" (damping[0][2]),
             "Damping matrix D (eq. 57), entry (1, 3), SI (N.s/m, N.s, N.m.s by row/column)";
-        fixed real "d21" (d[1][0]),
+        fixed real "d21" (damping[1][0]),
             "Damping matrix D (eq. 57), entry (2, 1), SI (N.s/m, N.s, N.m.s by row/column)";
-        fixed real "d22" (d[1][1]),
+        fixed real "d22" (damping[1][1]),
             "Damping matrix D (eq. 57), entry (2, 2), SI (N.s/m, N.s, N.m.s by row/column)";
-        fixed real "d23" (d[1][2]),
+        fixed real "d23" (damping[1][2]),
             "Damping matrix D (eq. 57), entry (2, 3), SI (N.s/m, N.s, N.m.s by row/column)";
-        fixed real "d31" (d[2][0]),
+        fixed real "d31" (damping[2][0]),
             "Damping matrix D (eq. 57), entry (3, 1), SI (N.s/m, N.s, N.m.s by row/column)";
-        fixed real "d32" (d[2][1]),
+        fixed real "d32" (damping[2][1]),
             "Damping matrix D (eq. 57), entry (3, 2), SI (N.s/m, N.s, N.m.s by row/column)";
-        fixed real "d33" (d[2][2]),
+        fixed real "d33" (damping[2][2]),
             "Damping matrix D (eq. 57), entry (3, 3), SI (N.s/m, N.s, N.m.s by row/column)";
         fixed real "max_substep" ["s"] (max_substep).min(0.0),
             "Largest RK4 sub-step (default 0.1 s; the fastest open-loop time constant is 8.40 s)";
@@ -129,13 +130,8 @@ fmi2_export::fmu! {
 
 impl FmuModel for SupplyVesselFmu {
     fn initialize(&mut self, _start_time: f64) -> Result<(), String> {
-        let mut vessel = SupplyVessel::new(self.m, self.d).map_err(|e| e.to_string())?;
-        if !(self.max_substep.is_finite() && self.max_substep > 0.0) {
-            return Err(format!(
-                "parameter max_substep = {} must be finite and > 0",
-                self.max_substep
-            ));
-        }
+        let mut vessel = SupplyVessel::new(self.mass, self.damping).map_err(|e| e.to_string())?;
+        check_positive("max_substep", self.max_substep)?;
         vessel.max_substep = self.max_substep;
         self.vessel = vessel;
         Ok(())
@@ -154,7 +150,7 @@ mod tests {
     #[test]
     fn errors_name_the_fmu_parameter_and_value() {
         let mut m = SupplyVesselFmu::default();
-        m.m[1][1] = -2.0;
+        m.mass[1][1] = -2.0;
         let e = m.initialize(0.0).unwrap_err();
         assert!(e.contains("m22 = -2"), "{e}");
         let mut m = SupplyVesselFmu {

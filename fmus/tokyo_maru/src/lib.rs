@@ -1,13 +1,13 @@
-//! `TokyoMaru` FMU: the Parsons & Cuong (1980) linear path model of the Tokyo Maru in restricted
+//! `TokyoMaru` FMU: the linear path model of the Tokyo Maru [Parsons1980, sec. 2] in restricted
 //! water (`models::hull::tokyo_maru`) as an FMI 2.0 co-simulation FMU. No physics here: the
 //! variable table maps the model onto FMI variables.
 
 use fmi2_export::FmuModel;
+use models::error::ParamError;
 use models::hull::tokyo_maru::{
     TokyoMaru, TokyoMaruInputs, TokyoMaruIntegration, TokyoMaruOutputs, T_R,
 };
 use models::hull::DEG;
-use models::steering_gear::ParamError;
 use serde::{Deserialize, Serialize};
 
 /// Parameters, inputs and state of one Tokyo Maru instance.
@@ -52,12 +52,11 @@ impl Default for TokyoMaruFmu {
 
 /// A model error with the model's parameter name replaced by the FMU variable's name.
 fn param_error(e: ParamError) -> String {
-    let name = match e.name {
-        "t_r" => "steering_time_constant_prime",
-        "max_substep_prime" => "euler_substep_prime",
-        other => other,
-    };
-    format!("parameter {name} = {} {}", e.value, e.rule)
+    e.renamed(&[
+        ("t_r", "steering_time_constant_prime"),
+        ("max_substep_prime", "euler_substep_prime"),
+    ])
+    .to_string()
 }
 
 impl TokyoMaruFmu {

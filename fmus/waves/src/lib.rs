@@ -1,6 +1,6 @@
-//! `Waves` FMU: long-crested irregular waves of `models::disturbances::waves` (spectra of 003
-//! eq. 2.21 / PM / JONSWAP, encounter frequency 003 eq. 2.22, moments 003 eqs. 2.23-2.24, the
-//! wave-frequency motion of 001) as an FMI 2.0 co-simulation FMU. No physics here.
+//! `Waves` FMU: long-crested irregular waves of `models::disturbances::waves` (spectra of
+//! [Klugt1987, eq. (2.21)] / PM / JONSWAP, encounter frequency [Klugt1987, eq. (2.22)], moments
+//! [Klugt1987, eqs. (2.23)-(2.24)], the wave-frequency motion of [Fossen1999, eqs. (10)-(11)]) as an FMI 2.0 co-simulation FMU. No physics here.
 
 use fmi2_export::FmuModel;
 use models::disturbances::waves::{
@@ -12,7 +12,7 @@ use serde::{Deserialize, Serialize};
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct WavesFmu {
     params: WaveParams,
-    /// Standard deviations of the 001 WF motion (surge m, sway m, yaw rad); σ_i derived.
+    /// Standard deviations of the WF motion of [Fossen1999, eqs. (10)-(11)] (surge m, sway m, yaw rad); σ_i derived.
     wf_std: [f64; 3],
     wave_direction: f64,
     speed: f64,

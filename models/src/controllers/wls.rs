@@ -1,28 +1,29 @@
-//! Weighted Least-Squares (WLS) batch parameter estimator of Parsons & Cuong (1980, source 004,
-//! section 4): p = [f22, f23, f25, f32, f33, f35, N′, Y′] fitted over a data window of measured
+//! Weighted Least-Squares (WLS) batch parameter estimator of [Parsons1980, sec. 4]:
+//! p = [f22, f23, f25, f32, f33, f35, N′, Y′] fitted over a data window of measured
 //! states z′ = [ψ′, r′, β′, η′] with the rudder δ′ known, for the path controller's adaptation.
 //!
 //! # Source
-//! Spec `adaptive_path_control.md` §2.12: model eq. (75) (4 states, γ̃ at H/T = 1.89, p7, p8
+//! [Parsons1980, sec. 4.1]: model [Parsons1980, eq. (75)] (4 states, γ̃ at H/T = 1.89, p7, p8
 //! constant over the window), Euler at Δt′, initial state = the Kalman estimate at the window
-//! start, cost eq. (77) J = ½ Σ (z′_k − x_m,k)ᵀ W (z′_k − x_m,k) with W = R⁻¹ (Table 9).
+//! start, cost [Parsons1980, eq. (77)] J = ½ Σ (z′_k − x_m,k)ᵀ W (z′_k − x_m,k) with W = R⁻¹ [Parsons1980, Table 9].
 //!
 //! # Reading taken
 //! The report minimises with DUD (Ralston & Jennrich 1978) with Cuong's unspecified stopping
-//! rules; the spec allows a Levenberg–Marquardt substitute ("evaluation counts will differ"). This
+//! rules; any minimiser of the same cost gives the same estimates (the evaluation counts differ). This
 //! is Levenberg–Marquardt with a forward-difference Jacobian (one model run per parameter), so
-//! the evaluation counts of Tables 11–15 are not comparable; the minimiser's result is.
+//! the evaluation counts of [Parsons1980, Tables 11–15] are not comparable; the minimiser's result is.
 //! Design-time computation (allocates; runs once per batch period).
 //!
 //! # In the loop
-//! [`WlsEstimator`] is the estimator of Fig. 24 as the PathWlsEstimator FMU runs it: data windows
+//! [`WlsEstimator`] is the estimator of [Parsons1980, Fig. 24] as the PathWlsEstimator FMU runs it: data windows
 //! of length LW repeating every LU (from `window_start`), one sample per step, the fit when a
-//! window is complete, warm-started from the last valid estimate (line 1106), the Table 10
+//! window is complete, warm-started from the last valid estimate [Parsons1980, sec. 4.2.1], the [Parsons1980, Table 10]
 //! validity of the result. The per-step sample path does not allocate (the window buffers are
 //! sized once, at the first sample); the fit, once per window, does.
 
 use super::path::{validity, UpdateDecision, TABLE_10};
 use super::ControlError;
+use crate::error::{check_finite, check_positive};
 use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
 
@@ -42,9 +43,9 @@ pub struct WlsSettings {
     pub dt: f64,
     /// γ̃21, γ̃22, γ̃31, γ̃32 (H/T = 1.89).
     pub gamma: [f64; 4],
-    /// Diagonal weight W = R⁻¹ (Table 9 r_jj: 1.2976e-9, 7.7215e-10, 8.2777e-10, 5.0651e-9).
+    /// Diagonal weight W = R⁻¹ ([Parsons1980, Table 9] r_jj: 1.2976e-9, 7.7215e-10, 8.2777e-10, 5.0651e-9).
     pub weight: [f64; 4],
-    /// Largest number of cost evaluations (the report suggests such a guard, line 1271).
+    /// Largest number of cost evaluations (the report suggests such a guard, [Parsons1980, sec. 4.3.2]).
     pub max_evaluations: usize,
 }
 
@@ -73,7 +74,7 @@ pub struct WlsFit {
     pub evaluations: usize,
 }
 
-/// Weighted residuals √W (z′_k − x_m,k) of eq. (75) simulated with `p` (k = 1 … n−1).
+/// Weighted residuals √W (z′_k − x_m,k) of [Parsons1980, eq. (75)] simulated with `p` (k = 1 … n−1).
 fn residuals(p: &[f64; 8], w: &Window, s: &WlsSettings) -> DVector<f64> {
     let n = w.z.len();
     let sw: [f64; 4] = s.weight.map(f64::sqrt);
@@ -98,8 +99,8 @@ fn residuals(p: &[f64; 8], w: &Window, s: &WlsSettings) -> DVector<f64> {
     r
 }
 
-/// Σ_k |z′_k − x_m,k|² of eq. (75) simulated with `p`: the unweighted sum of squares without ½,
-/// the scale the report's printed J seems to have (spec §6 item 13).
+/// Σ_k |z′_k − x_m,k|² of [Parsons1980, eq. (75)] simulated with `p`: the unweighted sum of squares without ½,
+/// the scale the report's printed J seems to have (our reading; the report does not say).
 pub fn sum_of_squares(p: &[f64; 8], w: &Window, s: &WlsSettings) -> f64 {
     let unit = WlsSettings {
         weight: [1.0; 4],
@@ -108,7 +109,7 @@ pub fn sum_of_squares(p: &[f64; 8], w: &Window, s: &WlsSettings) -> f64 {
     residuals(p, w, &unit).norm_squared()
 }
 
-/// Minimises eq. (77) from `p0` by Levenberg–Marquardt.
+/// Minimises [Parsons1980, eq. (77)] from `p0` by Levenberg–Marquardt.
 pub fn fit(w: &Window, s: &WlsSettings, p0: [f64; 8]) -> Result<WlsFit, ControlError> {
     if w.z.len() < 3 || w.rudder.len() != w.z.len() {
         return Err(ControlError(format!(
@@ -117,7 +118,7 @@ pub fn fit(w: &Window, s: &WlsSettings, p0: [f64; 8]) -> Result<WlsFit, ControlE
             w.rudder.len()
         )));
     }
-    super::positive("dt", s.dt)?;
+    check_positive("dt", s.dt)?;
     let mut p = p0;
     let mut r = residuals(&p, w, s);
     let mut evals = 1;
@@ -184,7 +185,7 @@ pub fn fit(w: &Window, s: &WlsSettings, p0: [f64; 8]) -> Result<WlsFit, ControlE
     })
 }
 
-/// When the data windows are loaded (Fig. 24), in ship lengths t′ from the start: windows of
+/// When the data windows are loaded [Parsons1980, Fig. 24], in ship lengths t′ from the start: windows of
 /// length LW at `window_start + n·LU` (n = 0, 1, …); the fit runs when a window is complete.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct WlsSchedule {
@@ -197,20 +198,15 @@ pub struct WlsSchedule {
 
 impl WlsSchedule {
     pub fn validate(&self) -> Result<(), ControlError> {
-        super::positive("window_length", self.window_length)?;
-        super::positive("update_cycle", self.update_cycle)?;
+        check_positive("window_length", self.window_length)?;
+        check_positive("update_cycle", self.update_cycle)?;
         if self.window_length > self.update_cycle {
             return Err(ControlError(format!(
                 "parameter window_length = {} must not exceed update_cycle = {}",
                 self.window_length, self.update_cycle
             )));
         }
-        if !self.window_start.is_finite() {
-            return Err(ControlError(format!(
-                "parameter window_start = {} must be finite",
-                self.window_start
-            )));
-        }
+        check_finite("window_start", self.window_start)?;
         Ok(())
     }
 
@@ -260,9 +256,9 @@ impl WlsEstimator {
         p0: [f64; 8],
     ) -> Result<Self, ControlError> {
         schedule.validate()?;
-        super::positive("dt", settings.dt)?;
+        check_positive("dt", settings.dt)?;
         for (i, w) in settings.weight.iter().enumerate() {
-            super::positive(["w_psi", "w_r", "w_beta", "w_eta"][i], *w)?;
+            check_positive(["w_psi", "w_r", "w_beta", "w_eta"][i], *w)?;
         }
         if settings.max_evaluations < 10 {
             return Err(ControlError(format!(
@@ -356,12 +352,12 @@ impl WlsEstimator {
         std::array::from_fn(|i| self.p[i])
     }
 
-    /// Table 10 branch of the current estimate (None: f̂23 or f̂25 out of range).
+    /// [Parsons1980, Table 10] branch of the current estimate (None: f̂23 or f̂25 out of range).
     pub fn decision(&self) -> UpdateDecision {
         validity(&self.f(), &TABLE_10)
     }
 
-    /// Cost evaluations, eq. (77) cost and the unweighted Σ|e|² of the last fit.
+    /// Cost evaluations, [Parsons1980, eq. (77)] cost and the unweighted Σ|e|² of the last fit.
     pub fn evaluations(&self) -> usize {
         self.evaluations
     }
@@ -391,14 +387,14 @@ mod tests {
     use crate::hull::tokyo_maru::{TABLE_2, T_R};
     use nalgebra::SVector;
 
-    /// Noise-free window from the Euler model of eq. (11) with the true coefficients (the
+    /// Noise-free window from the Euler model of [Parsons1980, eq. (11)] with the true coefficients (the
     /// measured β′ is earth-relative, as the model's): the fit recovers the truth.
     ///
-    /// Table 12/13 set-up (line 1145): truth at H/T = ∞ under the constant disturbance
+    /// [Parsons1980, Tables 12, 13] set-up [Parsons1980, sec. 4.2.2]: truth at H/T = ∞ under the constant disturbance
     /// N′ = 0.10262e-2, Y′ = 0.23277e-2, estimator started from the 1.89 values, window 2.5 L
     /// (500 samples), dither 0.5 L. The γ̃ are those of 1.89 while the truth has the ∞ γ's, so
     /// p7, p8 absorb Γ(∞)w through Γ(1.89): N̂′, Ŷ′ are the solution of Γ(1.89)[N̂′, Ŷ′] =
-    /// Γ(∞)[N′, Y′] ("biased by the γ errors", §2.12), and the six f's are recovered exactly.
+    /// Γ(∞)[N′, Y′] (biased by the γ errors, as derived here), and the six f's are recovered exactly.
     #[test]
     fn recovers_the_truth_under_a_constant_disturbance() {
         let truth = TABLE_2[4];
@@ -454,7 +450,7 @@ mod tests {
 
     /// The estimator in a loop: windows of LW = 2.5 L every LU = 6 L from t′ = 3.45 on the
     /// Δt′ = 0.005 grid hold exactly 500 samples, the fit comes with the last one, recovers the
-    /// noise-free truth (deep water under the constant disturbance) and is valid (Table 10).
+    /// noise-free truth (deep water under the constant disturbance) and is valid [Parsons1980, Table 10].
     #[test]
     fn estimator_windows_and_fit_in_a_loop() {
         let truth = TABLE_2[4];

@@ -1,46 +1,49 @@
-//! Currents and slowly varying force disturbances: the constant/ramped current of source 000,
-//! the design disturbance histories of source 004 (as nondimensional yaw moment N′ and side
-//! force Y′) and the earth-fixed bias of source 001.
+//! Currents and slowly varying force disturbances: the constant/ramped current of [Taylor2000],
+//! the design disturbance histories of [Parsons1980] (as nondimensional yaw moment N′ and side
+//! force Y′) and the earth-fixed bias of [Fossen1999].
 //!
-//! # Current velocity (000 §5.2.3.1, §5.3.3)
+//! # Current velocity [Taylor2000, sec. 5.2.3.1 and 5.3.3]
 //! Earth-fixed current of speed `V_c(t)` flowing **towards** the direction β_c (same frame as the
 //! heading): `V_c = V0` before `t_start`, then linearly to `V1` over `ramp_duration` (0: a step,
 //! "a current gust of 5 knots directly on its port beam"), `V1` after. Outputs: north/east
 //! components and the body-frame components `u_c = V_c cos(β_c − ψ)`, `v_c = V_c sin(β_c − ψ)`
-//! for the hull kinematics (ẋ = u cos ψ − v sin ψ + V_N, ...). 000 applies its 5-kn current in the
-//! autopilot tests "as an initial condition on the ship's sway velocity"; here it is a velocity
-//! for the kinematics, the form the spec recommends for the track tests (how 000 applied it
-//! there is not stated). Preset [`CurrentParams::ddg51_beam_current`]: 5 kn, step.
+//! for the hull kinematics (ẋ = u cos ψ − v sin ψ + V_N, ...). The thesis applies its 5-kn
+//! current in the autopilot tests "as an initial condition on the ship's sway velocity"
+//! [Taylor2000, sec. 5.2.3.1]; here it is a velocity for the kinematics, the form taken for the
+//! track tests too (how the thesis applied it there is not stated). Preset
+//! [`CurrentParams::ddg51_beam_current`]: 5 kn, step.
 //!
-//! # 004 disturbances (adaptive_path_control.md §2.6, §2.8), in t′ = t U/L
-//! All enter the hull as N′, Y′ through Γ_s (004 eq. 11) and are independent of H/T. Superposed:
-//! * **Design lateral current (Fig. 4)**: N′ = 1.0262e-3 s(t′), Y′ = 2.3277e-3 s(t′) (the
-//!   "correct values" of Tables 12-13; the text's rounded N′ is 0.00103), s = 1 for t′ ≤ 15,
-//!   linear to 0.5 at t′ = 20, 0.5 after (004 L 549, L 817: "0.00103 and 0.000515"). The end of
-//!   the constant part is a parameter (t′ = 18 in the WLS runs, L 1143).
-//! * **Passing ship (Fig. 3)**: the figure is lost; the spec's surrogate is used — zero-mean
+//! # Disturbances of [Parsons1980, sec. 2.3 and 3.2-3.3], in t′ = t U/L
+//! All enter the hull as N′, Y′ through Γ_s [Parsons1980, eq. (11)] and are independent of H/T. Superposed:
+//! * **Design lateral current [Parsons1980, Fig. 4]**: N′ = 1.0262e-3 s(t′), Y′ = 2.3277e-3 s(t′) (the
+//!   "correct values" of [Parsons1980, Tables 12-13]; the text's rounded N′ is 0.00103), s = 1 for t′ ≤ 15,
+//!   linear to 0.5 at t′ = 20, 0.5 after ([Parsons1980, sec. 2.3 and 3.3]: "0.00103 and
+//!   0.000515"). The end of the constant part is a parameter (t′ = 18 in the WLS runs,
+//!   [Parsons1980, sec. 4.2.2]).
+//! * **Passing ship [Parsons1980, Fig. 3]**: the figure is lost; a surrogate of our own is used — zero-mean
 //!   Ricker pulses centred on the beam-to-beam instant t′_p,
 //!   `g(τ; w) = (1 − 2(τ/w)²) exp(−(τ/w)²)`, τ = t′ − t′_p,
-//!   `N′ = −20.4e-5 f g(τ; 0.674)`, `Y′ = 48.0e-5 f g(τ; 0.706)`: peaks of 004 L 1243-1247 at
-//!   beam-to-beam, RMS over −2 ≤ τ ≤ 1.4 equal to 004's σ_N = 8.798e-5, σ_Y = 21.178e-5 (L 685),
-//!   active for |τ| ≲ 1.9 (the 3.5 L span). f = 1 (Figs. 29-37, t′_p = 7) or 4 (Figs. 6-7 and
-//!   11-12, t′_p = 20). A placeholder until Newton's data (DTMB 1461) are available.
-//! * **White sequences**: per-sample σ_N, σ_Y on the internal grid (004 L 1664: σ_N = 2e-5,
-//!   σ_Y = 5e-5 at Δt′ = 0.005, read as per-sample; spec §6 item 9), zero-order hold.
-//! * **First-order shaping filters** (eqs. 39-40): `T dN′/dt′ = −N′ + w1`, T = 1 ship length,
-//!   stationary std σ (q = 2Tσ², eqs. 53-54: σ_N = 8.798e-5, σ_Y = 21.178e-5).
-//! * **Random walks** (eqs. 56-57): `dN′/dt′ = w_N` with intensity q per unit t′ (eqs. 67-68:
+//!   `N′ = −20.4e-5 f g(τ; 0.674)`, `Y′ = 48.0e-5 f g(τ; 0.706)`: peaks of [Parsons1980, sec. 4.3.2] at
+//!   beam-to-beam, RMS over −2 ≤ τ ≤ 1.4 equal to σ_N = 8.798e-5, σ_Y = 21.178e-5 of [Parsons1980, sec. 3.2],
+//!   active for |τ| ≲ 1.9 (the 3.5 L span). f = 1 ([Parsons1980, Figs. 29-37], t′_p = 7) or 4 ([Parsons1980, Figs. 6-7 and
+//!   11-12], t′_p = 20). A placeholder until Newton's data (DTMB 1461) are available.
+//! * **White sequences**: per-sample σ_N, σ_Y on the internal grid ([Parsons1980, sec. 5.3]: σ_N = 2e-5,
+//!   σ_Y = 5e-5 at Δt′ = 0.005, read as per-sample), zero-order hold.
+//! * **First-order shaping filters** [Parsons1980, eqs. (39)-(40)]: `T dN′/dt′ = −N′ + w1`, T = 1 ship length,
+//!   stationary std σ (q = 2Tσ², [Parsons1980, eqs. (53)-(54)]: σ_N = 8.798e-5, σ_Y = 21.178e-5).
+//! * **Random walks** [Parsons1980, eqs. (56)-(57)]: `dN′/dt′ = w_N` with intensity q per unit t′ ([Parsons1980, eqs. (67)-(68)]:
 //!   q11 = 2e-8, q22 = 1.25e-7): increments over Δt′ have variance q Δt′.
-//!   Dimensional outputs: `N = N′ ½ρL³U²`, `Y = Y′ ½ρL²U²` (ρ = 1025 kg/m³, not given in 004).
+//!   Dimensional outputs: `N = N′ ½ρL³U²`, `Y = Y′ ½ρL²U²` (ρ = 1025 kg/m³, not given in the report).
 //!
-//! # 001 bias (eq. 7)
+//! # Bias [Fossen1999, eq. (7)]
 //! `ḃ = −T⁻¹ b + Ψ n`, earth-fixed (surge force N, sway force N, yaw moment N·m), T = 1000 s
-//! (001 eq. 58), Ψ not given in 001 (default 0: b decays from its initial value), stationary
+//! [Fossen1999, eq. (58)], Ψ not given in the paper (default 0: b decays from its initial value), stationary
 //! variance Ψ² T/2. Also rotated into the body frame with the heading input: `Jᵀ(ψ) b`.
 //!
 //! All random processes run on the fixed internal grid of [`super::shaping`].
 
 use super::shaping::{quantise_time, FirstOrderProcess, Start, WhiteSequence};
+use crate::error::{check_non_negative, check_positive};
 use crate::random::{channel, NoiseStream};
 use serde::{Deserialize, Serialize};
 
@@ -53,7 +56,7 @@ pub fn ricker(tau: f64, w: f64) -> f64 {
     (1.0 - 2.0 * x2) * (-x2).exp()
 }
 
-/// 004 passing-ship surrogate at τ = t′ − t′_p for magnitude factor f: (N′, Y′).
+/// Passing-ship surrogate (for [Parsons1980, Fig. 3]) at τ = t′ − t′_p for magnitude factor f: (N′, Y′).
 pub fn passing_ship(tau: f64, factor: f64) -> (f64, f64) {
     (
         -20.4e-5 * factor * ricker(tau, 0.674),
@@ -61,7 +64,7 @@ pub fn passing_ship(tau: f64, factor: f64) -> (f64, f64) {
     )
 }
 
-/// 004 Fig. 4 profile s(t′): 1 until `t_end_constant`, linear to `final_fraction` at
+/// [Parsons1980, Fig. 4] profile s(t′): 1 until `t_end_constant`, linear to `final_fraction` at
 /// `t_end_ramp`, constant after.
 pub fn design_current_profile(
     tp: f64,
@@ -87,26 +90,26 @@ pub struct CurrentParams {
     pub direction: f64,
     pub t_start: f64,
     pub ramp_duration: f64,
-    // 004 scaling
+    // [Parsons1980] scaling
     pub ship_speed: f64,
     pub ship_length: f64,
     pub density: f64,
-    // 004 design lateral current (Fig. 4)
+    // design lateral current [Parsons1980, Fig. 4]
     pub design_current: bool,
     pub design_n: f64,
     pub design_y: f64,
     pub design_t_constant: f64,
     pub design_t_ramp: f64,
     pub design_final_fraction: f64,
-    // 004 passing ship (Fig. 3)
+    // passing ship [Parsons1980, Fig. 3]
     pub passing_factor: f64,
     pub passing_time: f64,
-    // 004 random disturbances
+    // random disturbances of [Parsons1980, sec. 3.2-3.3 and 5.3]
     pub white_sigma: [f64; 2],
     pub shaping_sigma: [f64; 2],
     pub shaping_time_constant: f64,
     pub walk_q: [f64; 2],
-    // 001 bias
+    // bias [Fossen1999, eq. (7)]
     pub bias_time_constant: f64,
     pub bias_psi: [f64; 3],
     pub bias_initial: [f64; 3],
@@ -117,7 +120,7 @@ pub struct CurrentParams {
 
 impl Default for CurrentParams {
     /// No current, no disturbances; Tokyo Maru scaling (12 kn, 290 m), Δt′ = 0.005 grid,
-    /// 001 bias time constant 1000 s.
+    /// Bias time constant 1000 s [Fossen1999, eq. (58)].
     fn default() -> Self {
         let u = 12.0 * KNOT;
         CurrentParams {
@@ -151,7 +154,7 @@ impl Default for CurrentParams {
 }
 
 impl CurrentParams {
-    /// 000: a 5-kn current on the port beam of a ship heading north (flowing east), applied
+    /// [Taylor2000, sec. 5.2.3.1]: a 5-kn current on the port beam of a ship heading north (flowing east), applied
     /// as a step at `t_start`.
     pub fn ddg51_beam_current(t_start: f64) -> Self {
         CurrentParams {
@@ -164,16 +167,7 @@ impl CurrentParams {
         }
     }
 
-    /// 004 Figs. 6-7 / 11-12: 4× passing ship beam-to-beam at t′ = 20.
-    pub fn parsons_passing_ship_4x() -> Self {
-        CurrentParams {
-            passing_factor: 4.0,
-            passing_time: 20.0,
-            ..Self::default()
-        }
-    }
-
-    /// 004 Figs. 8-10 / 13-15: design lateral current of Fig. 4.
+    /// [Parsons1980, Figs. 8-10 and 13-15]: design lateral current of [Parsons1980, Fig. 4].
     pub fn parsons_design_current() -> Self {
         CurrentParams {
             design_current: true,
@@ -182,27 +176,13 @@ impl CurrentParams {
     }
 
     pub fn validate(&self) -> Result<(), String> {
-        let pos = |name: &str, v: f64| {
-            if v > 0.0 && v.is_finite() {
-                Ok(())
-            } else {
-                Err(format!("{name} = {v} must be > 0"))
-            }
-        };
-        let nonneg = |name: &str, v: f64| {
-            if v >= 0.0 && v.is_finite() {
-                Ok(())
-            } else {
-                Err(format!("{name} = {v} must be >= 0"))
-            }
-        };
-        pos("ship_speed", self.ship_speed)?;
-        pos("ship_length", self.ship_length)?;
-        pos("density", self.density)?;
-        pos("internal_step", self.internal_step)?;
-        pos("shaping_time_constant", self.shaping_time_constant)?;
-        pos("bias_time_constant", self.bias_time_constant)?;
-        nonneg("ramp_duration", self.ramp_duration)?;
+        check_positive("ship_speed", self.ship_speed)?;
+        check_positive("ship_length", self.ship_length)?;
+        check_positive("density", self.density)?;
+        check_positive("internal_step", self.internal_step)?;
+        check_positive("shaping_time_constant", self.shaping_time_constant)?;
+        check_positive("bias_time_constant", self.bias_time_constant)?;
+        check_non_negative("ramp_duration", self.ramp_duration)?;
         if !(self.design_t_ramp > self.design_t_constant) {
             return Err(format!(
                 "design_t_ramp = {} must exceed design_t_constant = {}",
@@ -220,7 +200,7 @@ impl CurrentParams {
             ("bias_psi_y", self.bias_psi[1]),
             ("bias_psi_n", self.bias_psi[2]),
         ] {
-            nonneg(n, v)?;
+            check_non_negative(n, v)?;
         }
         Ok(())
     }
@@ -303,7 +283,7 @@ impl Current {
         })
     }
 
-    /// Time constant [s] and gains of the 004 shaping filters: stationary std σ ⇔ g = σ √(2/T).
+    /// Time constant [s] and gains of the shaping filters of [Parsons1980, sec. 3.2]: stationary std σ ⇔ g = σ √(2/T).
     fn shaping_params(p: &CurrentParams) -> (f64, [f64; 2]) {
         let t = p.shaping_time_constant * p.time_scale();
         (t, p.shaping_sigma.map(|s| s * (2.0 / t).sqrt()))
@@ -322,9 +302,7 @@ impl Current {
         t_start: f64,
         ramp_duration: f64,
     ) -> Result<(), String> {
-        if !(ramp_duration >= 0.0) {
-            return Err(format!("ramp_duration = {ramp_duration} must be >= 0"));
-        }
+        check_non_negative("ramp_duration", ramp_duration)?;
         let p = &mut self.params;
         p.speed_initial = speed_initial;
         p.speed_final = speed_final;
@@ -437,12 +415,12 @@ impl Current {
         [n * q * p.ship_length, y * q]
     }
 
-    /// 001 bias, earth-fixed (X [N], Y [N], N [N·m]).
+    /// Bias [Fossen1999, eq. (7)], earth-fixed (X [N], Y [N], N [N·m]).
     pub fn bias(&self) -> [f64; 3] {
         std::array::from_fn(|i| self.bias[i].value(self.time))
     }
 
-    /// 001 bias in the body frame, Jᵀ(ψ) b.
+    /// Bias [Fossen1999, eq. (7)] in the body frame, Jᵀ(ψ) b.
     pub fn bias_body(&self) -> [f64; 3] {
         let b = self.bias();
         let (s, c) = self.heading.sin_cos();
@@ -480,7 +458,7 @@ mod tests {
                 assert!(n2 >= n - 1e-18 && y2 <= y + 1e-18);
             }
         }
-        // RMS over -2 <= τ <= 1.4 equals σ_N = 8.798e-5, σ_Y = 21.178e-5 (004 L 685) within 0.5 %
+        // RMS over -2 <= τ <= 1.4 equals σ_N = 8.798e-5, σ_Y = 21.178e-5 [Parsons1980, sec. 3.2] within 0.5 %
         let m = 34_000;
         let (mut sn, mut sy) = (0.0, 0.0);
         for k in 0..=m {
@@ -492,7 +470,7 @@ mod tests {
         let (rn, ry) = ((sn / (m + 1) as f64).sqrt(), (sy / (m + 1) as f64).sqrt());
         assert!((rn / 8.798e-5 - 1.0).abs() < 5e-3, "{rn}");
         assert!((ry / 21.178e-5 - 1.0).abs() < 5e-3, "{ry}");
-        // active span: below 1 % of the peak for |τ| >= 1.9 (the 3.5 L span of 004)
+        // active span: below 1 % of the peak for |τ| >= 1.9 (the 3.5 L span of [Parsons1980, sec. 4.3.2])
         for tau in [-1.95f64, 1.95, 2.5, -3.0] {
             let (n, y) = passing_ship(tau, 1.0);
             assert!(
@@ -500,7 +478,7 @@ mod tests {
                 "{tau}"
             );
         }
-        // 004 q11 = 2 T σ_N² = 1.548e-8, q22 = 8.970e-8 (eqs. 53-54)
+        // q11 = 2 T σ_N² = 1.548e-8, q22 = 8.970e-8 [Parsons1980, eqs. (53)-(54)]
         assert!((2.0 * 8.798e-5f64.powi(2) / 1.548e-8 - 1.0).abs() < 1e-3);
         assert!((2.0 * 21.178e-5f64.powi(2) / 8.970e-8 - 1.0).abs() < 1e-3);
     }
@@ -520,9 +498,10 @@ mod tests {
             assert!((n - 1.0262e-3 * s).abs() < 1e-12, "t' = {tp}: {n}");
             assert!((y - 2.3277e-3 * s).abs() < 1e-12, "t' = {tp}: {y}");
         }
-        // "constant disturbance levels of 0.00103 and 0.000515" (004 L 817)
+        // "constant disturbance levels of 0.00103 and 0.000515" [Parsons1980, sec. 3.3]
         assert!((1.0262e-3f64 - 0.00103).abs() < 5e-6);
-        // [DERIVED] eqs. 24-25 with the spec's Fujino derivatives at H/T = 1.89 and v′c = 1/12:
+        // [DERIVED] [Parsons1980, eqs. (24)-(25)] with the stability derivatives N′β = 0.0123,
+        // Y′β = 0.0279 obtained by inverting [Parsons1980, Table 2] at H/T = 1.89, and v′c = 1/12:
         // N′ = N′β v′c, Y′ = Y′β v′c within 0.2 % of the printed values
         assert!((0.0123f64 / 12.0 / 1.0262e-3 - 1.0).abs() < 2e-3);
         assert!((0.0279f64 / 12.0 / 2.3277e-3 - 1.0).abs() < 2e-3);

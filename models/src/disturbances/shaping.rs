@@ -23,7 +23,7 @@ use crate::random::NoiseStream;
 /// a whole nanosecond first. Importers compute communication points differently (FMPy
 /// `t0 + k h`, libcosim integer nanoseconds, an FMU's own `t + h`), which puts "the same" instant
 /// a few ulps apart; after rounding they coincide, so outputs that are functions of time (the
-/// sums of sinusoids, the interpolated processes, the 004 histories) are bit-identical across
+/// sums of sinusoids, the interpolated processes, the histories of [Parsons1980]) are bit-identical across
 /// importers whenever the communication points lie on a nanosecond grid. Exact for |t| < 9e6 s.
 pub const TIME_QUANTUM: f64 = 1e-9;
 
@@ -64,9 +64,9 @@ impl Grid {
 
 /// Second-order process `ẋ1 = x2`, `ẋ2 = −ω² x1 − 2 ζ ω x2 + g n(t)`.
 ///
-/// * x1 is the low-pass output `g/(s² + 2ζωs + ω²)` (003 Fig. 2.10 with g = σ ω²), stationary
+/// * x1 is the low-pass output `g/(s² + 2ζωs + ω²)` ([Klugt1987, Fig. 2.10] with g = σ ω²), stationary
 ///   variance `g²/(4 ζ ω³)`;
-/// * x2 is the band-pass output `g s/(s² + 2ζωs + ω²)` (001 eq. 10 with g = σ_i = K_w),
+/// * x2 is the band-pass output `g s/(s² + 2ζωs + ω²)` ([Fossen1999, eq. (10)] with g = σ_i = K_w),
 ///   stationary variance `g²/(4 ζ ω)`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct SecondOrderProcess {
@@ -189,7 +189,8 @@ pub struct FirstOrderProcess {
     time_constant: f64,
     gain: f64,
     phi: f64,
-    sd: f64,
+    /// Standard deviation of the noise added per grid step.
+    step_std: f64,
     grid: Grid,
     now: f64,
     next: f64,
@@ -209,7 +210,7 @@ impl FirstOrderProcess {
             time_constant,
             gain,
             phi: 1.0,
-            sd: 0.0,
+            step_std: 0.0,
             grid: Grid { t0, dt, k: 0 },
             now: 0.0,
             next: 0.0,
@@ -246,18 +247,18 @@ impl FirstOrderProcess {
         let dt = self.grid.dt;
         if self.is_walk() {
             self.phi = 1.0;
-            self.sd = self.gain.abs() * dt.sqrt();
+            self.step_std = self.gain.abs() * dt.sqrt();
         } else {
             let phi = (-dt / self.time_constant).exp();
             let v = self.gain * self.gain * self.time_constant / 2.0;
             self.phi = phi;
             // 1 − φ² without cancellation: −expm1(−2 dt/T)
-            self.sd = (v * -(-2.0 * dt / self.time_constant).exp_m1()).sqrt();
+            self.step_std = (v * -(-2.0 * dt / self.time_constant).exp_m1()).sqrt();
         }
     }
 
     fn draw_next(&mut self) -> f64 {
-        self.phi * self.now + self.sd * self.rng.normal()
+        self.phi * self.now + self.step_std * self.rng.normal()
     }
 
     pub fn advance_to(&mut self, t: f64) {
@@ -276,7 +277,7 @@ impl FirstOrderProcess {
 
 /// A white Gaussian sequence with per-sample standard deviation σ on the grid t_k = t0 + k·dt,
 /// each sample held over [t_k, t_(k+1)) (zero-order hold). Its equivalent continuous intensity
-/// is σ² dt (004 eqs. 16 and 64).
+/// is σ² dt [Parsons1980, eqs. (16) and (64)].
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct WhiteSequence {
     sigma: f64,
@@ -294,10 +295,6 @@ impl WhiteSequence {
             now,
             rng,
         }
-    }
-
-    pub fn set_sigma(&mut self, sigma: f64) {
-        self.sigma = sigma;
     }
 
     /// Advances so that the held sample is the one of the last grid instant ≤ t. A grid
@@ -335,7 +332,8 @@ mod tests {
 
     #[test]
     fn second_order_variances_match_the_analytic_values_within_3_percent() {
-        // 001 wave model: ζ = 0.1, ω0 = 0.8976 rad/s, σ = 1: std(x2) = 1.669 σ (spec §2.4).
+        // Wave model of [Fossen1999, sec. 6]: ζ = 0.1, ω0 = 0.8976 rad/s, σ = 1:
+        // std(x2) = 1.669 σ (derived here from the stationary variance σ²/(4ζω0)).
         let mut p = SecondOrderProcess::new(
             0.8976,
             0.1,
@@ -357,7 +355,7 @@ mod tests {
 
     #[test]
     fn first_order_variance_and_correlation_time() {
-        // 001 bias: T = 1000 s; 1e6 grid steps of 10 s = 10^4 correlation times.
+        // Bias of [Fossen1999, eq. (58)]: T = 1000 s; 1e6 grid steps of 10 s = 10^4 correlation times.
         let mut p = FirstOrderProcess::new(
             1000.0,
             0.02,

@@ -2,10 +2,10 @@
 //! and the wave-frequency (WF) motion of a DP vessel.
 //!
 //! # Spectra (`S_ζ(ω)`, one-sided, m²·s/rad, `m0 = ∫ S dω`, `H_s = 4 √m0`)
-//! * **Bretschneider, 12th ITTC form of 003 eq. 2.21** (rrs_models_filters.md §2.7):
+//! * **Bretschneider, 12th ITTC form of [Klugt1987, sec. 2.4.3, eq. (2.21)]**:
 //!   `S = A ω⁻⁵ exp(−B ω⁻⁴)`, `B = 691 T̄⁻⁴`, `A = B (0.5 H_1/3)²` (= 172.75 H² T̄⁻⁴), with
-//!   `T̄ = 2π m0/m1` the **mean** period. (The OCR original, seed 003 L 742-754, and the extract
-//!   agree; the constant 691 makes the spectrum's own T̄ equal the parameter to 0.01 %.)
+//!   `T̄ = 2π m0/m1` the **mean** period (the constant 691 makes the spectrum's own T̄ equal the
+//!   parameter to 0.01 %).
 //! * **Pierson-Moskowitz** in the two-parameter (H_s, peak period T_p) form:
 //!   `S = (5/16) H_s² ω_p⁴ ω⁻⁵ exp(−1.25 (ω_p/ω)⁴)`, `ω_p = 2π/T_p`. The fully developed
 //!   one-parameter sea (α = 0.0081) has `ω_p = 0.4013 √(g/H_s)`: [`SeaState::fully_developed_pm`].
@@ -13,10 +13,11 @@
 //!   ω ≤ ω_p and 0.09 above. The normalisation N is computed numerically so that `4√m0 = H_s`
 //!   exactly (instead of the approximate `1 − 0.287 ln γ` of DNV-RP-C205).
 //!
-//! # Encounter frequency and angle (003 eq. 2.22)
+//! # Encounter frequency and angle [Klugt1987, eq. (2.22)]
 //! `ω_e = ω0 − ω0² U cos γ / g`, with γ the angle between the ship's heading and the direction in
 //! which the waves travel: **γ = 0 following seas, ±90° beam seas, 180° head seas** (the reading
-//! the spec infers from eq. 2.22's sign and 003 L 3851, L 3953; Fig. 2.9 is lost). Here
+//! taken from the sign of [Klugt1987, eq. (2.22)] and the trial descriptions of [Klugt1987, sec. 7.2.3 and 7.4];
+//! [Klugt1987, Fig. 2.9] is lost). Here
 //! `γ = wave_direction − heading` wrapped to (−π, π], both angles in the same earth-fixed frame and
 //! `wave_direction` the direction the waves travel **towards**. In following seas at high speed
 //! ω_e becomes negative for ω0 > g/(U cos γ) (the ship overtakes the waves); the signed value is
@@ -30,34 +31,35 @@
 //!   constant the elevation is evaluated **exactly** at every time: `θ_i = φ_i + ω_e,i (t − t0)`.
 //!   When U or γ change (they are held over each communication step) the phases are rebased at
 //!   that instant, which is exact for piecewise-constant inputs.
-//! * **Shaping filter** (003 Fig. 2.10; 001 eq. 10): white noise through
+//! * **Shaping filter** ([Klugt1987, Fig. 2.10]; [Fossen1999, eq. (10)]): white noise through
 //!   `ẍ + 2ζ_f ω_f ẋ + ω_f² x = g n`, generated on the fixed internal grid of
 //!   [`shaping`](super::shaping) (exact discretisation, linear interpolation between grid points).
-//!   Output form *low-pass* (003): ζ = x, or *band-pass* (001): ζ = ẋ. ω_f is the encounter
+//!   Output form *low-pass* ([Klugt1987, Fig. 2.10]): ζ = x, or *band-pass* ([Fossen1999, eq. (10)]): ζ = ẋ. ω_f is the encounter
 //!   frequency of the filter frequency ω0 (default: the spectrum's peak), floored at 0.05 rad/s;
 //!   g is set so that the stationary variance is m0 (H_s exact in expectation):
 //!   low-pass `g² = 4 ζ_f ω_f³ m0`, band-pass `g² = 4 ζ_f ω_f m0`.
 //!
-//! # Moments (003 eqs. 2.23-2.24)
+//! # Moments [Klugt1987, eqs. (2.23)-(2.24)]
 //! `K = k_φ sin(γ) ζ(t)`, `N = k_ψ sin(2γ) ζ(t)`: the frequency responses H_gφ, H_gψ are not
-//! given in 003, so they are constant gains (parameters; default 0). γ is signed, so waves from
+//! given in the thesis, so they are constant gains (parameters; default 0). γ is signed, so waves from
 //! the other side reverse the roll moment.
 //!
-//! # Wave-frequency motion for DP (001 eqs. 10-11)
+//! # Wave-frequency motion for DP [Fossen1999, eqs. (10)-(11)]
 //! Three independent band-pass processes `h_w(s) = σ_i s/(s² + 2ζ ω0 s + ω0²)` (surge, sway, yaw)
-//! on the internal grid, default ζ = 0.1, ω0 = 0.8976 rad/s (001 §3.2). σ_i are not given in 001;
+//! on the internal grid, default ζ = 0.1, ω0 = 0.8976 rad/s [Fossen1999, sec. 6]. σ_i are not given in the paper;
 //! the defaults make the significant amplitude 2·std equal the "limited to" amplitudes of the
-//! simulation study (surge 10 m, sway 10 m, yaw 1°; 001 L 424): std(η_w) = 1.669 σ, so
+//! simulation study (surge 10 m, sway 10 m, yaw 1°; [Fossen1999, sec. 6.1]): std(η_w) = 1.669 σ, so
 //! σ = (5 m, 5 m, 0.5°)/1.669 [assumption]. Superposed on the LF position (not fed through a
 //! hull), in the earth frame, without encounter transformation (DP: U ≈ 0).
 //!
-//! # Sea state 4 of source 000 (preset [`SeaState::sea_state_4`])
-//! 000 (L 2764-2778) models SS4 only as "a random disturbance ... filtered to preserve only the
+//! # Sea state 4 of [Taylor2000] (preset [`SeaState::sea_state_4`])
+//! [Taylor2000, sec. 5.3.3.2] models SS4 only as "a random disturbance ... filtered to preserve only the
 //! low-frequency components", H_s 1.25-2.5 m, spectrum and filter not given. Preset:
-//! Pierson-Moskowitz, H_s = 1.875 m (mid-range), T_p = 8.84 s (000's design wave, 400 ft long:
-//! ω = √(2πg/λ) = 0.711 rad/s, L 2085-2089). Use `hs` 1.25 or 2.5 for the band's ends.
+//! Pierson-Moskowitz, H_s = 1.875 m (mid-range), T_p = 8.84 s (the thesis's design wave, 400 ft long:
+//! ω = √(2πg/λ) = 0.711 rad/s, [Taylor2000, sec. 5.1.4]). Use `hs` 1.25 or 2.5 for the band's ends.
 
 use super::shaping::{quantise_time, SecondOrderProcess, Start};
+use crate::error::{check_non_negative, check_positive, require};
 use crate::random::{channel, NoiseStream};
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
@@ -68,7 +70,7 @@ pub const GRAVITY: f64 = 9.81;
 /// Spectrum family.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub enum SpectrumKind {
-    /// 003 eq. 2.21, ITTC: parameterised by H_1/3 and the **mean** period T̄.
+    /// [Klugt1987, eq. (2.21)], ITTC: parameterised by H_1/3 and the **mean** period T̄.
     Bretschneider,
     /// Parameterised by H_s and the **peak** period T_p.
     PiersonMoskowitz,
@@ -118,23 +120,21 @@ impl SeaState {
             gamma,
         }
     }
-    /// Sea state 4 of source 000 (see the module documentation).
+    /// Sea state 4 of [Taylor2000, sec. 5.3.3.2] (see the module documentation).
     pub fn sea_state_4() -> Self {
         Self::pierson_moskowitz(1.875, 8.84)
     }
 
     pub fn validate(&self) -> Result<(), String> {
-        if !(self.hs >= 0.0 && self.hs.is_finite()) {
-            return Err(format!(
-                "significant_wave_height = {} must be >= 0",
-                self.hs
-            ));
-        }
-        if !(self.period > 0.0 && self.period.is_finite()) {
-            return Err(format!("wave_period = {} must be > 0", self.period));
-        }
-        if self.spectrum == SpectrumKind::Jonswap && !(self.gamma >= 1.0 && self.gamma <= 20.0) {
-            return Err(format!("jonswap_gamma = {} must be in [1, 20]", self.gamma));
+        check_non_negative("significant_wave_height", self.hs)?;
+        check_positive("wave_period", self.period)?;
+        if self.spectrum == SpectrumKind::Jonswap {
+            require(
+                (1.0..=20.0).contains(&self.gamma),
+                "jonswap_gamma",
+                self.gamma,
+                "must be in [1, 20]",
+            )?;
         }
         Ok(())
     }
@@ -279,7 +279,7 @@ impl Spectrum {
     }
 }
 
-/// Encounter frequency, 003 eq. 2.22: `ω_e = ω0 − ω0² U cos γ / g`.
+/// Encounter frequency, [Klugt1987, eq. (2.22)]: `ω_e = ω0 − ω0² U cos γ / g`.
 #[inline]
 pub fn encounter_frequency(omega0: f64, speed: f64, gamma: f64, g: f64) -> f64 {
     omega0 - omega0 * omega0 * speed * gamma.cos() / g
@@ -294,7 +294,7 @@ pub fn encounter_angle(wave_direction: f64, heading: f64) -> f64 {
     g
 }
 
-/// σ of 001 eq. 10 that gives the standard deviation `std`: var = σ²/(4 ζ ω0).
+/// σ of [Fossen1999, eq. (10)] that gives the standard deviation `std`: var = σ²/(4 ζ ω0).
 pub fn wf_sigma_for_std(std: f64, zeta: f64, omega0: f64) -> f64 {
     std * (4.0 * zeta * omega0).sqrt()
 }
@@ -309,9 +309,9 @@ pub enum Realisation {
 /// Output form of the shaping filter.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub enum ShapingForm {
-    /// 003 Fig. 2.10: second-order low-pass, ζ = x.
+    /// [Klugt1987, Fig. 2.10]: second-order low-pass, ζ = x.
     LowPass,
-    /// 001 eq. 10: σ s/(s² + 2ζω0 s + ω0²), ζ = ẋ.
+    /// [Fossen1999, eq. (10)]: σ s/(s² + 2ζω0 s + ω0²), ζ = ẋ.
     BandPass,
 }
 
@@ -329,11 +329,11 @@ pub struct WaveParams {
     pub shaping_damping: f64,
     /// Internal grid step of the noise processes [s].
     pub internal_step: f64,
-    /// Roll-moment gain k_φ [N·m per m of elevation] (003 eq. 2.23).
+    /// Roll-moment gain k_φ [N·m per m of elevation] [Klugt1987, eq. (2.23)].
     pub roll_gain: f64,
-    /// Yaw-moment gain k_ψ [N·m per m of elevation] (003 eq. 2.24).
+    /// Yaw-moment gain k_ψ [N·m per m of elevation] [Klugt1987, eq. (2.24)].
     pub yaw_gain: f64,
-    /// 001 WF model: dominant frequency ω0 [rad/s], damping ζ, intensities σ (surge [m], sway
+    /// WF model of [Fossen1999, eqs. (10)-(11)]: dominant frequency ω0 [rad/s], damping ζ, intensities σ (surge [m], sway
     /// [m], yaw [rad]) per √s.
     pub wf_omega0: f64,
     pub wf_zeta: f64,
@@ -376,27 +376,11 @@ impl WaveParams {
                 self.components
             ));
         }
-        if !(self.shaping_damping > 0.0) {
-            return Err(format!(
-                "shaping_damping = {} must be > 0",
-                self.shaping_damping
-            ));
-        }
-        if !(self.internal_step > 0.0 && self.internal_step.is_finite()) {
-            return Err(format!(
-                "internal_step = {} must be > 0",
-                self.internal_step
-            ));
-        }
-        if !(self.wf_omega0 > 0.0 && self.wf_zeta > 0.0) {
-            return Err(format!(
-                "wf_omega0 = {} and wf_zeta = {} must be > 0",
-                self.wf_omega0, self.wf_zeta
-            ));
-        }
-        if !(self.gravity > 0.0) {
-            return Err(format!("gravity = {} must be > 0", self.gravity));
-        }
+        check_positive("shaping_damping", self.shaping_damping)?;
+        check_positive("internal_step", self.internal_step)?;
+        check_positive("wf_omega0", self.wf_omega0)?;
+        check_positive("wf_zeta", self.wf_zeta)?;
+        check_positive("gravity", self.gravity)?;
         Ok(())
     }
 }
@@ -404,10 +388,14 @@ impl WaveParams {
 /// One sinusoid: amplitude, wave frequency, encounter frequency in use, phase at `t_ref`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 struct Component {
-    a: f64,
-    w: f64,
-    we: f64,
-    theta: f64,
+    /// Amplitude [m] (the band energy while the set is built).
+    amplitude: f64,
+    /// Wave frequency ω [rad/s].
+    frequency: f64,
+    /// Encounter frequency ω_e [rad/s] at the current speed and heading.
+    encounter_frequency: f64,
+    /// Phase [rad] at the current time.
+    phase: f64,
 }
 
 /// The wave model (see the module documentation).
@@ -449,14 +437,14 @@ impl Waves {
                 let w = w0 + rng.uniform() * dw;
                 let phase = 2.0 * PI * rng.uniform();
                 comps.push(Component {
-                    a: e,
-                    w,
-                    we: w,
-                    theta: phase,
+                    amplitude: e,
+                    frequency: w,
+                    encounter_frequency: w,
+                    phase,
                 });
             }
             for c in &mut comps {
-                c.a = (2.0 * c.a * m0 / energy).sqrt();
+                c.amplitude = (2.0 * c.amplitude * m0 / energy).sqrt();
             }
         }
         let shaping_w = if params.shaping_frequency > 0.0 {
@@ -528,8 +516,8 @@ impl Waves {
         let dt = self.time - self.t_ref;
         let g = self.params.gravity;
         for c in &mut self.comps {
-            c.theta = (c.theta + c.we * dt).rem_euclid(2.0 * PI);
-            c.we = encounter_frequency(c.w, speed, gamma, g);
+            c.phase = (c.phase + c.encounter_frequency * dt).rem_euclid(2.0 * PI);
+            c.encounter_frequency = encounter_frequency(c.frequency, speed, gamma, g);
         }
         self.t_ref = self.time;
         self.speed = speed;
@@ -575,7 +563,7 @@ impl Waves {
                 let dt = self.time - self.t_ref;
                 self.comps
                     .iter()
-                    .map(|c| c.a * (c.theta + c.we * dt).cos())
+                    .map(|c| c.amplitude * (c.phase + c.encounter_frequency * dt).cos())
                     .sum()
             }
             Realisation::ShapingFilter => {
@@ -603,7 +591,7 @@ impl Waves {
         self.params.yaw_gain * (2.0 * self.gamma).sin() * self.elevation()
     }
 
-    /// Encounter frequency of the spectral peak [rad/s] (signed, eq. 2.22).
+    /// Encounter frequency of the spectral peak [rad/s] (signed, [Klugt1987, eq. (2.22)]).
     pub fn peak_encounter_frequency(&self) -> f64 {
         encounter_frequency(
             self.spectrum.peak_frequency(),
@@ -613,19 +601,9 @@ impl Waves {
         )
     }
 
-    /// 001 wave-frequency motion (surge [m], sway [m], yaw [rad]).
+    /// Wave-frequency motion of [Fossen1999, eqs. (10)-(11)] (surge [m], sway [m], yaw [rad]).
     pub fn wf_motion(&self) -> [f64; 3] {
         std::array::from_fn(|i| self.wf[i].value(self.time)[1])
-    }
-
-    /// Target significant wave height [m].
-    pub fn target_hs(&self) -> f64 {
-        4.0 * self.m0.sqrt()
-    }
-
-    /// Number of sinusoids in use.
-    pub fn component_count(&self) -> usize {
-        self.comps.len()
     }
 }
 
@@ -850,9 +828,9 @@ mod tests {
             let mut w = Waves::new(p.clone(), 0.0).unwrap();
             w.set_inputs(u, gamma);
             let c = &w.comps[0];
-            let we = encounter_frequency(c.w, u, gamma, GRAVITY);
-            let a = c.a;
-            let theta0 = c.theta;
+            let we = encounter_frequency(c.frequency, u, gamma, GRAVITY);
+            let a = c.amplitude;
+            let theta0 = c.phase;
             for k in 0..100 {
                 let t = k as f64 * 0.77;
                 w.advance_to(t);

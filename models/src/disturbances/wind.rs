@@ -1,13 +1,13 @@
 //! Wind: mean wind plus gusts, relative wind on board and the roll and yaw moments of
-//! 003 eqs. 2.19-2.20.
+//! [Klugt1987, eqs. (2.19)-(2.20)].
 //!
-//! # Moments (003 §2.4.2, rrs_models_filters.md §2.6)
-//! `K_wφ = c_wφ V_w² sin γ` (2.19), `N_wψ = c_wR V_w² sin 2γ` (2.20), V_w the relative wind speed
-//! (as measured on board), γ the relative wind angle in (−180°, 180°]. 003 gives no values for
+//! # Moments [Klugt1987, sec. 2.4.2]
+//! `K_wφ = c_wφ V_w² sin γ` [Klugt1987, eq. (2.19)], `N_wψ = c_wR V_w² sin 2γ` [Klugt1987, eq. (2.20)], V_w the relative wind speed
+//! (as measured on board), γ the relative wind angle in (−180°, 180°]. The thesis gives no values for
 //! c_wφ, c_wR (they depend on superstructure area, air density; see Schelling 1977):
-//! parameters, default 0. The OCR original and the extract agree on both equations.
+//! parameters, default 0.
 //!
-//! # Angle convention (reading taken: Fig. 2.9 is lost)
+//! # Angle convention (reading taken: [Klugt1987, Fig. 2.9] is lost)
 //! Directions are those the air moves **towards** (as for the waves and currents of this
 //! project), in the earth frame of the heading. The relative wind angle is
 //! `γ = atan2` of the relative air velocity `W − U_ship` expressed in the body frame: γ = 0 wind
@@ -15,8 +15,8 @@
 //! sense as the wave encounter angle (0 following, 180 head). A ship under way in calm air
 //! sees a head wind of its own speed (γ = 180°, no moment).
 //!
-//! # Gusts (the spectrum documented here; 003 specifies none)
-//! 003: V_w = "a constant component and a component representing the stochastic variations of
+//! # Gusts (the spectrum documented here; the thesis specifies none)
+//! [Klugt1987, sec. 2.4.2]: V_w = "a constant component and a component representing the stochastic variations of
 //! the speed and the relative wind angle". Both variations are first-order Gauss-Markov
 //! processes on the fixed internal grid ([`super::shaping`], exact discretisation, linear
 //! interpolation): true wind speed `V(t) = V̄ + v_g(t)`, `T_g v̇_g = −v_g + …` with stationary
@@ -26,6 +26,7 @@
 //! V is clipped at 0.
 
 use super::shaping::{quantise_time, FirstOrderProcess, Start};
+use crate::error::{check_non_negative, check_positive};
 use crate::random::{channel, NoiseStream};
 use serde::{Deserialize, Serialize};
 
@@ -71,18 +72,14 @@ impl WindParams {
             ("gust_std", self.gust_std),
             ("direction_std", self.direction_std),
         ] {
-            if !(v >= 0.0 && v.is_finite()) {
-                return Err(format!("{n} = {v} must be >= 0"));
-            }
+            check_non_negative(n, v)?;
         }
         for (n, v) in [
             ("gust_time_constant", self.gust_time_constant),
             ("direction_time_constant", self.direction_time_constant),
             ("internal_step", self.internal_step),
         ] {
-            if !(v > 0.0 && v.is_finite()) {
-                return Err(format!("{n} = {v} must be > 0"));
-            }
+            check_positive(n, v)?;
         }
         Ok(())
     }
@@ -195,13 +192,13 @@ impl Wind {
         )
     }
 
-    /// 003 eq. 2.19: c_wφ V_w² sin γ [N·m].
+    /// [Klugt1987, eq. (2.19)]: c_wφ V_w² sin γ [N·m].
     pub fn roll_moment(&self) -> f64 {
         let (v, g) = self.relative();
         self.params.roll_coefficient * v * v * g.sin()
     }
 
-    /// 003 eq. 2.20: c_wR V_w² sin 2γ [N·m].
+    /// [Klugt1987, eq. (2.20)]: c_wR V_w² sin 2γ [N·m].
     pub fn yaw_moment(&self) -> f64 {
         let (v, g) = self.relative();
         self.params.yaw_coefficient * v * v * (2.0 * g).sin()

@@ -2,62 +2,64 @@
 //! ([`ContainerShip`]) and its linearisation ([`LinearContainerShip`]).
 //!
 //! # Source
-//! Spec `container_ship.md` (restating MSS `CRAFT/SHIP/models/container.m` and `Lcontainer.m`,
-//! snapshot 736a3d12), after K. Son and K. Nomoto, "On the coupled motion of steering and rolling
-//! of a high-speed container ship", *Naval Arch. and Ocean Eng.* 20:73-83 (1982):
-//! * §1 conventions: x north, y east, ψ clockwise; φ > 0 starboard down; positive δ → r > 0
-//!   (starboard turn), outward heel φ < 0 in the steady turn, inverse initial roll (§5.4).
-//! * §2.2-2.5 ship data, mass/inertia data, hydrodynamic derivatives and interaction constants
-//!   (the constants below, named as in the tables);
-//! * §2.6 actuator dynamics, §2.7 force model, §2.8 equations of motion, §2.9 operating points;
-//! * §4 linearised model; §8 implementation notes.
+//! The MSS toolbox (T. I. Fossen, Marine Systems Simulator, `CRAFT/SHIP/models/container.m` and
+//! `Lcontainer.m`, snapshot 736a3d12), after K. Son and K. Nomoto, "On the coupled motion of
+//! steering and rolling of a high-speed container ship", *Naval Arch. and Ocean Eng.* 20:73-83
+//! (1982):
+//! * conventions: x north, y east, ψ clockwise; φ > 0 starboard down; positive δ → r > 0
+//!   (starboard turn), outward heel φ < 0 in the steady turn, inverse initial roll (MSS
+//!   `exRRD3.m`).
+//! * ship data, mass/inertia data, hydrodynamic derivatives and interaction constants
+//!   (the constants below, named as in `container.m`);
+//! * actuator dynamics, force model, equations of motion, operating points (`container.m`);
+//! * linearised model (`Lcontainer.m`).
 //!
 //! # Readings taken
-//! * m′_y = 0.007049 (the 2001 MSS correction, §2.3).
-//! * Propeller inflow u′_P multiplied by u′ (the 2022 MSS form, §2.7);
-//!   [`PropellerInflow::Pre2022Cos`] selects the older cos(v′) form used by `exRRD2.m` (§5.3).
-//! * GM = 0.3 m as in the model (not KM − KB), §2.2; a parameter.
-//! * Validity guards (§2.1: MSS stops with an error for U ≤ 0 or n ≤ 0): a step must never abort
+//! * m′_y = 0.007049 (the 2001 MSS correction).
+//! * Propeller inflow u′_P multiplied by u′ (the 2022 MSS form);
+//!   [`PropellerInflow::Pre2022Cos`] selects the older cos(v′) form used by `exRRD2.m`.
+//! * GM = 0.3 m as in the model (not KM − KB); a parameter.
+//! * Validity guards (MSS stops with an error for U ≤ 0 or n ≤ 0): a step must never abort
 //!   the host, so the shaft command is clamped to [`ContainerShipParams::shaft_min_rpm`],
 //!   160 rpm and the speed used for nondimensionalisation is floored at
 //!   [`ContainerShipParams::min_speed`]; [`ContainerShip::outside_validity`] reports when either
 //!   guard is active.
 //! * External forces (`*_ext` inputs, dimensional, N and N·m) are added to the nondimensional
 //!   Y′, K′, N′ after division by ½ρL²U² resp. ½ρL³U² (ρ = 1025 kg/m³), the way `exRRD2.m` adds
-//!   its wave state to K′ (§5.3). They are zero in every source run.
+//!   its wave state to K′. They are zero in every source run.
 //! * No current input: the source model has none.
 //!
 //! # Integration
 //! Classical RK4 with a fixed sub-step ≤ [`ContainerShipParams::max_substep`] (default 0.05 s,
-//! the bound of §8), inputs held over the step; see [`crate::integrate`]. U, the rudder and the
-//! shaft logic are evaluated inside every RK stage (§8).
+//! the step MSS's examples use), inputs held over the step; see [`crate::integrate`]. U, the
+//! rudder and the shaft logic are evaluated inside every RK stage.
 
-use super::{check_finite, check_positive, mss_rudder_rate, wrap_pi, DEG};
+use super::{mss_rudder_rate, wrap_pi, DEG};
+use crate::error::{check_finite, check_positive, require, ParamError};
 use crate::integrate::rk4_advance;
-use crate::steering_gear::ParamError;
 use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 
-// ---- §2.2 ship data ----
-/// Reference length L [m] (§2.2).
+// ---- ship data ----
+/// Reference length L [m].
 pub const L: f64 = 175.0;
-/// Displacement volume ∇ [m³] (§2.2).
+/// Displacement volume ∇ [m³].
 pub const DISPLACEMENT_VOLUME: f64 = 21222.0;
-/// Rudder area A_R [m²] (§2.2).
+/// Rudder area A_R [m²].
 pub const RUDDER_AREA: f64 = 33.0376;
-/// Rudder aspect ratio Λ (§2.2).
+/// Rudder aspect ratio Λ.
 pub const RUDDER_ASPECT: f64 = 1.8219;
-/// Propeller diameter D [m] (§2.2).
+/// Propeller diameter D [m].
 pub const PROP_DIAMETER: f64 = 6.533;
-/// Thrust deduction t (§2.2).
+/// Thrust deduction t.
 pub const THRUST_DEDUCTION: f64 = 0.175;
-/// Water density ρ [kg/m³] (§2.2); cancels except in the dimensional external-force inputs.
+/// Water density ρ [kg/m³]; cancels except in the dimensional external-force inputs.
 pub const RHO: f64 = 1025.0;
-/// Gravity g [m/s²] (§2.2).
+/// Gravity g [m/s²].
 pub const G: f64 = 9.81;
 
-// ---- §2.3 mass and inertia (prime) ----
+// ---- mass and inertia (prime) ----
 const M: f64 = 0.00792;
 const MX: f64 = 0.000238;
 const MY: f64 = 0.007049;
@@ -75,13 +77,13 @@ const M42: f64 = MY * ALPHA_Y;
 const M33: f64 = IX + JX;
 const M44: f64 = IZ + JZ;
 
-// ---- §2.4 hydrodynamic derivatives (prime) ----
+// ---- hydrodynamic derivatives (prime) ----
 const XUU: f64 = -0.0004226;
 const XVR: f64 = -0.00311;
 const XRR: f64 = 0.00020;
 const XPP: f64 = -0.00020; // X'_φφ
 const XVV: f64 = -0.00386;
-/// Rows of the §2.4 table in the order v, r, p, φ, v³, r³, v²r, vr², v²φ, vφ², r²φ, rφ².
+/// Rows of the derivative table of `container.m` in the order v, r, p, φ, v³, r³, v²r, vr², v²φ, vφ², r²φ, rφ².
 const YC: [f64; 12] = [
     -0.0116, 0.00242, 0.0, -0.000063, -0.109, 0.00177, 0.0214, -0.0405, 0.04605, 0.00304, 0.009325,
     -0.001368,
@@ -95,7 +97,7 @@ const NC: [f64; 12] = [
     -0.0053766, -0.0038592, 0.0024195,
 ];
 
-// ---- §2.5 propeller / interaction ----
+// ---- propeller / interaction ----
 const WP: f64 = 0.184;
 const TAU: f64 = 1.09;
 const XP: f64 = -0.526;
@@ -115,7 +117,7 @@ const XH: f64 = -0.48;
 const XR: f64 = -0.5;
 const ZR: f64 = 0.033;
 
-/// Form of the propeller inflow u′_P (§2.7 history note, §5.3).
+/// Form of the propeller inflow u′_P.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub enum PropellerInflow {
     /// u′_P = u′·[(1 − w_p) + τ(…)] (MSS since 2022; the default).
@@ -127,21 +129,21 @@ pub enum PropellerInflow {
 /// Tunable parameters of [`ContainerShip`]. Angles in rad, rates in rad/s, shaft speeds in rpm.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct ContainerShipParams {
-    /// Rudder command saturation [rad]; 10° (§2.6). `exRRD2.m` uses 20°.
+    /// Rudder command saturation [rad]; 10°. `exRRD2.m` uses 20°.
     pub rudder_max: f64,
-    /// Rudder rate limit [rad/s]; 5°/s (§2.6). `exRRD2.m` uses 20°/s.
+    /// Rudder rate limit [rad/s]; 5°/s. `exRRD2.m` uses 20°/s.
     pub rudder_rate_max: f64,
-    /// Shaft command upper limit [rpm]; 160 (§2.6).
+    /// Shaft command upper limit [rpm]; 160.
     pub shaft_max_rpm: f64,
     /// Shaft command lower clamp [rpm] (validity guard, not in the source; default 1 rpm).
     pub shaft_min_rpm: f64,
-    /// Metacentric height GM [m]; 0.3 (§2.2).
+    /// Metacentric height GM [m]; 0.3.
     pub gm: f64,
-    /// Propeller inflow form (§2.7).
+    /// Propeller inflow form.
     pub propeller_inflow: PropellerInflow,
     /// Speed floor [m/s] for the nondimensionalisation (validity guard; default 0.1 m/s).
     pub min_speed: f64,
-    /// Largest RK4 sub-step [s]; 0.05 (§8).
+    /// Largest RK4 sub-step [s]; 0.05.
     pub max_substep: f64,
 }
 
@@ -161,31 +163,18 @@ impl Default for ContainerShipParams {
 }
 
 impl ContainerShipParams {
-    /// The plant of MSS `exRRD2.m` (§5.3): rudder limits 20° and 20°/s and the pre-2022
-    /// cos(v′) propeller inflow (its wave-roll state is left to the wave model, fed through
-    /// `roll_moment_ext`).
-    pub fn exrrd2() -> Self {
-        ContainerShipParams {
-            rudder_max: 20.0 * DEG,
-            rudder_rate_max: 20.0 * DEG,
-            propeller_inflow: PropellerInflow::Pre2022Cos,
-            ..Self::default()
-        }
-    }
-
     /// Checks every parameter; the error names the parameter and its value.
     pub fn validate(&self) -> Result<(), ParamError> {
         check_positive("rudder_max", self.rudder_max)?;
         check_positive("rudder_rate_max", self.rudder_rate_max)?;
         check_positive("shaft_max_rpm", self.shaft_max_rpm)?;
         check_positive("shaft_min_rpm", self.shaft_min_rpm)?;
-        if self.shaft_min_rpm >= self.shaft_max_rpm {
-            return Err(ParamError {
-                name: "shaft_min_rpm",
-                value: self.shaft_min_rpm,
-                rule: "must be < shaft_max_rpm",
-            });
-        }
+        require(
+            self.shaft_min_rpm < self.shaft_max_rpm,
+            "shaft_min_rpm",
+            self.shaft_min_rpm,
+            "must be < shaft_max_rpm",
+        )?;
         check_positive("gm", self.gm)?;
         check_positive("min_speed", self.min_speed)?;
         check_positive("max_substep", self.max_substep)?;
@@ -247,9 +236,9 @@ pub struct ContainerShipOutputs {
     pub p_prime: f64,
 }
 
-/// Nonlinear 4-DOF Son & Nomoto container ship (spec `container_ship.md` §2).
+/// Nonlinear 4-DOF Son & Nomoto container ship (MSS `container.m`).
 ///
-/// State (§2.1): `[u, v, r, x, y, ψ, p, φ, δ, n]` in m/s, m/s, rad/s, m, m, rad, rad/s, rad, rad,
+/// State: `[u, v, r, x, y, ψ, p, φ, δ, n]` in m/s, m/s, rad/s, m, m, rad, rad/s, rad, rad,
 /// rpm.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct ContainerShip {
@@ -273,7 +262,7 @@ pub struct ContainerForces {
 
 impl ContainerShip {
     /// A ship with the given parameters and initial state `[u, v, r, x, y, ψ, p, φ, δ, n]`.
-    /// Requires u > 0 and n > 0 (§2.1 validity) and finite values.
+    /// Requires u > 0 and n > 0 (the validity range of `container.m`) and finite values.
     pub fn new(params: ContainerShipParams, state: [f64; 10]) -> Result<Self, ParamError> {
         params.validate()?;
         const NAMES: [&str; 10] = ["u", "v", "r", "x", "y", "psi", "p", "phi", "delta", "n_rpm"];
@@ -289,7 +278,7 @@ impl ContainerShip {
         })
     }
 
-    /// Straight-line equilibrium speed [m/s] at shaft speed `n_rpm` (§2.9), in closed form.
+    /// Straight-line equilibrium speed [m/s] at shaft speed `n_rpm`, in closed form.
     ///
     /// With δ = v = r = p = φ = 0 one has u′ = 1, u′_P = 1 − w_p, F′_N = 0, and X′ = 0 reads
     /// X′_uu + (1 − t)·2D⁴K_T n²/(L²u²) = 0 with K_T = a₀ − a₁(1 − w_p)u/(nD): a quadratic in
@@ -305,7 +294,7 @@ impl ContainerShip {
         k * n
     }
 
-    /// The ship on a straight course at the equilibrium of `n_rpm` (§2.9), at the origin,
+    /// The ship on a straight course at the equilibrium of `n_rpm`, at the origin,
     /// heading north, default parameters.
     pub fn at_equilibrium(n_rpm: f64) -> Result<Self, ParamError> {
         check_positive("n_rpm", n_rpm)?;
@@ -316,7 +305,7 @@ impl ContainerShip {
         )
     }
 
-    /// The initial state of MSS `exTurnCircle.m` / `exZigZag.m` (§2.9, §6):
+    /// The initial state of MSS `exTurnCircle.m` / `exZigZag.m`:
     /// `[8, 0, …, 0, 70]` (to be run with n_c = 80 rpm).
     pub fn mss_manoeuvre_start() -> Self {
         Self::new(
@@ -376,7 +365,7 @@ impl ContainerShip {
         }
     }
 
-    /// Nondimensional forces and moments (§2.7) at `state` with actual rudder and shaft speed
+    /// Nondimensional forces and moments at `state` with actual rudder and shaft speed
     /// from the state, plus external inputs.
     pub fn forces(
         params: &ContainerShipParams,
@@ -453,7 +442,7 @@ impl ContainerShip {
         }
     }
 
-    /// State derivative (§2.8) in state order `[u̇, v̇, ṙ, ẋ, ẏ, ψ̇, ṗ, φ̇, δ̇, ṅ]`.
+    /// State derivative in state order `[u̇, v̇, ṙ, ẋ, ẏ, ψ̇, ṗ, φ̇, δ̇, ṅ]`.
     pub fn derivative(
         params: &ContainerShipParams,
         s: &[f64; 10],
@@ -463,7 +452,7 @@ impl ContainerShip {
         let (u, v, r, psi, p, phi, delta, n_rpm) = (s[0], s[1], s[2], s[5], s[6], s[7], s[8], s[9]);
         let sp = f.speed;
 
-        // Actuators (§2.6).
+        // Actuators.
         let d_delta = mss_rudder_rate(
             inp.rudder_command,
             delta,
@@ -478,7 +467,7 @@ impl ContainerShip {
         let tm = if ns > 0.3 { 5.65 / ns } else { 18.83 };
         let d_n = 60.0 * (nc - ns) / tm;
 
-        // Coupled sway-roll-yaw (§2.8 closed form).
+        // Coupled sway-roll-yaw (closed form of the 3×3 solve).
         let det = M22 * M33 * M44 - M32 * M32 * M44 - M42 * M42 * M33;
         let a_v = (M33 * M44 * f.y - M32 * M44 * f.k - M42 * M33 * f.n) / det;
         let a_p = (-M32 * M44 * f.y + (M22 * M44 - M42 * M42) * f.k + M32 * M42 * f.n) / det;
@@ -512,17 +501,17 @@ impl ContainerShip {
     }
 }
 
-/// Linearised container ship (spec `container_ship.md` §4, MSS `Lcontainer.m`).
+/// Linearised container ship (MSS `Lcontainer.m`).
 ///
 /// State `[u, v, r, x, y, ψ, p, φ, δ]` (9 elements, no shaft). Input δ_c [rad]; parameter U₀
-/// (default 7.0 m/s). Equation (§4.1):
+/// (default 7.0 m/s). Equation:
 /// (T M′ T⁻¹) ν̇ + (U/L)(T N′ T⁻¹) ν + (U/L)²(T G′ T⁻¹) η = (U²/L) T b′ δ, ν = [v, r, p],
 /// η = [y, ψ, φ], T = diag(1, 1/L, 1/L).
 ///
-/// Reading taken: the strictly linear form U = U₀ (the spec's recommendation); MSS's
+/// Reading taken: the strictly linear form U = U₀; MSS's
 /// U = √(U₀² + v²) is available with [`LinearContainerShip::mss_speed`] = true. Only the η
 /// entries that G′ touches (φ) matter, since G′'s first two columns are zero. The kinematics are
-/// the §4.1 ones (ẋ = U₀ cos ψ − v sin ψ cos φ, …), so the model is linear only in (v, r, p, φ, δ).
+/// those of `Lcontainer.m` (ẋ = U₀ cos ψ − v sin ψ cos φ, …), so the model is linear only in (v, r, p, φ, δ).
 /// Integration: RK4, sub-step ≤ `max_substep` (the rudder limiter makes an exact ZOH inexact).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct LinearContainerShip {
@@ -544,25 +533,25 @@ pub struct LinearContainerShipInputs {
     pub rudder_command: f64,
 }
 
-/// §4.1 M′ in (v, r, p) order.
+/// M′ in (v, r, p) order.
 pub const LIN_M: [[f64; 3]; 3] = [
     [0.01497, 0.0003525, -0.0002205],
     [0.0003525, 0.000875, 0.0],
     [-0.0002205, 0.0, 0.0000210],
 ];
-/// §4.1 N′ in (v, r, p) order.
+/// N′ in (v, r, p) order.
 pub const LIN_N: [[f64; 3]; 3] = [
     [0.012035, 0.00522, 0.0],
     [0.0038436, 0.00243, -0.000213],
     [-0.000314, 0.0000692, 0.0000075],
 ];
-/// §4.1 G′ in (v, r, p) × (y, ψ, φ) order.
+/// G′ in (v, r, p) × (y, ψ, φ) order.
 pub const LIN_G: [[f64; 3]; 3] = [
     [0.0, 0.0, 0.0000704],
     [0.0, 0.0, 0.0001468],
     [0.0, 0.0, 0.0004966],
 ];
-/// §4.1 b′.
+/// b′.
 pub const LIN_B: [f64; 3] = [-0.002578, 0.00126, 0.0000855];
 
 impl LinearContainerShip {
@@ -580,7 +569,7 @@ impl LinearContainerShip {
         })
     }
 
-    /// The MSS default, U₀ = 7.0 m/s (§4.1).
+    /// The MSS default, U₀ = 7.0 m/s.
     pub fn mss_default() -> Self {
         Self::new(7.0).expect("valid preset")
     }
@@ -612,7 +601,7 @@ impl LinearContainerShip {
         )
     }
 
-    /// The 5-state form ż = A z + B δ, z = [v, r, p, φ, ψ] at speed `u` (spec §4.2).
+    /// The 5-state form ż = A z + B δ, z = [v, r, p, φ, ψ] at speed `u` (derived here from the linearised equations).
     pub fn state_space(u: f64) -> (SMatrix<f64, 5, 5>, SVector<f64, 5>) {
         let (m, n, g, b) = Self::dimensional(u);
         let mi = m.try_inverse().expect("M' is positive definite");
@@ -724,7 +713,7 @@ mod tests {
         }
     }
 
-    /// §2.3 derived mass-matrix entries and §2.8 Δ = 2.298524e-10.
+    /// Derived mass-matrix entries and the determinant Δ = 2.298524e-10.
     #[test]
     fn mass_matrix_constants() {
         assert!((M11 - 0.008158).abs() < 1e-12);
@@ -735,7 +724,7 @@ mod tests {
         assert!((M44 - 8.75e-4).abs() < 1e-12);
         let det = M22 * M33 * M44 - M32 * M32 * M44 - M42 * M42 * M33;
         assert!((det - 2.298524e-10).abs() < 1e-16, "{det}");
-        // §2.5 derived constants.
+        // Derived constants.
         let slope = 6.13 * RUDDER_ASPECT / (RUDDER_ASPECT + 2.25);
         assert!((slope - 2.742761).abs() < 1e-6);
         assert!((RUDDER_AREA / (L * L) - 1.078779e-3).abs() < 1e-9);
@@ -743,7 +732,7 @@ mod tests {
         assert!(((1.0 + AH) * ZR - 0.040821).abs() < 1e-12);
     }
 
-    /// §2.9: straight-line equilibria 7.32959 m/s at 70 rpm and 8.37667 m/s at 80 rpm, within
+    /// Straight-line equilibria 7.32959 m/s at 70 rpm and 8.37667 m/s at 80 rpm, within
     /// 1e-4, reached by *simulating* from an off-equilibrium start (u = 7, resp. 8 m/s, n = n_c)
     /// for 3000 s, and in closed form.
     #[test]
@@ -767,8 +756,8 @@ mod tests {
         }
     }
 
-    /// §1 sign conventions and §5.4 inverse initial roll: positive rudder → r > 0 (starboard turn),
-    /// steady outward heel φ < 0, initial roll φ > 0 (same sign as δ). Run of `exRRD3.m` (§5.4):
+    /// Sign conventions and the inverse initial roll: positive rudder → r > 0 (starboard turn),
+    /// steady outward heel φ < 0, initial roll φ > 0 (same sign as δ). Run of `exRRD3.m`:
     /// u₀ = 7.3, n = 70 rpm, δ_c = 10° from t = 50 s to 74.9 s, here with RK4.
     #[test]
     fn sign_conventions_and_inverse_roll() {
@@ -839,7 +828,7 @@ mod tests {
         assert!(o.y > 0.0, "starboard turn moves east from a north heading");
     }
 
-    /// The rudder servo of §2.6: a 35° command saturates at 10°; rate 5°/s.
+    /// The rudder servo of `container.m`: a 35° command saturates at 10°; rate 5°/s.
     #[test]
     fn rudder_saturation_and_rate() {
         let mut ship = ContainerShip::at_equilibrium(70.0).unwrap();
@@ -886,7 +875,7 @@ mod tests {
         }
     }
 
-    /// §4.2: the dimensional A and B at U₀ = 7.0 m/s, from the §4.1 matrices (relative 1e-4).
+    /// The dimensional A and B at U₀ = 7.0 m/s, from the `Lcontainer.m` matrices (relative 1e-4).
     #[test]
     fn linear_state_space_matches_spec() {
         let a_ref: [[f64; 5]; 5] = [
@@ -911,8 +900,8 @@ mod tests {
         }
     }
 
-    /// §4.1 consistency fact: G′₃₃ = W′GM′ − K′_φ at U = 7 m/s (0.0004966), from the nonlinear
-    /// data; and the §4.2 cross-check: the Jacobian of the nonlinear model at 7.0 m/s
+    /// Consistency fact: G′₃₃ = W′GM′ − K′_φ at U = 7 m/s (0.0004966), from the nonlinear
+    /// data; and a cross-check: the Jacobian of the nonlinear model at 7.0 m/s
     /// (n ≈ 66.85 rpm) agrees closely with A (here: the dominant entries within 3 %).
     #[test]
     fn linear_consistent_with_nonlinear() {

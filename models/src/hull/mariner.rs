@@ -1,19 +1,19 @@
 //! Mariner-class cargo ship: nonlinear 3-DOF (surge, sway, yaw) manoeuvring model.
 //!
 //! # Source
-//! Spec `container_ship.md` §3 (restating MSS `CRAFT/SHIP/models/mariner.m`), after
+//! The MSS toolbox (T. I. Fossen, Marine Systems Simulator, `CRAFT/SHIP/models/mariner.m`), after
 //! M. S. Chislett and J. Strøm-Tejsen (1965), *Planar motion mechanism tests and full-scale
 //! steering and manoeuvring predictions for a Mariner class vessel*, Report Hy-5, Lyngby:
-//! * §3.1 states, inputs and data (L = 160.93 m, U₀ = 7.7175 m/s, rudder 40°, 5°/s);
-//! * §3.2 coefficient table (all ×10⁻⁵ except x′_G) and mass terms;
-//! * §3.3 equations, sign facts and the bias terms Y′₀, N′₀.
+//! * states, inputs and data (L = 160.93 m, U₀ = 7.7175 m/s, rudder 40°, 5°/s);
+//! * coefficient table (all ×10⁻⁵ except x′_G) and mass terms;
+//! * equations, sign facts and the bias terms Y′₀, N′₀.
 //!
 //! # Readings taken
-//! * Rudder sign (§1, §3.3): the model negates its input, δ_c = −u_i, so a positive input gives a
+//! * Rudder sign: the model negates its input, δ_c = −u_i, so a positive input gives a
 //!   starboard turn (r > 0) and the rudder *state* δ has the opposite sign of the input. The output
 //!   [`MarinerOutputs::rudder`] is the physical rudder −δ (as MSS plots it; same sign as the input);
 //!   [`MarinerOutputs::rudder_state`] is δ.
-//! * Because Y′₀, N′₀ ≠ 0, x = 0 is not an equilibrium (§3.3). [`Mariner::trimmed`] starts on the
+//! * Because Y′₀, N′₀ ≠ 0, x = 0 is not an equilibrium. [`Mariner::trimmed`] starts on the
 //!   trimmed straight course instead, solving X′ = Y′ = N′ = 0 with r = 0 for (Δu, v, δ) by Newton
 //!   iteration; the matching input is returned by [`Mariner::trim_input`].
 //! * No current input: the source model has none.
@@ -22,19 +22,19 @@
 //! RK4 with a fixed sub-step ≤ [`MarinerParams::max_substep`] (default 0.05 s), inputs held over
 //! the step; see [`crate::integrate`].
 
-use super::{check_finite, check_positive, mss_rudder_rate, wrap_pi, DEG};
+use super::{mss_rudder_rate, wrap_pi, DEG};
+use crate::error::{check_finite, check_positive, require, ParamError};
 use crate::integrate::rk4_advance;
-use crate::steering_gear::ParamError;
 use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 
-/// Length L [m] (§3.1).
+/// Length L [m].
 pub const L: f64 = 160.93;
-/// Default nominal speed U₀ [m/s] = 15 kn (§3.1).
+/// Default nominal speed U₀ [m/s] = 15 kn.
 pub const U0_DEFAULT: f64 = 7.7175;
 
 const S: f64 = 1e-5;
-// §3.2 coefficients.
+// Coefficients of `mariner.m`.
 const MP: f64 = 798.0 * S;
 const IZ: f64 = 39.2 * S;
 const XG: f64 = -0.023;
@@ -55,7 +55,7 @@ const N_VDOT: f64 = 4.646 * S;
 const N_RDOT: f64 = -43.8 * S;
 
 /// Y′ and N′ coefficients in the order v, r, vvv, vvr, vu, ru, δ, δδδ, uδ, uuδ, vδδ, vvδ,
-/// 0, 0u, 0uu (§3.2, ×10⁻⁵).
+/// 0, 0u, 0uu (×10⁻⁵).
 const YC: [f64; 15] = [
     -1160.0, -499.0, -8078.0, 15356.0, -1160.0, -499.0, 278.0, -90.0, 556.0, 278.0, -4.0, 1190.0,
     -4.0, -8.0, -4.0,
@@ -74,11 +74,11 @@ const M33: f64 = IZ - N_RDOT;
 /// Parameters of [`Mariner`].
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct MarinerParams {
-    /// Nominal speed U₀ [m/s]; 7.7175 (§3.1).
+    /// Nominal speed U₀ [m/s]; 7.7175.
     pub u0: f64,
-    /// Rudder command saturation [rad]; 40° (§3.1).
+    /// Rudder command saturation [rad]; 40°.
     pub rudder_max: f64,
-    /// Rudder rate limit [rad/s]; 5°/s (§3.1).
+    /// Rudder rate limit [rad/s]; 5°/s.
     pub rudder_rate_max: f64,
     /// Largest RK4 sub-step [s]; 0.05.
     pub max_substep: f64,
@@ -140,7 +140,7 @@ pub struct MarinerOutputs {
     pub rudder_state: f64,
     /// Total speed U [m/s].
     pub speed: f64,
-    /// Drift angle β = atan2(v, U₀ + Δu) [rad] (§6.1).
+    /// Drift angle β = atan2(v, U₀ + Δu) [rad].
     pub drift_angle: f64,
     /// u′ = Δu/U.
     pub u_prime: f64,
@@ -150,7 +150,7 @@ pub struct MarinerOutputs {
     pub r_prime: f64,
 }
 
-/// The Mariner-class ship (spec `container_ship.md` §3). State `[Δu, v, r, x, y, ψ, δ]`.
+/// The Mariner-class ship (MSS `mariner.m`). State `[Δu, v, r, x, y, ψ, δ]`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Mariner {
     pub params: MarinerParams,
@@ -166,13 +166,12 @@ impl Mariner {
         for (i, &s) in state.iter().enumerate() {
             check_finite(NAMES[i], s)?;
         }
-        if params.u0 + state[0] <= 0.0 {
-            return Err(ParamError {
-                name: "delta_u",
-                value: state[0],
-                rule: "u0 + delta_u must be > 0",
-            });
-        }
+        require(
+            params.u0 + state[0] > 0.0,
+            "delta_u",
+            state[0],
+            "u0 + delta_u must be > 0",
+        )?;
         Ok(Mariner {
             params,
             state,
@@ -180,7 +179,7 @@ impl Mariner {
         })
     }
 
-    /// MSS's start: x = 0 at U₀ = 7.7175 m/s (not an equilibrium, §3.3).
+    /// MSS's start: x = 0 at U₀ = 7.7175 m/s (not an equilibrium).
     pub fn mss_default() -> Self {
         Self::new(MarinerParams::default(), [0.0; 7]).expect("valid preset")
     }
@@ -236,7 +235,7 @@ impl Mariner {
         self.time
     }
 
-    /// Nondimensional X′, Y′, N′ (§3.3) and the total speed U.
+    /// Nondimensional X′, Y′, N′ and the total speed U.
     pub fn forces(u0: f64, s: &[f64; 7]) -> (f64, f64, f64, f64) {
         let (du, v, r, d) = (s[0], s[1], s[2], s[6]);
         let speed = ((u0 + du).powi(2) + v * v).sqrt();
@@ -277,7 +276,7 @@ impl Mariner {
         (x, y, n, speed)
     }
 
-    /// State derivative (§3.3).
+    /// State derivative.
     pub fn derivative(params: &MarinerParams, s: &[f64; 7], inp: &MarinerInputs) -> [f64; 7] {
         let (x, y, n, sp) = Self::forces(params.u0, s);
         let (du, v, r, psi, d) = (s[0], s[1], s[2], s[5], s[6]);
@@ -340,7 +339,7 @@ impl Mariner {
 mod tests {
     use super::*;
 
-    /// §3.2 mass terms.
+    /// Mass terms.
     #[test]
     fn mass_terms() {
         assert!((M11 - 840e-5).abs() < 1e-15);
@@ -350,7 +349,7 @@ mod tests {
         assert!((M33 - 83.0e-5).abs() < 1e-15);
     }
 
-    /// §3.3 trim: holding a straight line needs u_i ≈ −1.108° (state δ ≈ +1.108°),
+    /// Trim: holding a straight line needs u_i ≈ −1.108° (state δ ≈ +1.108°),
     /// v ≈ 0.0091 m/s. Independent check: the linear part of Y′ = N′ = 0 at Δu = 0 is
     /// [Y_v Y_δ; N_v N_δ][v′; δ] = −[Y_0; N_0], solved here by Cramer's rule.
     #[test]
@@ -383,9 +382,9 @@ mod tests {
         }
     }
 
-    /// §3.3 bias: with zero rudder from x = 0 the Mariner drifts to starboard,
+    /// Bias: with zero rudder from x = 0 the Mariner drifts to starboard,
     /// ψ ≈ 0.18° after 10 s and ≈ 8° after 100 s (MSS values; tolerance 5 %, since MSS used its
-    /// own integrator and the spec rounds).
+    /// own integrator and the values are rounded).
     #[test]
     fn zero_rudder_drift() {
         let mut s = Mariner::mss_default();
@@ -403,7 +402,7 @@ mod tests {
         assert!((psi100 - 8.0).abs() < 0.05 * 8.0);
     }
 
-    /// Positive input → starboard turn; the rudder state has the opposite sign (§1, §3.3).
+    /// Positive input → starboard turn; the rudder state has the opposite sign.
     #[test]
     fn sign_convention() {
         let mut s = Mariner::trimmed(U0_DEFAULT).unwrap();

@@ -11,12 +11,12 @@
 //!
 //! | type | source |
 //! | --- | --- |
-//! | [`container_ship::ContainerShip`], [`container_ship::LinearContainerShip`] | spec `container_ship.md` §2, §4 (Son & Nomoto 1982 via MSS) |
-//! | [`mariner::Mariner`] | spec `container_ship.md` §3 (Chislett & Strøm-Tejsen 1965 via MSS) |
-//! | [`nomoto::NomotoShip`] | seed 000, spec `ddg51_ekf_autopilot.md` §2.8-2.14, §3.2 |
-//! | [`supply_vessel::SupplyVessel`] | seed 001, spec `passive_observer_dp.md` §2.1-2.3, §3.1 |
-//! | [`tokyo_maru::TokyoMaru`] | seed 004, spec `adaptive_path_control.md` §2.1-2.3, Tables 1-2 |
-//! | [`rrs_ship::RrsShip`] | seed 003, spec `rrs_models_filters.md` §2.3-2.4, Tables 2.1-2.5 |
+//! | [`container_ship::ContainerShip`], [`container_ship::LinearContainerShip`] | Son & Nomoto (1982) as implemented in the MSS toolbox (`container.m`, `Lcontainer.m`) |
+//! | [`mariner::Mariner`] | Chislett & Strøm-Tejsen (1965) as implemented in the MSS toolbox (`mariner.m`) |
+//! | [`nomoto::NomotoShip`] | [Taylor2000, sec. 4.1 and 5.2.1], Esso Osaka data [Taylor2000, Tables 2.2-2.3] |
+//! | [`supply_vessel::SupplyVessel`] | [Fossen1999, sec. 2.1-2.5 and 6] |
+//! | [`tokyo_maru::TokyoMaru`] | [Parsons1980, sec. 2.1-2.3, Tables 1-2] |
+//! | [`rrs_ship::RrsShip`] | [Klugt1987, sec. 2.2.2, 2.4 and 2.5, Tables 2.1-2.5] |
 
 pub mod container_ship;
 pub mod mariner;
@@ -42,43 +42,13 @@ pub fn wrap_pi(a: f64) -> f64 {
     w
 }
 
-/// First-order rudder servo of the MSS ships (spec `container_ship.md` §2.6, also used by the
-/// Mariner §3.1 and the linear container ship §4.1): the command is saturated to ±`max`, the rate
+/// First-order rudder servo of the MSS ships (MSS `container.m`, also used by `mariner.m` and
+/// `Lcontainer.m`): the command is saturated to ±`max`, the rate
 /// is `(δ_c,sat − δ)/1 s` clipped to ±`rate_max`. There is no separate limit on the state.
 #[inline]
 pub(crate) fn mss_rudder_rate(command: f64, delta: f64, max: f64, rate_max: f64) -> f64 {
     let dc = command.clamp(-max, max);
     (dc - delta).clamp(-rate_max, rate_max)
-}
-
-pub(crate) fn check_positive(
-    name: &'static str,
-    v: f64,
-) -> Result<(), crate::steering_gear::ParamError> {
-    if v.is_finite() && v > 0.0 {
-        Ok(())
-    } else {
-        Err(crate::steering_gear::ParamError {
-            name,
-            value: v,
-            rule: "must be finite and > 0",
-        })
-    }
-}
-
-pub(crate) fn check_finite(
-    name: &'static str,
-    v: f64,
-) -> Result<(), crate::steering_gear::ParamError> {
-    if v.is_finite() {
-        Ok(())
-    } else {
-        Err(crate::steering_gear::ParamError {
-            name,
-            value: v,
-            rule: "must be finite",
-        })
-    }
 }
 
 #[cfg(test)]

@@ -2,53 +2,60 @@
 //! the linear sway-yaw model (Esso Osaka coefficients as a preset).
 //!
 //! # Source
-//! Seed 000 (DDG-51 EKF identification and autopilot thesis, 2000), spec `ddg51_ekf_autopilot.md`:
-//! * §2.1 sign convention: positive δ → positive r (starboard turn), K = +2.04;
-//! * §2.8 linear identification model (Eqs. 4.1-4.2), unknowns −Y_v, (m − Y_r), −N_v,
-//!   (m x_G − N_r);
-//! * §2.9 nondimensionalisation [INFERRED]: SNAME prime system, t′ = tU/L;
-//! * §2.11, §3.2 Esso Osaka (Tables 2.2, 2.3); §2.13 kinematics (Eqs. 5.35-5.37);
-//! * §2.14 Nomoto model T ψ̈ + ψ̇ = K δ (Eq. 5.24) with T′ = 1.9287, K′ = 2.04 (Eqs. 5.25-5.26),
-//!   dimensional at 22 kn T = 24.2 s, K = 0.1626 1/s [DERIVED]; the Nomoto formulas from the
-//!   sway-yaw matrices; §3.1 DDG-51 data (LBP 466 ft).
+//! The DDG-51 thesis [Taylor2000]:
+//! * sign convention: positive δ → positive r (starboard turn), K = +2.04 (derived from the
+//!   rudder model, [Taylor2000, eqs. (3.31)-(3.33)]);
+//! * linear identification model [Taylor2000, sec. 4.1, eqs. (4.1)-(4.2)], unknowns −Y_v,
+//!   (m − Y_r), −N_v, (m x_G − N_r);
+//! * nondimensionalisation [INFERRED]: SNAME prime system, t′ = tU/L (the thesis never defines
+//!   it);
+//! * Esso Osaka [Taylor2000, sec. 2.3, Tables 2.2-2.3]; kinematics
+//!   [Taylor2000, sec. 5.3.1, eqs. (5.35)-(5.37)];
+//! * Nomoto model T ψ̈ + ψ̇ = K δ [Taylor2000, sec. 5.2.1, eq. (5.24)] with T′ = 1.9287,
+//!   K′ = 2.04 [Taylor2000, eqs. (5.25)-(5.26)], dimensional at 22 kn T = 24.2 s,
+//!   K = 0.1626 1/s [DERIVED]; the Nomoto formulas from the sway-yaw matrices (standard, derived
+//!   here); DDG-51 data (LBP 466 ft) [Taylor2000, Table 3.1].
 //!
 //! # Model
 //! Sway-yaw (prime system, u′ = 1, time t′ = tU/L): M ν̇′ + N ν′ = b δ with ν′ = [v′, r′],
 //! M = [[m − Y_v̇, m x_G − Y_ṙ], [m x_G − N_v̇, I_z − N_ṙ]], N = [[−Y_v, m − Y_r],
 //! [−N_v, m x_G − N_r]], b = [Y_δ, N_δ]. Nomoto: T′ ṙ′ + r′ = K′ δ.
-//! Kinematics (Eqs. 5.35-5.36, u = U): ẋ = U cos ψ − v sin ψ + c_N, ẏ = U sin ψ + v cos ψ + c_E,
-//! ψ̇ = r, where (c_N, c_E) is the current (the thesis modelled its 5-kn current as an initial
-//! sway velocity, §2.18; here it is an earth-fixed velocity added to the kinematics).
+//! Kinematics ([Taylor2000, eqs. (5.35)-(5.36)], u = U): ẋ = U cos ψ − v sin ψ + c_N,
+//! ẏ = U sin ψ + v cos ψ + c_E, ψ̇ = r, where (c_N, c_E) is the current (the thesis modelled its
+//! 5-kn current as an initial sway velocity, [Taylor2000, sec. 5.2.3.1]; here it is an
+//! earth-fixed velocity added to the kinematics).
 //!
 //! # Readings taken, and the Esso Osaka values the source does not give
-//! The thesis gives only the four N-matrix coefficients of the Esso Osaka (Table 2.3) and its
-//! principal particulars (Table 2.2); the mass matrix, the rudder coefficients and the speed are
-//! missing (spec §2.11). They are parameters with these documented defaults [ASSUMED]:
-//! * m′ = 0.01814 (from Δ = 314,410 LT, [DERIVED] in the spec), x′_G = −25/1066.3;
+//! The thesis gives only the four N-matrix coefficients of the Esso Osaka
+//! [Taylor2000, Table 2.3] and its principal particulars [Taylor2000, Table 2.2]; the mass
+//! matrix, the rudder coefficients and the speed are missing. They are parameters with these
+//! documented defaults [ASSUMED]:
+//! * m′ = 0.01814 (derived from Δ = 314,410 LT), x′_G = −25/1066.3;
 //!   added masses from Clarke's regressions (Clarke, Gedling & Hine 1983) with
-//!   T/L = 92.8/1066.3, B/L = 173.9/1066.3, C_B = 0.64 (Table 2.2 as printed);
+//!   T/L = 92.8/1066.3, B/L = 173.9/1066.3, C_B = 0.64 ([Taylor2000, Table 2.2] as printed);
 //!   I′_z = m′(0.25)² (radius of gyration L/4);
-//! * b = [Y′_δ, N′_δ] from the thesis's own rudder model (§2.5, Eq. 3.30): one rudder of
+//! * b = [Y′_δ, N′_δ] from the thesis's own rudder model [Taylor2000, sec. 3.2.2.4, eq. (3.30)]: one rudder of
 //!   A_R = 1289.67 ft², ∂C_L/∂α = 2.217 /rad (AR 1.538), inflow speed U, at x′_R = −0.5:
-//!   Y′_δ = −(A_R/L²)·2.217, N′_δ = x′_R·Y′_δ (positive δ → starboard turn, §2.1);
+//!   Y′_δ = −(A_R/L²)·2.217, N′_δ = x′_R·Y′_δ (positive δ → starboard turn, as above);
 //! * U = 10 kn (any speed gives the same nondimensional results).
 //!
-//! With Table 2.3 the linear Esso Osaka is **course unstable**: det N = (−Y_v)(m x_G − N_r) −
+//! With [Taylor2000, Table 2.3] the linear Esso Osaka is **course unstable**: det N = (−Y_v)(m x_G − N_r) −
 //! (m − Y_r)(−N_v) = −3.71e-7 < 0 (the real ship is known to be directionally unstable). Its
 //! "steady turning rate" r′ = K′δ with K′ = (n11 b2 − n21 b1)/det N is therefore an unstable
 //! equilibrium, of opposite sign to the rudder (tested). With the assumed M the eigenvalues of
 //! −M⁻¹N are −0.638 and +0.0060 per unit t′: the divergence time constant is ≈ 166 L/U (≈ 3 h at
-//! 10 kn), so over the minutes of the thesis's 10° turn (Fig. 2-7) the linear model still
-//! looks like a (slowly tightening) turn. The thesis may also have kept the rudder-induced
-//! damping of its §2.5 rudder model in N (spec §2.14), which is not reproducible from the text.
+//! 10 kn), so over the minutes of the thesis's 10° turn [Taylor2000, Fig. 2-7] the linear model
+//! still looks like a (slowly tightening) turn. The thesis may also have kept the rudder-induced
+//! damping of its rudder model [Taylor2000, sec. 3.2.2.4] in N, which is not reproducible from
+//! the text.
 //!
 //! # Integration
 //! RK4 with a fixed sub-step ≤ [`NomotoShip::max_substep`] (default 0.1 s, i.e. ≤ 0.008 L/U
 //! for the DDG-51 at 22 kn), inputs held over the step; see [`crate::integrate`].
 
-use super::{check_finite, check_positive, wrap_pi, KNOT};
+use super::{wrap_pi, KNOT};
+use crate::error::{check_finite, check_mass_matrix_2x2, check_positive, ParamError};
 use crate::integrate::rk4_advance;
-use crate::steering_gear::ParamError;
 use nalgebra::{Matrix2, Vector2};
 use serde::{Deserialize, Serialize};
 
@@ -79,8 +86,9 @@ pub struct NomotoInputs {
     /// Rudder-equivalent environmental disturbance δ_w [rad], added to δ in the dynamics:
     /// T′ ṙ′ + r′ = K′(δ + δ_w), or b(δ + δ_w) for the sway-yaw model. The thesis's sea-state-4
     /// disturbance is "a random disturbance filtered to preserve only the low-frequency
-    /// components" whose entry point into the hull is not given (spec §2.18); the rudder-equivalent
-    /// form is the usual one for a Nomoto plant (as 003 eq. 3.29 for the RRS ship).
+    /// components" ([Taylor2000, sec. 5.3.3.2]) whose entry point into the hull is not given; the
+    /// rudder-equivalent form is the usual one for a Nomoto plant (as [Klugt1987, eq. (3.29)] for
+    /// the RRS ship).
     pub yaw_disturbance: f64,
 }
 
@@ -132,11 +140,8 @@ impl NomotoShip {
                 check_finite("k", *k)?;
             }
             NomotoModel::SwayYaw { m, n, b } => {
+                check_mass_matrix_2x2(m)?;
                 for (name, v) in [
-                    ("m11", m[0][0]),
-                    ("m12", m[0][1]),
-                    ("m21", m[1][0]),
-                    ("m22", m[1][1]),
                     ("n11", n[0][0]),
                     ("n12", n[0][1]),
                     ("n21", n[1][0]),
@@ -145,14 +150,6 @@ impl NomotoShip {
                     ("b2", b[1]),
                 ] {
                     check_finite(name, v)?;
-                }
-                let det = m[0][0] * m[1][1] - m[0][1] * m[1][0];
-                if !(det.abs() > 0.0) {
-                    return Err(ParamError {
-                        name: "m (determinant)",
-                        value: det,
-                        rule: "mass matrix must be invertible",
-                    });
                 }
             }
         }
@@ -166,7 +163,7 @@ impl NomotoShip {
         })
     }
 
-    /// DDG-51 first-order Nomoto model, T′ = 1.9287, K′ = 2.04 (Eqs. 5.25-5.26), L = 466 ft,
+    /// DDG-51 first-order Nomoto model, T′ = 1.9287, K′ = 2.04 [Taylor2000, eqs. (5.25)-(5.26)], L = 466 ft,
     /// U = 22 kn (L/U = 12.55 s).
     pub fn ddg51() -> Self {
         Self::new(
@@ -177,7 +174,7 @@ impl NomotoShip {
         .expect("valid preset")
     }
 
-    /// Esso Osaka linear sway-yaw model: N from Table 2.3; M, b and U are the [ASSUMED] defaults
+    /// Esso Osaka linear sway-yaw model: N from [Taylor2000, Table 2.3]; M, b and U are the [ASSUMED] defaults
     /// of the module documentation.
     pub fn esso_osaka() -> Self {
         let (m, b) = esso_osaka_assumed_m_b();
@@ -217,7 +214,7 @@ impl NomotoShip {
     }
 
     /// First-order Nomoto (T′, K′) of the model: identity for the Nomoto model; for the sway-yaw
-    /// model T′ = T1 + T2 − T3, K′ = (n11 b2 − n21 b1)/det N (spec §2.14).
+    /// model T′ = T1 + T2 − T3, K′ = (n11 b2 − n21 b1)/det N (the standard Nomoto formulas).
     pub fn nomoto_constants(&self) -> (f64, f64) {
         match &self.model {
             NomotoModel::FirstOrder { t, k } => (*t, *k),
@@ -309,7 +306,8 @@ pub fn esso_osaka_assumed_m_b() -> ([[f64; 2]; 2], [f64; 2]) {
 mod tests {
     use super::*;
 
-    /// §2.9/§2.14 [DERIVED]: DDG-51 at 22 kn has L/U = 12.55 s, T = 24.2 s, K = 0.1626 1/s.
+    /// [DERIVED] from [Taylor2000, eqs. (5.25)-(5.26)]: DDG-51 at 22 kn has L/U = 12.55 s,
+    /// T = 24.2 s, K = 0.1626 1/s.
     #[test]
     fn ddg51_scales() {
         let s = NomotoShip::ddg51();
@@ -359,7 +357,7 @@ mod tests {
         }
     }
 
-    /// Step response of the Nomoto model (§2.14): for a rudder step δ at t = 0,
+    /// Step response of the Nomoto model [Taylor2000, eq. (5.24)]: for a rudder step δ at t = 0,
     /// r(t) = (K/(L/U)) δ (1 − e^{−t/T}), ψ(t) = K δ (t′ − T′(1 − e^{−t′/T′})) with
     /// T = T′ L/U, written out here; the simulation must agree to 1e-9 (RK4, 0.1 s sub-step),
     /// independently of the communication step (0.1, 1 and 5 s).
@@ -388,7 +386,10 @@ mod tests {
                 o.yaw_rate
             );
             assert!((o.heading - psi_exp).abs() < 1e-9 * psi_exp);
-            assert!(o.yaw_rate > 0.0, "positive rudder → starboard turn (§2.1)");
+            assert!(
+                o.yaw_rate > 0.0,
+                "positive rudder → starboard turn (sign convention)"
+            );
         }
         // Steady turning rate K δ: after 10 T.
         let mut s = NomotoShip::ddg51();
@@ -402,7 +403,7 @@ mod tests {
         assert!((s.outputs().r_prime - 2.04 * d).abs() < 1e-4 * 2.04 * d);
     }
 
-    /// Esso Osaka (Table 2.3): det N = (−Y_v)(m x_G − N_r) − (m − Y_r)(−N_v) = −3.7072e-7
+    /// Esso Osaka [Taylor2000, Table 2.3]: det N = (−Y_v)(m x_G − N_r) − (m − Y_r)(−N_v) = −3.7072e-7
     /// (written out here), so the linear model is course unstable: exactly one positive
     /// eigenvalue of −M⁻¹N. The steady turning rate from the coefficients,
     /// r′ = (n11 b2 − n21 b1)/det N · δ and v′ = (n22 b1 − n12 b2)/det N · δ (Cramer's rule on

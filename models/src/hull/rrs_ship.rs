@@ -1,15 +1,15 @@
-//! Van der Klugt's RRS ship: the 22-knot simulation model (Fig. 2.5) and the speed-dependent
-//! fifth-order control model (Fig. 2.6).
+//! The RRS ship of [Klugt1987]: the 22-knot simulation model [Klugt1987, Fig. 2.5] and the speed-dependent
+//! fifth-order control model [Klugt1987, Fig. 2.6].
 //!
 //! # Source
-//! Seed 003 (van der Klugt, *Rudder Roll Stabilization*, TU Delft 1987), spec
-//! `rrs_models_filters.md`:
-//! * §2.3: the simulation model, Eqs. 2.16-2.18 (sway, rate of turn, roll as transfer functions)
-//!   and the assembled state-space form given there; parameters Table 2.1 (rudder-driven,
-//!   22 kn ≈ 11.32 m/s) and Table 2.2 (wave-height-driven);
-//! * §2.4: the control model, Eqs. 3.29-3.30 (states φ, φ̇, v′, r, ψ); speed laws Table 2.3 with
-//!   the identification results of Table 2.4; the ±20° re-identification of Table 2.5 as a preset;
-//! * §6.2 [DERIVED] reference values (eigenvalues, DC gains, |φ/δ(jω_n)|, wave-to-roll peak).
+//! [Klugt1987, sec. 2.2.2, 2.5 and 3.3]:
+//! * the simulation model [Klugt1987, sec. 2.2.2 and 2.5.3, eqs. (2.16)-(2.18)] (sway, rate of turn, roll as transfer functions)
+//!   and the assembled state-space form given there; parameters [Klugt1987, Table 2.1] (rudder-driven,
+//!   22 kn ≈ 11.32 m/s) and [Klugt1987, Table 2.2] (wave-height-driven);
+//! * the control model [Klugt1987, sec. 2.5.4 and 3.3, eqs. (3.29)-(3.30)] (states φ, φ̇, v′, r, ψ); speed laws [Klugt1987, Table 2.3] with
+//!   the identification results of [Klugt1987, Table 2.4]; the ±20° re-identification of [Klugt1987, Table 2.5] as a preset;
+//! * reference values computed from these models (eigenvalues, DC gains, |φ/δ(jω_n)|,
+//!   wave-to-roll peak; [DERIVED], not printed in the thesis).
 //!
 //! # Equations (one structure covers both models)
 //! ```text
@@ -17,26 +17,26 @@
 //! τ_r ṙ = −r + k_dr δ + k_vr v + y_wr + w_ψ
 //! ψ̇ = r,  φ̇ = p
 //! ṗ = −2 z_n ω_n p − ω_n² φ + ω_n² (k_dp δ + k_rp r + k_vp v + y_wp + w_φ)
-//! wave filters driven by the wave height w (§2.3):
+//! wave filters driven by the wave height w [Klugt1987, sec. 2.2.2]:
 //!   ȧ1 = a2, ȧ2 = −ω_wv² a1 − 2 z_wv ω_wv a2 + w,  y_wv = ω_wv² k_wv (a1 + τ_wv a2)
 //!   ḃ1 = b2, ḃ2 = −ω_wr² b1 − 2 z_wr ω_wr b2 + w,  y_wr = ω_wr² k_wr (b1 + τ_wr b2)
 //!   ċ1 = c2, ċ2 = −ω_wp² c1 − 2 z_wp ω_wp c2 + w,  y_wp = ω_wp² k_wp c2
 //! ```
 //! The control model is the special case k_rv = k_rp = 0 without wave filters (v is then
 //! v′ = x3, the sway caused by the rudder); its disturbances w_φ, w_ψ are the rudder-equivalent
-//! roll and yaw disturbances of Eq. 3.29 (entering as ω_n² w_φ and w_ψ/τ_r). The simulation model
+//! roll and yaw disturbances of [Klugt1987, eq. (3.29)] (entering as ω_n² w_φ and w_ψ/τ_r). The simulation model
 //! accepts w_φ, w_ψ too (an extension; zero in the source).
 //!
 //! # Readings taken
-//! * ω_n = 0.64 for Table 2.1 and 0.63 for Tables 2.4/2.5 (spec §8 O8: the text's 0.64 belongs to
-//!   Table 2.1).
-//! * Roll denominator s² + 2 z_n ω_n s + ω_n² (spec §8 O6; the OCR prints z_w ω_w).
+//! * ω_n = 0.64 for [Klugt1987, Table 2.1] and 0.63 for [Klugt1987, Tables 2.4, 2.5] (the
+//!   text's 0.64 is read as belonging to [Klugt1987, Table 2.1]).
+//! * Roll denominator s² + 2 z_n ω_n s + ω_n² (the OCR text prints z_w ω_w, read as a slip).
 //! * Units: all angles in rad (every gain is a ratio of angle-like quantities, so the model is
-//!   unit-consistent, spec §5 remarks); the sway state has the model's own arbitrary scale (the
-//!   control model fixes K_dv0 = 0.01, Table 2.4) and is *not* a velocity in m/s; wave height w in
+//!   unit-consistent); the sway state has the model's own arbitrary scale (the
+//!   control model fixes K_dv0 = 0.01, [Klugt1987, Table 2.4]) and is *not* a velocity in m/s; wave height w in
 //!   m (unit not stated in the source). Consequently the position kinematics use the speed U
 //!   only: ẋ = U cos ψ, ẏ = U sin ψ (sway neglected) — the thesis has no position.
-//! * Speed: the control model evaluates Table 2.3 at the input U (held over the step, as the
+//! * Speed: the control model evaluates [Klugt1987, Table 2.3] at the input U (held over the step, as the
 //!   thesis treats U as slowly varying); U is clamped to ≥ [`RrsShip::min_speed`] (default
 //!   1 m/s; the thesis extrapolates to 2 m/s). The simulation model is valid at 22 kn only; there
 //!   U drives only the kinematics.
@@ -45,9 +45,9 @@
 //! RK4 with a fixed sub-step ≤ [`RrsShip::max_substep`] (default 0.05 s; the fastest pole of
 //! either model is ≈ 1.2 rad/s), inputs held over the step; see [`crate::integrate`].
 
-use super::{check_positive, wrap_pi, KNOT};
+use super::{wrap_pi, KNOT};
+use crate::error::{check_finite, check_positive, ParamError};
 use crate::integrate::rk4_advance;
-use crate::steering_gear::ParamError;
 use nalgebra::{SMatrix, SVector};
 use serde::{Deserialize, Serialize};
 
@@ -56,7 +56,7 @@ pub const NX: usize = 11;
 /// Number of linear inputs: δ, w_φ, w_ψ, w (wave height).
 pub const NU: usize = 4;
 
-/// Parameters of the linear hull at one speed (the symbols of Tables 2.1-2.4).
+/// Parameters of the linear hull at one speed (the symbols of [Klugt1987, Tables 2.1-2.4]).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct RrsHullCoefficients {
     pub k_dv: f64,
@@ -72,7 +72,7 @@ pub struct RrsHullCoefficients {
     pub k_vp: f64,
 }
 
-/// Wave-height-driven filters of Table 2.2.
+/// Wave-height-driven filters of [Klugt1987, Table 2.2].
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct RrsWaveCoefficients {
     pub k_wv: f64,
@@ -89,7 +89,7 @@ pub struct RrsWaveCoefficients {
 }
 
 impl RrsHullCoefficients {
-    /// Table 2.1: simulation model, rudder-driven transfers, 22 kn (ω_n = 0.64).
+    /// [Klugt1987, Table 2.1]: simulation model, rudder-driven transfers, 22 kn (ω_n = 0.64).
     pub fn table_2_1() -> Self {
         RrsHullCoefficients {
             k_dv: 0.08,
@@ -120,14 +120,14 @@ impl RrsHullCoefficients {
             ("k_rp", self.k_rp),
             ("k_vp", self.k_vp),
         ] {
-            super::check_finite(n, v)?;
+            check_finite(n, v)?;
         }
         Ok(())
     }
 }
 
 impl RrsWaveCoefficients {
-    /// Table 2.2: wave-height-driven transfers, 22 kn.
+    /// [Klugt1987, Table 2.2]: wave-height-driven transfers, 22 kn.
     pub fn table_2_2() -> Self {
         RrsWaveCoefficients {
             k_wv: 0.056,
@@ -158,13 +158,13 @@ impl RrsWaveCoefficients {
             ("tau_wr", self.tau_wr),
             ("k_wp", self.k_wp),
         ] {
-            super::check_finite(n, v)?;
+            check_finite(n, v)?;
         }
         Ok(())
     }
 }
 
-/// Speed laws of Table 2.3 with the constants of Table 2.4 (or 2.5).
+/// Speed laws of [Klugt1987, Table 2.3] with the constants of [Klugt1987, Table 2.4] (or 2.5).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct RrsSpeedLaws {
     /// k_dp = K_dp0 U²
@@ -189,7 +189,7 @@ pub struct RrsSpeedLaws {
 }
 
 impl RrsSpeedLaws {
-    /// Table 2.4 ("ship model 2"), ω_n = 0.63.
+    /// [Klugt1987, Table 2.4] ("ship model 2"), ω_n = 0.63.
     pub fn table_2_4() -> Self {
         RrsSpeedLaws {
             k_dp0: -0.0014,
@@ -205,7 +205,7 @@ impl RrsSpeedLaws {
         }
     }
 
-    /// Table 2.5 (non-linearity check at U = 11 m/s, rudder ±20°): z_n = 0.126 held constant.
+    /// [Klugt1987, Table 2.5] (non-linearity check at U = 11 m/s, rudder ±20°): z_n = 0.126 held constant.
     pub fn table_2_5() -> Self {
         RrsSpeedLaws {
             k_dp0: -0.0014,
@@ -221,7 +221,7 @@ impl RrsSpeedLaws {
         }
     }
 
-    /// The coefficients at speed `u` [m/s] (Table 2.3; k_rv = k_rp = 0).
+    /// The coefficients at speed `u` [m/s] ([Klugt1987, Table 2.3]; k_rv = k_rp = 0).
     pub fn at(&self, u: f64) -> RrsHullCoefficients {
         RrsHullCoefficients {
             k_dv: self.k_dv0 * u,
@@ -251,7 +251,7 @@ impl RrsSpeedLaws {
             ("z_n1", self.z_n1),
             ("k_vr0", self.k_vr0),
         ] {
-            super::check_finite(n, v)?;
+            check_finite(n, v)?;
         }
         Ok(())
     }
@@ -260,12 +260,12 @@ impl RrsSpeedLaws {
 /// Which of the two models.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub enum RrsVariant {
-    /// Fig. 2.5, Tables 2.1/2.2, 22 kn only, with wave-height filters.
+    /// [Klugt1987, Fig. 2.5, Tables 2.1, 2.2], 22 kn only, with wave-height filters.
     Simulation {
         hull: RrsHullCoefficients,
         waves: RrsWaveCoefficients,
     },
-    /// Fig. 2.6, Table 2.3 speed laws (Table 2.4 or 2.5 constants), no wave filters.
+    /// [Klugt1987, Fig. 2.6, Table 2.3] speed laws ([Klugt1987, Table 2.4] or 2.5 constants), no wave filters.
     Control { laws: RrsSpeedLaws },
 }
 
@@ -276,11 +276,11 @@ pub struct RrsShipInputs {
     pub rudder: f64,
     /// Ship speed U [m/s] (control-model parameters and kinematics).
     pub speed: f64,
-    /// Rudder-equivalent roll disturbance w_φ [rad] (Eq. 3.29).
+    /// Rudder-equivalent roll disturbance w_φ [rad] [Klugt1987, eq. (3.29)].
     pub roll_disturbance: f64,
-    /// Rudder-equivalent yaw disturbance w_ψ [rad] (Eq. 3.29).
+    /// Rudder-equivalent yaw disturbance w_ψ [rad] [Klugt1987, eq. (3.29)].
     pub yaw_disturbance: f64,
-    /// Wave height w [m] driving the Table 2.2 filters (simulation model only).
+    /// Wave height w [m] driving the [Klugt1987, Table 2.2] filters (simulation model only).
     pub wave_elevation: f64,
 }
 
@@ -342,7 +342,7 @@ impl RrsShip {
         })
     }
 
-    /// The 22-knot simulation model (Tables 2.1, 2.2).
+    /// The 22-knot simulation model [Klugt1987, Tables 2.1, 2.2].
     pub fn simulation_22kn() -> Self {
         Self::new(RrsVariant::Simulation {
             hull: RrsHullCoefficients::table_2_1(),
@@ -351,7 +351,7 @@ impl RrsShip {
         .expect("valid preset")
     }
 
-    /// The fifth-order control model with the Table 2.4 speed laws.
+    /// The fifth-order control model with the [Klugt1987, Table 2.4] speed laws.
     pub fn control_model() -> Self {
         Self::new(RrsVariant::Control {
             laws: RrsSpeedLaws::table_2_4(),
@@ -359,7 +359,7 @@ impl RrsShip {
         .expect("valid preset")
     }
 
-    /// The control model with the Table 2.5 (±20° rudder) constants.
+    /// The control model with the [Klugt1987, Table 2.5] (±20° rudder) constants.
     pub fn control_model_table_2_5() -> Self {
         Self::new(RrsVariant::Control {
             laws: RrsSpeedLaws::table_2_5(),
@@ -551,7 +551,7 @@ mod tests {
         e
     }
 
-    /// §6.2 [DERIVED]: open-loop eigenvalues of the simulation model (hull states, Tables 2.1):
+    /// [DERIVED]: open-loop eigenvalues of the simulation model (hull states, [Klugt1987, Table 2.1]):
     /// 0, −0.75719, −0.12315, −0.06016 ± 0.63717j (tolerance 1e-5).
     #[test]
     fn simulation_model_eigenvalues() {
@@ -572,10 +572,10 @@ mod tests {
         }
     }
 
-    /// §6.2 [DERIVED]: DC gains of the simulation model, v/δ = 0.06916, r/δ = −0.08341 1/s,
-    /// φ/δ = 0.08588, from a simulated rudder step of 0.01 rad held for 400 s (the spec rounds
+    /// [DERIVED]: DC gains of the simulation model, v/δ = 0.06916, r/δ = −0.08341 1/s,
+    /// φ/δ = 0.08588, from a simulated rudder step of 0.01 rad held for 400 s (the reference values are rounded
     /// to 4-5 digits: tolerance 5e-5 absolute on the gains).
-    /// Also the control model at 22 kn (Table 2.4 evaluated): r/δ = −0.0827, φ/δ = 0.0897.
+    /// Also the control model at 22 kn ([Klugt1987, Table 2.4] evaluated): r/δ = −0.0827, φ/δ = 0.0897.
     #[test]
     fn dc_gains_by_simulation() {
         let d = 0.01;
@@ -610,18 +610,18 @@ mod tests {
             o.roll / d
         );
         // Closed form at U = 22 kn = 11.3178 m/s: r/δ = k_dr + k_dv k_vr = −0.082620,
-        // φ/δ = k_dp + k_dv k_vp = 0.089666 (Table 2.3/2.4 written out here).
+        // φ/δ = k_dp + k_dv k_vp = 0.089666 ([Klugt1987, Tables 2.3, 2.4] written out here).
         let u = U_22KN;
         let r_cf = -0.0027 * u + 0.01 * u * -0.46;
         let p_cf = -0.0014 * u * u + 0.01 * u * 0.21 * u;
         assert!((o.yaw_rate / d - r_cf).abs() < 1e-6 && (o.roll / d - p_cf).abs() < 1e-6);
-        // The spec prints r/δ = −0.0827: a rounding slip of the extract (−0.08262 rounds to
-        // −0.0826), hence the tolerance 1e-4 against the printed value.
+        // The reference value r/δ = −0.0827 is a rounding slip (−0.08262 rounds to
+        // −0.0826), hence the tolerance 1e-4 against it.
         assert!((o.yaw_rate / d + 0.0827).abs() < 1e-4);
         assert!((o.roll / d - 0.0897).abs() < 5e-5);
     }
 
-    /// Table 2.4 evaluated (spec §5, [DERIVED]): coefficients at 11 m/s.
+    /// [Klugt1987, Table 2.4] evaluated ([DERIVED]): coefficients at 11 m/s.
     #[test]
     fn table_2_4_evaluated() {
         let c = RrsSpeedLaws::table_2_4().at(11.0);
@@ -634,13 +634,13 @@ mod tests {
         assert!((c.tau_r - 1.182).abs() < 1e-3);
     }
 
-    /// §6.2 [DERIVED]: |φ/δ(jω_n)| of the control model = 0.210 / 0.422 / 0.786 / 0.958 at
+    /// [DERIVED]: |φ/δ(jω_n)| of the control model = 0.210 / 0.422 / 0.786 / 0.958 at
     /// U = 5 / 7.5 / 11 / 12.5 m/s. Measured by simulating a sinusoidal rudder at ω_n = 0.63
-    /// (tolerance 0.0015 absolute: the spec gives 3 digits; the mid-point sampled, held input
+    /// (tolerance 0.0015 absolute: the reference values have 3 digits; the mid-point sampled, held input
     /// at h = 0.01 s changes the amplitude by sinc(ωh/2) ≈ 1 − 7e-6 only),
     /// and checked against the closed form
-    /// φ/δ = ω_n²[k_dp(sτ_v + 1) + k_vp k_dv]/[(sτ_v + 1)(s² + 2z_nω_n s + ω_n²)] (§2.4),
-    /// written out here from Table 2.3/2.4 (tolerance 1e-3 relative).
+    /// φ/δ = ω_n²[k_dp(sτ_v + 1) + k_vp k_dv]/[(sτ_v + 1)(s² + 2z_nω_n s + ω_n²)] [Klugt1987, eq. (3.29)],
+    /// written out here from [Klugt1987, Tables 2.3, 2.4] (tolerance 1e-3 relative).
     #[test]
     fn rudder_to_roll_at_natural_frequency() {
         let ship = RrsShip::control_model();
@@ -665,12 +665,12 @@ mod tests {
         }
     }
 
-    /// §6.2 [DERIVED]: wave-height → roll |H_wφ| = |H_wp H_φ| peaks at 13.5 near 0.639 rad/s.
-    /// H_wφ is the direct path of Eq. 2.18 (through y_wp only), so the simulation model is run with
+    /// [DERIVED]: wave-height → roll |H_wφ| = |H_wp H_φ| peaks at 13.5 near 0.639 rad/s.
+    /// H_wφ is the direct path of [Klugt1987, eq. (2.18)] (through y_wp only), so the simulation model is run with
     /// the sway and yaw wave gains k_wv = k_wr = 0; the peak is located on the frequency response
     /// of the model's linear system (golden-section search) and confirmed by a simulated
     /// sinusoidal wave at the peak frequency. Tolerances: peak value 0.05, frequency 0.002 rad/s
-    /// (the spec gives 3 digits). The full response including the sway/yaw paths is printed.
+    /// (the reference values have 3 digits). The full response including the sway/yaw paths is printed.
     #[test]
     fn wave_height_to_roll_peak() {
         let full = RrsShip::simulation_22kn();

@@ -1,33 +1,30 @@
-//! 3-DOF low-frequency DP model of the supply vessel *Northern Clipper* (Fossen & Strand 1999).
+//! 3-DOF low-frequency DP model of the supply vessel *Northern Clipper* [Fossen1999].
 //!
 //! # Source
-//! Seed 001 (T. I. Fossen and J. P. Strand, "Passive nonlinear observer design for ships using
-//! Lyapunov methods: full-scale experiments with a supply vessel", 1999), spec
-//! `passive_observer_dp.md`:
-//! * §2.1 kinematics η̇ = J(ψ) ν, Eqs. 1-2 (η = [x, y, ψ], ν = [u, v, r]);
-//! * §2.2 LF model M ν̇ + D ν = τ + Jᵀ(ψ) b, Eqs. 3-6;
-//! * §2.3 bias model (earth-fixed b, Eq. 7) — here an *input* (the `Current`/`Wind` models or a
-//!   constant supply it);
-//! * §2.4-2.5: the wave-frequency motion η_w is superposed on the measurement, y = η + η_w, not
-//!   fed through the hull (spec §5 item 4);
-//! * §3.1 Northern Clipper M and D (Eqs. 56-57, SI, x_G = 0, u₀ = 0) and the [DERIVED]
-//!   eig(M⁻¹D) = 0.11907, 0.025655, 0.0094579 1/s.
+//! [Fossen1999]:
+//! * kinematics η̇ = J(ψ) ν [Fossen1999, sec. 2.1, eqs. (1)-(2)] (η = [x, y, ψ], ν = [u, v, r]);
+//! * LF model M ν̇ + D ν = τ + Jᵀ(ψ) b [Fossen1999, sec. 2.2, eqs. (3)-(6)];
+//! * bias model (earth-fixed b) [Fossen1999, sec. 2.3, eq. (7)] — here an *input* (the
+//!   `Current`/`Wind` models or a constant supply it);
+//! * the wave-frequency motion η_w [Fossen1999, sec. 2.4-2.5] is superposed on the measurement,
+//!   y = η + η_w, not fed through the hull;
+//! * Northern Clipper M and D [Fossen1999, eqs. (56)-(57)] (SI, x_G = 0, u₀ = 0) and the
+//!   [DERIVED] eig(M⁻¹D) = 0.11907, 0.025655, 0.0094579 1/s.
 //!
 //! # Readings taken
-//! * M and D are taken as dimensional SI (kg, kg·m², N·s/m, …) as the spec assumes (§3); the
-//!   paper prints no units.
+//! * M and D are taken as dimensional SI (kg, kg·m², N·s/m, …); the paper prints no units.
 //! * τ = B_u u with B_u not given: the input is τ itself (surge force, sway force, yaw moment),
-//!   as in the paper's simulation (Eq. 61).
-//! * b is earth-fixed [N, N, N·m] and rotated into the body by Jᵀ(ψ) (Eq. 3).
+//!   as in the paper's simulation [Fossen1999, eq. (61)].
+//! * b is earth-fixed [N, N, N·m] and rotated into the body by Jᵀ(ψ) [Fossen1999, eq. (3)].
 //! * No separate current velocity input: the paper lumps current into b.
 //!
 //! # Integration
 //! RK4 with a fixed sub-step ≤ [`SupplyVessel::max_substep`] (default 0.1 s; the fastest open-loop
 //! time constant is 8.40 s), inputs held over the step; see [`crate::integrate`].
 
-use super::{check_finite, check_positive, wrap_pi};
+use super::wrap_pi;
+use crate::error::{check_finite, check_positive, require, ParamError};
 use crate::integrate::rk4_advance;
-use crate::steering_gear::ParamError;
 use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 
@@ -36,7 +33,7 @@ use serde::{Deserialize, Serialize};
 pub struct SupplyVesselInputs {
     /// Thrust τ = [surge force N, sway force N, yaw moment N·m] (body frame).
     pub tau: [f64; 3],
-    /// Earth-fixed bias b = [north force N, east force N, yaw moment N·m] (Eq. 3).
+    /// Earth-fixed bias b = [north force N, east force N, yaw moment N·m] [Fossen1999, eq. (3)].
     pub bias: [f64; 3],
     /// Wave-frequency motion η_w = [north m, east m, yaw rad] superposed on the measurement.
     pub wave_motion: [f64; 3],
@@ -58,9 +55,9 @@ pub struct SupplyVesselOutputs {
 /// The vessel. State `[x, y, ψ, u, v, r]`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct SupplyVessel {
-    /// Inertia matrix M (Eq. 5), row-major.
+    /// Inertia matrix M [Fossen1999, eq. (5)], row-major.
     pub m: [[f64; 3]; 3],
-    /// Damping matrix D (Eq. 6), row-major.
+    /// Damping matrix D [Fossen1999, eq. (6)], row-major.
     pub d: [[f64; 3]; 3],
     /// Largest RK4 sub-step [s].
     pub max_substep: f64,
@@ -69,13 +66,13 @@ pub struct SupplyVessel {
     time: f64,
 }
 
-/// Northern Clipper M (Eq. 56).
+/// Northern Clipper M [Fossen1999, eq. (56)].
 pub const NORTHERN_CLIPPER_M: [[f64; 3]; 3] = [
     [5.3122e6, 0.0, 0.0],
     [0.0, 8.2831e6, 0.0],
     [0.0, 0.0, 3.7454e9],
 ];
-/// Northern Clipper D (Eq. 57).
+/// Northern Clipper D [Fossen1999, eq. (57)].
 pub const NORTHERN_CLIPPER_D: [[f64; 3]; 3] = [
     [5.0242e4, 0.0, 0.0],
     [0.0, 2.7229e5, -4.3933e6],
@@ -103,13 +100,12 @@ impl SupplyVessel {
             check_positive(MN[i][i], m[i][i])?;
         }
         let mm = Matrix3::from_fn(|i, j| m[i][j]);
-        if mm.try_inverse().is_none() {
-            return Err(ParamError {
-                name: "m (determinant)",
-                value: mm.determinant(),
-                rule: "must be invertible",
-            });
-        }
+        require(
+            mm.try_inverse().is_some(),
+            "m (determinant)",
+            mm.determinant(),
+            "must be invertible",
+        )?;
         Ok(SupplyVessel {
             m,
             d,
@@ -120,7 +116,7 @@ impl SupplyVessel {
         })
     }
 
-    /// Northern Clipper (§3.1).
+    /// Northern Clipper [Fossen1999, eqs. (56)-(57)].
     pub fn northern_clipper() -> Self {
         Self::new(NORTHERN_CLIPPER_M, NORTHERN_CLIPPER_D).expect("valid preset")
     }
@@ -185,7 +181,7 @@ impl SupplyVessel {
 mod tests {
     use super::*;
 
-    /// §3.1 [DERIVED]: eig(M⁻¹D) = 0.11907, 0.025655, 0.0094579 1/s (relative 1e-4).
+    /// [DERIVED] from [Fossen1999, eqs. (56)-(57)]: eig(M⁻¹D) = 0.11907, 0.025655, 0.0094579 1/s (relative 1e-4).
     #[test]
     fn open_loop_eigenvalues() {
         let m = Matrix3::from_fn(|i, j| NORTHERN_CLIPPER_M[i][j]);
@@ -237,7 +233,7 @@ mod tests {
 
     /// Earth-fixed bias: b = [b_N, 0, 0] at ψ = 0 drives the vessel north at the steady speed
     /// b_N/D11 with no sway or yaw; with the heading east the same b acts as a body sway force
-    /// −b_N (Jᵀ(π/2) b = [0, −b_N, 0], Eq. 3), checked on the initial sway acceleration −b_N/M22.
+    /// −b_N (Jᵀ(π/2) b = [0, −b_N, 0], [Fossen1999, eq. (3)]), checked on the initial sway acceleration −b_N/M22.
     /// The measured output is η + η_w.
     #[test]
     fn earth_fixed_bias_and_wave_superposition() {

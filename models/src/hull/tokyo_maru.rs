@@ -1,20 +1,21 @@
-//! Tokyo Maru linear path model in restricted water (Parsons & Cuong 1980).
+//! Tokyo Maru linear path model in restricted water [Parsons1980].
 //!
 //! # Source
-//! Seed 004 (M. G. Parsons and H. T. Cuong, *Adaptive Path Control of Surface Ships in
-//! Restricted Waters*, Univ. of Michigan Report 211, 1980), spec `adaptive_path_control.md`:
-//! * §2.1 nondimensionalisation (t′ = tU/L, r′ = rL/U, η′ = η/L, angles in rad);
-//! * §2.2 Eq. 11: ẋ = F_s x + G_s δ′_c + Γ_s [N′, Y′]ᵀ with x = [ψ′, r′, β′, η′, δ′];
-//! * §2.3 Table 1 (L = 290 m, 12 kn) and Table 2 (f_ij, γ_ij versus H/T at Fn = 0.116);
-//! * §2.4 steering gear Eq. 10, T_r = 0.212874 ([DERIVED], 10 s);
-//! * §2.6(b) lateral current, Eqs. 17-20 (β′_e = β′ + v′_c);
-//! * §4.1 test U7 (eigen-decomposition of F_s(∞)) and U9 (steady state under the design current).
+//! [Parsons1980, sec. 2]:
+//! * nondimensionalisation (t′ = tU/L, r′ = rL/U, η′ = η/L, angles in rad) [Parsons1980, sec. 2.1];
+//! * ẋ = F_s x + G_s δ′_c + Γ_s [N′, Y′]ᵀ with x = [ψ′, r′, β′, η′, δ′] [Parsons1980, eq. (11)];
+//! * L = 290 m, 12 kn [Parsons1980, Table 1] and f_ij, γ_ij versus H/T at Fn = 0.116
+//!   [Parsons1980, Table 2];
+//! * steering gear [Parsons1980, eq. (10)], T_r = 0.212874 (derived here from 10 s);
+//! * lateral current (β′_e = β′ + v′_c) [Parsons1980, sec. 2.3, eqs. (17)-(20)];
+//! * the eigen-decomposition of F_s(∞) [Parsons1980, sec. 4.2.1] and the steady state under the
+//!   design current [Parsons1980, sec. 4.2.2] are tested.
 //!
-//! # Interpolation over H/T (the report gives no rule, spec §3 note and §6 item 5)
+//! # Interpolation over H/T (the report gives no rule)
 //! Piecewise-linear in H/T between the tabulated 1.30, 1.50, 1.89, 2.50; for H/T > 2.5 linear in
 //! T/H between the 2.50 column (T/H = 0.4) and the ∞ column (T/H = 0), so that H/T = ∞ is reached
-//! continuously; H/T below 1.30 is clamped to 1.30 (no extrapolation). Per the spec (§3 Table 14
-//! notes) no simple rule reproduces the report's "true" sloping-bottom coefficients exactly; this
+//! continuously; H/T below 1.30 is clamped to 1.30 (no extrapolation). No simple rule reproduces
+//! the report's "true" sloping-bottom coefficients [Parsons1980, Table 14] exactly; this
 //! rule stays within 2.4 % of them for f23 and 1.7 % for f25 (the coefficients that matter for
 //! control), 5.6 % for the non-monotonic f33 (tested). A user table can replace the interpolation
 //! ([`TokyoMaru::coefficients_override`]).
@@ -25,12 +26,13 @@
 //! report are all nondimensional). Outputs both prime and dimensional (U = 12 kn, L = 290 m).
 //! Rudder: by default the input is the *actual* rudder δ (the steering gear is a separate model,
 //! [`crate::steering_gear::SteeringGearParams::tokyo_maru_004`]); with
-//! [`TokyoMaru::internal_steering_gear`] the input is the command δ_c and Eq. 10 is integrated
-//! inside (the full 5-state F_s of Eq. 11).
-//! Current: v_c [m/s] is the lateral current toward +η; it is implemented with Eqs. 17-19:
+//! [`TokyoMaru::internal_steering_gear`] the input is the command δ_c and
+//! [Parsons1980, eq. (10)] is integrated inside (the full 5-state F_s of [Parsons1980, eq. (11)]).
+//! Current: v_c [m/s] is the lateral current toward +η; it is implemented with
+//! [Parsons1980, eqs. (17)-(19)]:
 //! the hydrodynamic state is β′_e = β′ + v′_c (relative to the water), η̇′ = ψ′ − β′_e + v′_c, and
 //! the output β′ is relative to earth. In a steady current this equals external forces
-//! Y′ = Y′_β v′_c, N′ = N′_β v′_c (Eqs. 24-25). Position: track along north, x = ξ (ξ̇′ = 1,
+//! Y′ = Y′_β v′_c, N′ = N′_β v′_c [Parsons1980, eqs. (24)-(25)]. Position: track along north, x = ξ (ξ̇′ = 1,
 //! linearised, consistent with η̇′ = ψ′ − β′), y = η.
 //!
 //! # Integration
@@ -39,20 +41,20 @@
 //! [`TokyoMaruIntegration::Euler`] reproduces the report's fixed-step Euler (Δt′ = 0.005) for
 //! comparisons with its figures.
 
-use super::{check_positive, wrap_pi, KNOT};
+use super::{wrap_pi, KNOT};
+use crate::error::{check_positive, check_positive_or_infinite, ParamError};
 use crate::integrate::zoh_discretise;
-use crate::steering_gear::ParamError;
 use nalgebra::{SMatrix, SVector};
 use serde::{Deserialize, Serialize};
 
-/// Length between perpendiculars L [m] (Table 1).
+/// Length between perpendiculars L [m] [Parsons1980, Table 1].
 pub const L: f64 = 290.0;
-/// Speed U [m/s] = 12 kn (§2.1).
+/// Speed U [m/s] = 12 kn [Parsons1980, Table 1].
 pub const U: f64 = 12.0 * KNOT;
-/// Steering time constant T_r (nondimensional) = 10 s ([DERIVED], §2.4).
+/// Steering time constant T_r (nondimensional) = 10 s (derived here for [Parsons1980, eq. (10)]).
 pub const T_R: f64 = 10.0 * U / L;
 
-/// The ten coefficients of Table 2 at one depth.
+/// The ten coefficients of [Parsons1980, Table 2] at one depth.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct TokyoMaruCoefficients {
     pub f22: f64,
@@ -71,10 +73,10 @@ pub struct TokyoMaruCoefficients {
     pub g32: f64,
 }
 
-/// Tabulated depths of Table 2 (the last is ∞).
+/// Tabulated depths of [Parsons1980, Table 2] (the last is ∞).
 pub const TABLE_2_DEPTHS: [f64; 5] = [1.30, 1.50, 1.89, 2.50, f64::INFINITY];
 
-/// Table 2 columns, in the order of [`TABLE_2_DEPTHS`].
+/// [Parsons1980, Table 2] columns, in the order of [`TABLE_2_DEPTHS`].
 pub const TABLE_2: [TokyoMaruCoefficients; 5] = [
     TokyoMaruCoefficients {
         f22: -1.6508,
@@ -179,7 +181,7 @@ impl TokyoMaruCoefficients {
         TABLE_2[3]
     }
 
-    /// The 5-state F_s, G_s, Γ_s of Eq. 11 (x = [ψ′, r′, β′, η′, δ′], u = δ′_c, w = [N′, Y′]) with
+    /// The 5-state F_s, G_s, Γ_s of [Parsons1980, eq. (11)] (x = [ψ′, r′, β′, η′, δ′], u = δ′_c, w = [N′, Y′]) with
     /// steering time constant `t_r` (nondimensional).
     pub fn eq11(&self, t_r: f64) -> (SMatrix<f64, 5, 5>, SMatrix<f64, 5, 1>, SMatrix<f64, 5, 2>) {
         let mut f = SMatrix::<f64, 5, 5>::zeros();
@@ -240,7 +242,7 @@ pub struct TokyoMaruOutputs {
     pub yaw_rate: f64,
     /// Drift angle relative to earth β′ = β [rad].
     pub drift_angle: f64,
-    /// Sway velocity v = −Uβ [m/s] (Eq. 5).
+    /// Sway velocity v = −Uβ [m/s] [Parsons1980, eq. (5)].
     pub sway_velocity: f64,
     /// Lateral deviation η′ and η = η′L [m].
     pub cross_track_prime: f64,
@@ -259,9 +261,9 @@ pub struct TokyoMaruOutputs {
 pub struct TokyoMaru {
     /// Depth ratio H/T (tunable; ∞ allowed).
     pub depth_ratio: f64,
-    /// Replaces the Table 2 interpolation when set.
+    /// Replaces the [Parsons1980, Table 2] interpolation when set.
     pub coefficients_override: Option<TokyoMaruCoefficients>,
-    /// Integrate Eq. 10 inside (input = command δ_c) instead of taking the actual rudder.
+    /// Integrate [Parsons1980, eq. (10)] inside (input = command δ_c) instead of taking the actual rudder.
     pub internal_steering_gear: bool,
     /// Steering time constant T_r (nondimensional), used with the internal gear.
     pub t_r: f64,
@@ -289,13 +291,7 @@ impl TokyoMaru {
     /// A ship on the track (all states 0) at depth ratio `depth_ratio` (≥ 1.30 or ∞ recommended;
     /// must be > 0).
     pub fn new(depth_ratio: f64) -> Result<Self, ParamError> {
-        if !(depth_ratio > 0.0) {
-            return Err(ParamError {
-                name: "depth_ratio",
-                value: depth_ratio,
-                rule: "must be > 0 (inf allowed)",
-            });
-        }
+        check_positive_or_infinite("depth_ratio", depth_ratio)?;
         Ok(TokyoMaru {
             depth_ratio,
             coefficients_override: None,
@@ -321,13 +317,7 @@ impl TokyoMaru {
 
     /// Checks the tunable parameters.
     pub fn validate(&self) -> Result<(), ParamError> {
-        if !(self.depth_ratio > 0.0) {
-            return Err(ParamError {
-                name: "depth_ratio",
-                value: self.depth_ratio,
-                rule: "must be > 0 (inf allowed)",
-            });
-        }
+        check_positive_or_infinite("depth_ratio", self.depth_ratio)?;
         check_positive("t_r", self.t_r)?;
         if let TokyoMaruIntegration::Euler { max_substep_prime } = self.integration {
             check_positive("max_substep_prime", max_substep_prime)?;
@@ -472,7 +462,7 @@ mod tests {
     use super::*;
     use nalgebra::Complex;
 
-    /// §2.1 [DERIVED] conversions: U/L = 0.0212874 1/s, T_r = 0.212874.
+    /// [DERIVED] conversions: U/L = 0.0212874 1/s, T_r = 0.212874.
     #[test]
     fn scales() {
         assert!((U / L - 0.0212874).abs() < 1e-7);
@@ -485,13 +475,13 @@ mod tests {
         e
     }
 
-    /// Test U7 (spec §4.1, §2.3): eigenvalues of F_s(∞) with T_r = 0.212874 are −4.6976 (−1/T_r),
+    /// [Parsons1980, sec. 4.2.1]: eigenvalues of F_s(∞) with T_r = 0.212874 are −4.6976 (−1/T_r),
     /// −2.48884, −0.09917 and the repeated 0 (tolerance 1e-5); eigenvectors
     /// ξ4 = [−0.0933, 0.0093, 0.0054, 0.9956, 0] and ξ5 = [−0.3669, 0.9132, −0.1553, +0.0850, 0]
     /// (unit norm, up to sign; tolerance 1e-4). The printed ξ4(η) = 0.9958 differs from the
-    /// [VERIFIED] 0.9956 in the 4th digit and the printed ξ5(η) = −0.0850 has the wrong sign (the
-    /// η component must be (ψ − β)/λ = +0.085, spec §2.3); the verified values are used.
-    /// Also the sway-yaw pairs of the other Table 2 columns (spec §2.3 [DERIVED], 1e-4).
+    /// recomputed 0.9956 in the 4th digit and the printed ξ5(η) = −0.0850 has the wrong sign (the
+    /// η component must be (ψ − β)/λ = +0.085); the recomputed values are used.
+    /// Also the sway-yaw pairs of the other [Parsons1980, Table 2] columns ([DERIVED], 1e-4).
     #[test]
     fn u7_eigen_decomposition() {
         let (f, _, _) = TokyoMaruCoefficients::at_depth_ratio(f64::INFINITY).eq11(T_R);
@@ -550,9 +540,9 @@ mod tests {
     }
 
     /// Interpolation rule (module docs): exact at the tabulated depths, and compared with the
-    /// report's "true" sloping-bottom coefficients of Table 14 (at the window-end
-    /// H/T = 1.89 + 0.35(t′_end − 0.35), spec §3 Table 14 notes). The report's rule is unknown
-    /// (spec §6 item 5). Observed worst relative deviations: f22 0.6 % and f23 2.4 % (both at
+    /// report's "true" sloping-bottom coefficients of [Parsons1980, Table 14] (at the window-end
+    /// H/T = 1.89 + 0.35(t′_end − 0.35), our reading of that table). The report's rule is unknown.
+    /// Observed worst relative deviations: f22 0.6 % and f23 2.4 % (both at
     /// H/T 2.82, where the report's values stay near the 2.5 column while the T/H rule moves
     /// toward ∞), f25 1.7 %, f32 3.8 %, f33 5.6 %, f35 2.6 % (all at H/T 2.19). The report's
     /// "true" f33 is non-monotonic (−0.52766 at 1.89, −0.50774 at 2.19, −0.54561 at 2.5) and
@@ -625,11 +615,12 @@ mod tests {
         );
     }
 
-    /// Plant part of U9 (spec §4.1, §2.6(c)): at H/T = ∞ with the printed design-current forces
+    /// Plant part of the constant-disturbance equilibrium [Parsons1980, sec. 4.2.2]: at H/T = ∞
+    /// with the printed design-current forces
     /// N′ = 0.0010262, Y′ = 0.0023277 and the rudder held at δ′ = 0.1310, the hull settles at
     /// β′ = −0.1428 with r′ ≈ 0. Tolerances 5e-4 on β′ and on r′: the printed rudder 0.1310 is
-    /// rounded (the spec [VERIFIED] 0.1309), and with δ′ held open loop a rudder error of 1e-4
-    /// leaves a steady r′ ≈ 3e-4 (observed −2.9e-4). The controller-in-the-loop U9 belongs to the
+    /// rounded (recomputed: 0.1309), and with δ′ held open loop a rudder error of 1e-4
+    /// leaves a steady r′ ≈ 3e-4 (observed −2.9e-4). The controller-in-the-loop case belongs to the
     /// controller.
     #[test]
     fn u9_plant_equilibrium() {
@@ -652,7 +643,7 @@ mod tests {
         assert!(o.yaw_rate_prime.abs() < 5e-4);
     }
 
-    /// §2.6(b)-(c): at H/T = 1.89 the design current is equivalent to N′ = N′_β v′_c,
+    /// [Parsons1980, sec. 2.3, eqs. (24)-(25)]: at H/T = 1.89 the design current is equivalent to N′ = N′_β v′_c,
     /// Y′ = Y′_β v′_c ([DERIVED] 0.0010250, 0.0023250 for v′_c = 1/12), and the equilibrium has
     /// δ′ = 0, ψ′ = β′ = −v′_c, η′ constant. Checked both with the force inputs and with the
     /// current input (1 kn = U/12), starting from ψ′ = β′ = −1/12.

@@ -1,28 +1,29 @@
-//! Artyszuk's DGPS position/velocity Kalman filter and its manoeuvre bias.
+//! The DGPS position/velocity Kalman filter of [Artyszuk2003] and its manoeuvre bias.
 //!
 //! # Source
-//! Seed 002 (Artyszuk, "Kalman filter performance in DGPS-based sea manoeuvring trial system"),
-//! spec `dgps_kalman.md` §2.2-2.4 (Eqs. 1-7) and the [DERIVED] reference values of §3.4:
+//! [Artyszuk2003, sec. 1-2, eqs. (1)-(7)], with steady-state reference values computed from
+//! these equations ([DERIVED], not printed in the paper):
 //! ```text
 //! x = [v_NS, v_EW, x, y],  z = [x_DGPS, y_DGPS]
 //! Φ = [[1,0,0,0],[0,1,0,0],[Δt,0,1,0],[0,Δt,0,1]],  H = [[0,0,1,0],[0,0,0,1]]
 //! R = diag(4, 4) m²,  Q = S_p [[Δt,0,Δt²/2,0],[0,Δt,0,Δt²/2],[Δt²/2,0,Δt³/3,0],[0,Δt²/2,0,Δt³/3]]
-//! P⁻ = ΦPΦᵀ + Q,  K = P⁻Hᵀ(HP⁻Hᵀ + R)⁻¹,  P = (I − KH)P⁻;  x = Φx + K(z − HΦx)   (Eq. 5)
-//! v_xy = sqrt(v_NS² + v_EW²)   (Eq. 6),   β_A = ψ − atan2(v_EW, v_NS)   (Eq. 7)
+//! P⁻ = ΦPΦᵀ + Q,  K = P⁻Hᵀ(HP⁻Hᵀ + R)⁻¹,  P = (I − KH)P⁻;  x = Φx + K(z − HΦx)   [Artyszuk2003, eq. (5)]
+//! v_xy = sqrt(v_NS² + v_EW²)   [Artyszuk2003, eq. (6)],   β_A = ψ − atan2(v_EW, v_NS)   [Artyszuk2003, eq. (7)]
 //! ```
 //! # Readings taken
 //! * S_p in m²/s³ (PSD of a white acceleration; the paper gives no unit), Δt = 1 s.
-//! * Eq. 7 is evaluated with atan2 and wrapped to (−π, π]; ψ is the gyro heading (the paper's
-//!   "course angle ψ", line 130, is the heading).
-//! * §2.1 current correction (line 34): the body-frame water-related velocity is the
+//! * [Artyszuk2003, eq. (7)] is evaluated with atan2 and wrapped to (−π, π]; ψ is the gyro heading (the paper's
+//!   "course angle ψ" after [Artyszuk2003, eq. (7)] is the heading).
+//! * Current correction [Artyszuk2003, sec. 1]: the body-frame water-related velocity is the
 //!   ground-related one minus Dᵀ(ψ)·|v_c|[cos γ_c, sin γ_c], γ_c the direction the current flows
-//!   *toward* (0 = a north current moving the ship north, line 40), and
-//!   tan β_A^water = −v_y^water / v_x^water (line 44), evaluated with atan2 as Eq. 7. The
+//!   *toward* (0 = a north current moving the ship north, [Artyszuk2003, sec. 1]), and
+//!   tan β_A^water = −v_y^water / v_x^water [Artyszuk2003, sec. 1], evaluated with atan2 as [Artyszuk2003, eq. (7)]. The
 //!   ground-related body velocity is the filter's [v_NS, v_EW] rotated by Dᵀ(ψ).
-//! * The steady-state form (Eq. 5, the paper's results) is the default; the full time-varying
+//! * The steady-state form ([Artyszuk2003, eq. (5)], the paper's results) is the default; the full time-varying
 //!   recursion from P₀ is an option. A co-simulation step h is ⌈h/Δt⌉ filter cycles with the
 //!   measurement held.
 
+use crate::error::{check_non_negative, check_positive};
 use crate::hull::wrap_pi;
 use nalgebra::{Matrix2, SMatrix, SVector};
 use serde::{Deserialize, Serialize};
@@ -32,7 +33,7 @@ type M42 = SMatrix<f64, 4, 2>;
 type M24 = SMatrix<f64, 2, 4>;
 type V4 = SVector<f64, 4>;
 
-/// Φ, H, Q, R of Eqs. 3-4.
+/// Φ, H, Q, R of [Artyszuk2003, eqs. (3)-(4)].
 pub fn model(dt: f64, sp: f64, r: f64) -> (M4, M24, M4, Matrix2<f64>) {
     let mut phi = M4::identity();
     phi[(2, 0)] = dt;
@@ -86,7 +87,7 @@ pub struct DgpsKalmanParams {
     pub sp: f64,
     /// Measurement variance per axis [m²] (4: σ = 2 m).
     pub r: f64,
-    /// Full time-varying recursion from P₀ (else the steady-state form, Eq. 5).
+    /// Full time-varying recursion from P₀ (else the steady-state form, [Artyszuk2003, eq. (5)]).
     pub full_recursion: bool,
     /// P₀ = p0 · I for the full recursion.
     pub p0: f64,
@@ -107,13 +108,9 @@ impl Default for DgpsKalmanParams {
 impl DgpsKalmanParams {
     pub fn validate(&self) -> Result<(), String> {
         for (n, v) in [("dt", self.dt), ("sp", self.sp), ("r", self.r)] {
-            if !(v > 0.0 && v.is_finite()) {
-                return Err(format!("{n} = {v} must be finite and > 0"));
-            }
+            check_positive(n, v)?;
         }
-        if !(self.p0 >= 0.0 && self.p0.is_finite()) {
-            return Err(format!("p0 = {} must be finite and >= 0", self.p0));
-        }
+        check_non_negative("p0", self.p0)?;
         Ok(())
     }
 }
@@ -194,7 +191,7 @@ impl DgpsKalman {
         }
     }
 
-    /// Speed over ground v_xy (Eq. 6) [m/s].
+    /// Speed over ground v_xy [Artyszuk2003, eq. (6)] [m/s].
     pub fn speed_over_ground(&self) -> f64 {
         self.x[0].hypot(self.x[1])
     }
@@ -204,7 +201,7 @@ impl DgpsKalman {
         self.x[1].atan2(self.x[0])
     }
 
-    /// Drift angle β_A = ψ − χ (Eq. 7), wrapped to (−π, π].
+    /// Drift angle β_A = ψ − χ [Artyszuk2003, eq. (7)], wrapped to (−π, π].
     pub fn drift_angle(&self, heading: f64) -> f64 {
         drift_angle(heading, self.x[0], self.x[1])
     }
@@ -217,7 +214,7 @@ impl DgpsKalman {
         rotate_to_body(heading, self.x[0], self.x[1])
     }
 
-    /// Water-related body velocity (§2.1) for a current of `current_speed` [m/s] flowing toward
+    /// Water-related body velocity [Artyszuk2003, sec. 1] for a current of `current_speed` [m/s] flowing toward
     /// `current_direction` [rad from north, clockwise].
     pub fn body_velocity_through_water(
         &self,
@@ -229,7 +226,7 @@ impl DgpsKalman {
         water_velocity(heading, g, current_speed, current_direction)
     }
 
-    /// Water-related drift angle β_A^water = atan2(−v_y^water, v_x^water) (§2.1, line 44).
+    /// Water-related drift angle β_A^water = atan2(−v_y^water, v_x^water) [Artyszuk2003, sec. 1].
     pub fn drift_angle_through_water(
         &self,
         heading: f64,
@@ -241,13 +238,13 @@ impl DgpsKalman {
     }
 }
 
-/// Dᵀ(ψ)[a_N, a_E] = [cos ψ a_N + sin ψ a_E, −sin ψ a_N + cos ψ a_E] (§2.1, line 38).
+/// Dᵀ(ψ)[a_N, a_E] = [cos ψ a_N + sin ψ a_E, −sin ψ a_N + cos ψ a_E] [Artyszuk2003, sec. 1].
 pub fn rotate_to_body(heading: f64, north: f64, east: f64) -> [f64; 2] {
     let (s, c) = heading.sin_cos();
     [c * north + s * east, -s * north + c * east]
 }
 
-/// §2.1 (line 34): water-related body velocity = ground-related body velocity `ground` minus
+/// [Artyszuk2003, sec. 1]: water-related body velocity = ground-related body velocity `ground` minus
 /// Dᵀ(ψ)·|v_c|[cos γ_c, sin γ_c].
 pub fn water_velocity(
     heading: f64,
@@ -260,7 +257,7 @@ pub fn water_velocity(
     [ground[0] - cb[0], ground[1] - cb[1]]
 }
 
-/// Eq. 7: β_A = ψ − atan2(v_EW, v_NS), wrapped.
+/// [Artyszuk2003, eq. (7)]: β_A = ψ − atan2(v_EW, v_NS), wrapped.
 pub fn drift_angle(heading: f64, v_ns: f64, v_ew: f64) -> f64 {
     wrap_pi(heading - v_ew.atan2(v_ns))
 }
@@ -269,9 +266,9 @@ pub fn drift_angle(heading: f64, v_ns: f64, v_ew: f64) -> f64 {
 mod tests {
     use super::*;
 
-    /// T1 (spec §3.4): K∞ = (k_v, k_p) per axis: S_p 0.001 → (0.014466, 0.162914); 0.01 →
+    /// Steady-state gains ([DERIVED] from [Artyszuk2003, eqs. (3)-(5)]): K∞ = (k_v, k_p) per axis: S_p 0.001 → (0.014466, 0.162914); 0.01 →
     /// (0.042688, 0.271106); 0.1 → (0.11936, 0.430124); a-priori P∞ (P_vv, P_vp, P_pp) and the
-    /// a-posteriori one; tolerance 1e-5 (the spec's), 1e-4 for the 5-significant-digit 0.11936.
+    /// a-posteriori one; tolerance 1e-5 (the reference values' precision), 1e-4 for the 5-significant-digit 0.11936.
     #[test]
     fn steady_gains_t1() {
         let cases = [
@@ -312,7 +309,7 @@ mod tests {
         }
     }
 
-    /// T1: the gain reaches 1 % of K∞ within ~30 cycles for S_p ≥ 0.01 whatever P₀ (spec: 20, 16,
+    /// The gain reaches 1 % of K∞ within ~30 cycles for S_p ≥ 0.01 whatever P₀ (reference re-computation: 20, 16,
     /// 18, 19 cycles at 0.01 for P₀ = 0, I, diag(100, 100, 4, 4), 1e4 I).
     #[test]
     fn gain_convergence_cycles() {
@@ -393,7 +390,7 @@ mod tests {
         assert!((f.drift_angle(chi).to_degrees() - lag.to_degrees()).abs() < 1e-9);
     }
 
-    /// T9 (§2.4 worked example): ψ = 30°, 5 m/s at course 20° ⇒ β_A = +10.00°.
+    /// Worked example of [Artyszuk2003, eq. (7)]: ψ = 30°, 5 m/s at course 20° ⇒ β_A = +10.00°.
     #[test]
     fn drift_angle_example() {
         let (vn, ve) = (
@@ -404,7 +401,7 @@ mod tests {
         assert!((drift_angle(30f64.to_radians(), vn, ve).to_degrees() - 10.0).abs() < 1e-9);
     }
 
-    /// T8 (§2.1 worked example): ψ = 90°, ground body velocity [7, 0] m/s, a 0.25 m/s north
+    /// Worked example of the current correction [Artyszuk2003, sec. 1]: ψ = 90°, ground body velocity [7, 0] m/s, a 0.25 m/s north
     /// current (γ_c = 0) ⇒ Dᵀ·[0.25, 0] = [0, −0.25], water velocity [7.0, 0.25] m/s and
     /// β_A^water = atan(−0.25/7) = −2.045° while β_A^ground = 0. Also through the filter: a
     /// filter holding v = [0, 7] (course east) at heading 90° gives the same numbers.
@@ -424,7 +421,7 @@ mod tests {
         let beta = f.drift_angle_through_water(psi, 0.25, 0.0).to_degrees();
         assert!((beta + 2.045).abs() < 5e-4, "{beta}");
         assert!(f.drift_angle(psi).abs() < 1e-12);
-        // Without current the water and ground drift angles agree (Eq. 7 vs line 44).
+        // Without current the water and ground drift angles agree ([Artyszuk2003, eq. (7)] vs the water-related form of [Artyszuk2003, sec. 1]).
         for k in 1..100 {
             f.cycle(k as f64 * 0.5, k as f64 * 6.9);
         }

@@ -2,17 +2,21 @@
 //! linear hull coefficients of a sway-yaw model on-line.
 //!
 //! # Source
-//! Seed 000 (DDG-51 EKF identification thesis, 2000), spec `ddg51_ekf_autopilot.md`:
-//! * §2.10 Table 2.1 (Gelb Table 6.1-1): propagation dx̂/dt = f(x̂), Ṗ = F P + P Fᵀ + Q
-//!   (Eqs. 2.10-2.12), gain K = P⁻Hᵀ(HP⁻Hᵀ + R)⁻¹ (2.20), update x̂⁺ = x̂⁻ + K(z − Hx̂⁻) (2.19),
-//!   P⁺ = (I − KH)P⁻ (2.21); state augmentation with ṗ = 0 (App. A, Eqs. A.1-A.2);
-//! * §2.10.1 the DDG-51 filter: state X = [u, v, r, n, p₁, p₂, p₃, p₄] with
+//! The DDG-51 thesis [Taylor2000]:
+//! * [Taylor2000, sec. 2.2, Table 2.1] (after Gelb (1974), Table 6.1-1): propagation dx̂/dt = f(x̂),
+//!   Ṗ = F P + P Fᵀ + Q [Taylor2000, eqs. (2.10)-(2.12)], gain K = P⁻Hᵀ(HP⁻Hᵀ + R)⁻¹
+//!   [Taylor2000, eq. (2.20)], update x̂⁺ = x̂⁻ + K(z − Hx̂⁻) [Taylor2000, eq. (2.19)],
+//!   P⁺ = (I − KH)P⁻ [Taylor2000, eq. (2.21)]; state augmentation with ṗ = 0
+//!   [Taylor2000, App. A, eqs. (A.1)-(A.2)];
+//! * the DDG-51 filter [Taylor2000, sec. 4.2-4.3]: state X = [u, v, r, n, p₁, p₂, p₃, p₄] with
 //!   p₁ = −Y′_v, p₂ = m′ − Y′_r, p₃ = −N′_v, p₄ = m′x′_G − N′_r; u̇ = ṅ = 0 ("filter model was
-//!   linear", L1684); u, v, r, n measured, H = [I₄ 0]; the Jacobian entries written there;
-//! * §2.8 Eqs. 4.1-4.2: M ν̇′ = f, f₂ = −p₁v′ − p₂r′ + Y_R, f₃ = −p₃v′ − p₄r′ + N_R with u′ = 1;
-//! * §3.4 Table 4.1: Q = 0.05 on the physical states, "fake" noise FQ = 0.01 on the parameters,
-//!   R = 0.01; Esso Osaka run Q = 0 (L666);
-//! * L1744-1747: the parameter value is the mean of the last 67 % of the estimates.
+//!   linear", [Taylor2000, sec. 4.3.2]); u, v, r, n measured, H = [I₄ 0]; the Jacobian entries
+//!   (derived here);
+//! * M ν̇′ = f, f₂ = −p₁v′ − p₂r′ + Y_R, f₃ = −p₃v′ − p₄r′ + N_R with u′ = 1
+//!   [Taylor2000, sec. 4.1, eqs. (4.1)-(4.2)];
+//! * [Taylor2000, Table 4.1]: Q = 0.05 on the physical states, "fake" noise FQ = 0.01 on the
+//!   parameters, R = 0.01; Esso Osaka run Q = 0 [Taylor2000, sec. 2.3];
+//! * the parameter value is the mean of the last 67 % of the estimates [Taylor2000, sec. 4.3.3].
 //!
 //! # Model (prime system, time t′ = tU/L)
 //! ```text
@@ -21,26 +25,32 @@
 //! z = [u/U, v/U, rL/U, n/n₀]  (H = [I₄ 0])
 //! ```
 //! M (mass and added mass) and b (rudder) are known parameters: the thesis says the rudder
-//! force "is assumed to be accurately modeled and requires no identification" (L1388-1392).
+//! force "is assumed to be accurately modeled and requires no identification"
+//! [Taylor2000, sec. 4.1].
 //!
-//! # Readings taken (the thesis is silent; spec §6 item 9)
+//! # Readings taken (the thesis is silent on these)
 //! * Q and FQ are continuous spectral densities per unit of nondimensional time t′; R is the
 //!   variance of each nondimensional measurement per sample. All are diagonal.
 //! * The rudder term is linear (b δ) — the thesis calls its filter model "completely linear"
-//!   (L2905) — and δ is the rudder angle actually applied (an input, held over a step).
-//! * Sample interval: a parameter (default 1 s, "not less than one second", L400-403). At the
+//!   [Taylor2000, sec. 6.2] — and δ is the rudder angle actually applied (an input, held over a
+//!   step).
+//! * Sample interval: a parameter (default 1 s, "not less than one second",
+//!   [Taylor2000, sec. 2.2.1]). At the
 //!   start of a communication step that reaches the next sample time, the held measurement
 //!   updates the estimate; then x̂ and P are propagated over the step (classical RK4 on x̂ and
 //!   P together, sub-step ≤ `max_substep`). The outputs are therefore the a-priori estimates at
 //!   the end of the step; they depend on the state only.
 //! * x̂₀ and P₀ are parameters (P₀ diagonal, one variance for the physical states and one for
 //!   the coefficients); u′ and n′ start at 1.
-//! * The update uses the Joseph form (I − KH)P(I − KH)ᵀ + KRKᵀ, algebraically Eq. 2.21.
+//! * The update uses the Joseph form (I − KH)P(I − KH)ᵀ + KRKᵀ, algebraically [Taylor2000, eq. (2.21)].
 //! * The running mean over the last 67 % of the estimates: after the k-th update, the mean of
 //!   the a-posteriori estimates k − w + 1 … k with w = max(1, round(0.67 k)). The estimate
 //!   history is kept as prefix sums (32 bytes per update: 115 kB per hour at 1 s), which is
 //!   what makes the window exact; it grows by doubling, so no allocation happens on most steps.
 
+use crate::error::{
+    check_finite, check_mass_matrix_2x2, check_non_negative, check_positive, require,
+};
 use crate::integrate::rk4_advance;
 use nalgebra::{Matrix2, SMatrix, SVector, Vector2};
 use serde::{Deserialize, Serialize};
@@ -60,7 +70,7 @@ pub struct ParameterEkfParams {
     pub length: f64,
     /// Nominal speed U [m/s] (nondimensionalisation and time scale L/U).
     pub speed: f64,
-    /// Nominal shaft speed n₀ [rpm] (n′ = n/n₀; spec §2.9 leaves n′ undefined).
+    /// Nominal shaft speed n₀ [rpm] (n′ = n/n₀; the thesis leaves n′ undefined).
     pub shaft_speed: f64,
     /// Mass matrix M′ = [[m − Y_v̇, m x_G − Y_ṙ], [m x_G − N_v̇, I_z − N_ṙ]] (row-major).
     pub mass: [[f64; 2]; 2],
@@ -72,11 +82,11 @@ pub struct ParameterEkfParams {
     pub initial_state_variance: f64,
     /// P₀ diagonal of the coefficients.
     pub initial_coefficient_variance: f64,
-    /// Q, spectral density on the physical states per unit t′ (Table 4.1: 0.05; Esso Osaka 0).
+    /// Q, spectral density on the physical states per unit t′ ([Taylor2000, Table 4.1]: 0.05; Esso Osaka 0).
     pub process_noise: f64,
-    /// FQ, "fake" spectral density on the coefficients per unit t′ (Table 4.1: 0.01).
+    /// FQ, "fake" spectral density on the coefficients per unit t′ ([Taylor2000, Table 4.1]: 0.01).
     pub coefficient_noise: f64,
-    /// R, variance of each nondimensional measurement (Table 4.1: 0.01).
+    /// R, variance of each nondimensional measurement ([Taylor2000, Table 4.1]: 0.01).
     pub measurement_noise: f64,
     /// Measurement sample interval [s] (default 1).
     pub sample_interval: f64,
@@ -87,7 +97,7 @@ pub struct ParameterEkfParams {
 }
 
 impl ParameterEkfParams {
-    /// Table 4.1 noise (Q 0.05, FQ 0.01, R 0.01) on the given ship data; P₀ = 0.01 (states),
+    /// [Taylor2000, Table 4.1] noise (Q 0.05, FQ 0.01, R 0.01) on the given ship data; P₀ = 0.01 (states),
     /// 1e-4 (coefficients, i.e. σ = 0.01, the size of −Y′_v); sample interval 1 s.
     pub fn table_4_1(
         length: f64,
@@ -125,9 +135,7 @@ impl ParameterEkfParams {
             ("sample_interval", self.sample_interval),
             ("max_substep", self.max_substep),
         ] {
-            if !(v > 0.0 && v.is_finite()) {
-                return Err(format!("{n} = {v} must be finite and > 0"));
-            }
+            check_positive(n, v)?;
         }
         for (n, v) in [
             ("initial_state_variance", self.initial_state_variance),
@@ -138,50 +146,33 @@ impl ParameterEkfParams {
             ("process_noise", self.process_noise),
             ("coefficient_noise", self.coefficient_noise),
         ] {
-            if !(v >= 0.0 && v.is_finite()) {
-                return Err(format!("{n} = {v} must be finite and >= 0"));
-            }
+            check_non_negative(n, v)?;
         }
-        if !(self.averaging_fraction > 0.0 && self.averaging_fraction <= 1.0) {
-            return Err(format!(
-                "averaging_fraction = {} must be in (0, 1]",
-                self.averaging_fraction
-            ));
-        }
-        let names = [["m11", "m12"], ["m21", "m22"]];
-        for i in 0..2 {
-            for j in 0..2 {
-                let v = self.mass[i][j];
-                if !v.is_finite() {
-                    return Err(format!("{} = {v} must be finite", names[i][j]));
-                }
-            }
-        }
-        let det = self.mass[0][0] * self.mass[1][1] - self.mass[0][1] * self.mass[1][0];
-        if !(det.abs() > 0.0) {
-            return Err(format!(
-                "mass matrix determinant = {det} must be non-zero (m11, m12, m21, m22)"
-            ));
-        }
+        require(
+            self.averaging_fraction > 0.0 && self.averaging_fraction <= 1.0,
+            "averaging_fraction",
+            self.averaging_fraction,
+            "must be in (0, 1]",
+        )?;
+        check_mass_matrix_2x2(&self.mass)?;
         for (n, v) in [("b1", self.rudder[0]), ("b2", self.rudder[1])] {
-            if !v.is_finite() {
-                return Err(format!("{n} = {v} must be finite"));
-            }
+            check_finite(n, v)?;
         }
-        for (i, v) in self.initial_coefficients.iter().enumerate() {
-            if !v.is_finite() {
-                return Err(format!(
-                    "initial coefficient p{} = {v} must be finite",
-                    i + 1
-                ));
-            }
+        let names = [
+            "initial_neg_y_v",
+            "initial_m_minus_y_r",
+            "initial_neg_n_v",
+            "initial_mxg_minus_n_r",
+        ];
+        for (n, v) in names.iter().zip(self.initial_coefficients) {
+            check_finite(n, v)?;
         }
         Ok(())
     }
 }
 
 /// First-order Nomoto constants (T′, K′) of the sway-yaw model M ν̇′ + N ν′ = b δ
-/// (spec §2.14; the formula of `hull::nomoto`): T′ = T₁ + T₂ − T₃, K′ = (n₁₁b₂ − n₂₁b₁)/det N.
+/// (the standard formulas, as in `hull::nomoto`): T′ = T₁ + T₂ − T₃, K′ = (n₁₁b₂ − n₂₁b₁)/det N.
 pub fn nomoto_constants(m: &[[f64; 2]; 2], n: &[f64; 4], b: &[f64; 2]) -> (f64, f64) {
     let (n11, n12, n21, n22) = (n[0], n[1], n[2], n[3]);
     let det_n = n11 * n22 - n12 * n21;
@@ -313,7 +304,7 @@ impl ParameterEkf {
         )
     }
 
-    /// Measurement update with u [m/s], v [m/s], r [rad/s], n [rpm] (Eqs. 2.19-2.21).
+    /// Measurement update with u [m/s], v [m/s], r [rad/s], n [rpm] [Taylor2000, eqs. (2.19)-(2.21)].
     pub fn update(&mut self, u: f64, v: f64, r: f64, n: f64) {
         let (l, us) = (self.params.length, self.params.speed);
         let z = [u / us, v / us, r * l / us, n / self.params.shaft_speed];
@@ -353,7 +344,7 @@ impl ParameterEkf {
     }
 
     /// Propagates x̂ and P over `h` seconds with the rudder angle `rudder` [rad] held
-    /// (Eqs. 2.10-2.12, RK4 in t′).
+    /// ([Taylor2000, eqs. (2.10)-(2.12)], RK4 in t′).
     pub fn propagate(&mut self, rudder: f64, h: f64) {
         let scale = self.params.speed / self.params.length;
         let qs = self.params.process_noise;
@@ -390,7 +381,7 @@ impl ParameterEkf {
     }
 }
 
-/// Filter dynamics f(x̂) (only v̇′, ṙ′ are non-zero) and its Jacobian F = ∂f/∂x (spec §2.10.1
+/// Filter dynamics f(x̂) (only v̇′, ṙ′ are non-zero) and its Jacobian F = ∂f/∂x (derived here,
 /// with the linear rudder): rows v̇′, ṙ′ hold −M⁻¹N in the (v′, r′) columns and
 /// −M⁻¹[:, 0]·(v′, r′), −M⁻¹[:, 1]·(v′, r′) in the (p₁, p₂), (p₃, p₄) columns.
 pub fn dynamics(x: &[f64], minv: &Matrix2<f64>, minv_b_delta: &Vector2<f64>) -> (Vector2<f64>, M8) {
@@ -448,7 +439,7 @@ mod tests {
     };
     use crate::random::NoiseStream;
 
-    /// The Esso Osaka truth of Table 2.3 (spec §3.2).
+    /// The Esso Osaka truth of [Taylor2000, Table 2.3].
     const ESSO: [f64; 4] = [0.0244, 0.0138, 1.4578e-3, 8.093e-4];
 
     fn zigzag_10_10() -> ManoeuvreGenerator {
@@ -630,20 +621,21 @@ mod tests {
         turning_circle(&run(&mut ship, &mut turn_10(), 0.5, 1500.0), 0.0).unwrap()
     }
 
-    /// AT-10 (spec §4.1, §4.13), noise-free: the filter model is the plant (Esso Osaka linear
-    /// sway-yaw model, `NomotoShip::esso_osaka()`: Table 2.3 N with the documented assumed M, b,
-    /// U = 10 kn, L/U = 63.2 s), Q = FQ = 0, R = 0.01 (Table 4.1, "in all cases", L1566),
+    /// Esso Osaka verification [Taylor2000, sec. 2.3], noise-free: the filter model is the plant (Esso Osaka linear
+    /// sway-yaw model, `NomotoShip::esso_osaka()`: [Taylor2000, Table 2.3] N with the documented assumed M, b,
+    /// U = 10 kn, L/U = 63.2 s), Q = FQ = 0, R = 0.01 ([Taylor2000, Table 4.1], "in all cases",
+    /// [Taylor2000, sec. 4.3.1]),
     /// exact measurements every 1 s of a 10/10 zig-zag. From x̂₀ = 0.5× and 1.5× the truth
     /// (P₀ = 1e-3 on the coefficients, σ ≈ 1.3× −Y′_v) all four coefficients end within 1 %
     /// after 30 min (measured 0.38 % and 0.12 %; within 1 % from 1107 s and 693 s), and the 10° tactical diameter of the
-    /// identified model is within 5 % of the true one (Fig. 2-7's "less than 5 %"; measured
+    /// identified model is within 5 % of the true one ([Taylor2000, Fig. 2-7]'s "less than 5 %"; measured
     /// ≈ 0.1 %).
     ///
-    /// Not reproduced: the thesis's "about 3 minutes" to converge (L674). Ours: all four stay
+    /// Not reproduced: the thesis's "about 3 minutes" to converge [Taylor2000, sec. 2.3]. Ours: all four stay
     /// within 1 % from 1107 s (17.5 L/U) with P₀ = 1e-3 and x̂₀ = 0.5×, from 515 s with P₀ = 1e-2 and from
     /// 220 s with R = 1e-4 — with Q = 0 the EKF is a recursive least-squares fit whose prior
     /// (x̂₀, P₀) decays as R/(P₀·information), so the time depends on P₀, R and the speed
-    /// (time scale L/U), none of which the thesis gives for this run (spec §2.11, §6 item 10).
+    /// (time scale L/U), none of which the thesis gives for this run.
     #[test]
     fn at10_esso_osaka_noise_free_converges_to_table_2_3() {
         let true_turn = esso_turn(ESSO);
@@ -669,8 +661,8 @@ mod tests {
         assert!(settle_time(&rec, 0.01) < 600.0);
     }
 
-    /// AT-10 with measurement noise. The thesis prints no spread for the Esso Osaka run; the
-    /// closest statement is Fig. 2-7 (10° turn "less than 5 %" error in turning diameter), so
+    /// The Esso Osaka verification with measurement noise. The thesis prints no spread for the Esso Osaka run; the
+    /// closest statement is [Taylor2000, Fig. 2-7] (10° turn "less than 5 %" error in turning diameter), so
     /// that is the bound here: with N(0, 0.01²) noise on v′ and r′ (5 % and 2 % of the
     /// zig-zag's peak |v′| = 0.20, |r′| = 0.48) and the exact filter model (Q = FQ = 0,
     /// R = 0.01), the 67 % running mean of every coefficient is within 5 % (measured 0.1-1.3 %
@@ -679,7 +671,8 @@ mod tests {
     /// Found on the way (not asserted): (a) noise of the size the filter assumes, σ = √R = 0.1,
     /// biases the estimates by −35 … −46 % after 1 h — the EKF as a parameter estimator is
     /// biased when the noise is large against the signal (Ljung 1979: the gain's dependence on
-    /// the parameters is neglected); the thesis calls R = 0.01 "conservative" (footnote L1601),
+    /// the parameters is neglected); the thesis calls R = 0.01 "conservative" (footnote in
+    /// [Taylor2000, sec. 4.3.1]),
     /// i.e. larger than the actual noise; (b) with the DDG-51 settings Q = 0.05, FQ = 0.01 on
     /// this exact model the noise-free estimates still converge (0.0 % after 1 h) but with
     /// σ = 0.01 the coefficients random-walk far away (−N_v × 46) — FQ = 0.01 per unit t′ is
@@ -703,7 +696,7 @@ mod tests {
     /// 10/10 zig-zag for `t_end` s, samples every 1 s of u, v, r, n (+ `noise_sd`·N(0, 1) in
     /// nondimensional units); the filter gets the step average of the actual (rate-limited)
     /// rudder. Filter model: M and b from the (v, r) block of the linearised model
-    /// (`LIN_M`, `LIN_B`, spec `container_ship.md` §4.1), x̂₀ = 0.5 × the (v, r) block of
+    /// (`LIN_M`, `LIN_B`, from MSS `Lcontainer.m`), x̂₀ = 0.5 × the (v, r) block of
     /// `LIN_N`.
     fn container_identify(
         params: impl Fn(ParameterEkfParams) -> ParameterEkfParams,
@@ -767,24 +760,24 @@ mod tests {
         (tp, tl)
     }
 
-    /// AT-11 (spec §4.5, §4.13) on ContainerShip as the nonlinear plant, with the Table 4.1
+    /// Post-identification validation [Taylor2000, sec. 4.3.4] on ContainerShip as the nonlinear plant, with the [Taylor2000, Table 4.1]
     /// settings (Q = 0.05, FQ = 0.01, R = 0.01), a 30-min 10/10 zig-zag and the mean of the
     /// last 67 % of the estimates. The identified linear model turns tighter than the plant at
-    /// 10° rudder, as in the thesis (L1788-1800):
+    /// 10° rudder, as in the thesis [Taylor2000, sec. 4.3.4]:
     /// * tactical diameter (180° heading change): −15.1 % noise-free, −13.1 % with
     ///   N(0, 0.001²) measurement noise (thesis "approximately 15 %", identified tighter);
     ///   asserted within 20 % and negative;
     /// * steady turning diameter: −24.0 % noise-free (−21.6 % with noise): **not within 20 %**,
     ///   asserted within 26 %. Why: no linear model can match the plant's steady turns at all
     ///   rudder angles. The plant's steady r′/δ falls from 2.61 at 2° to 1.94 at 5° and 1.44
-    ///   at 10° (nonlinear damping Y_vvv, N_rrr, N_vvr … of `container_ship.md` §2.4); the
+    ///   at 10° (nonlinear damping Y_vvv, N_rrr, N_vvr … of MSS `container.m`); the
     ///   zig-zag (peak |r′| = 0.23) fits K′ = 1.91, matching the 5° steady diameter within
     ///   1.3 % (asserted within 5 %) while the 2° turn is 36 % too wide and the 10° turn 24 %
     ///   too tight. The thesis's DDG-51 plant [43] is not given, so its 15 % cannot be tied to
     ///   a definition of the diameter; the tactical one is the closer reading of its trajectory
-    ///   plot (Fig. 4-11).
-    /// * AT-12: the plant's 10° speed loss is 20.5 % (thesis ≈ 20 %), asserted 18-23 %; its
-    ///   shaft speed is governed (`container_ship.md` §2.6), so the thesis's ≈ 10 % rpm loss has
+    ///   plot [Taylor2000, Fig. 4-11].
+    /// * Speed loss: the plant's 10° speed loss is 20.5 % (thesis ≈ 20 %), asserted 18-23 %; its
+    ///   shaft speed is governed (MSS `container.m`), so the thesis's ≈ 10 % rpm loss has
     ///   no counterpart.
     ///
     /// Robustness measured while writing this (not asserted): the result does not depend on
@@ -820,7 +813,7 @@ mod tests {
         }
     }
 
-    /// The analytic Jacobian of §2.10.1 equals central finite differences of f.
+    /// The analytic Jacobian (derived here) equals central finite differences of f.
     #[test]
     fn jacobian_matches_finite_differences() {
         let (m, b, _, _) = esso();
@@ -850,7 +843,7 @@ mod tests {
         }
     }
 
-    /// One update equals Eqs. 2.19-2.21 written out with H = [I₄ 0]; the running mean is the
+    /// One update equals [Taylor2000, eqs. (2.19)-(2.21)] written out with H = [I₄ 0]; the running mean is the
     /// mean of the last round(0.67 k) a-posteriori estimates, checked against the stored list.
     #[test]
     fn update_and_running_mean() {

@@ -1,48 +1,47 @@
-//! Fossen & Strand's nonlinear passive observer for dynamic positioning, with wave filtering and
+//! The nonlinear passive observer of [Fossen1999] for dynamic positioning, with wave filtering and
 //! bias estimation.
 //!
 //! # Source
-//! Seed 001 (T. I. Fossen and J. P. Strand, "Passive nonlinear observer design for ships using
-//! Lyapunov methods: full-scale experiments with a supply vessel", 1999), spec
-//! `passive_observer_dp.md` §2.8-2.10 (Eqs. 22-26, 40-48) and §3.2-3.3 (Eqs. 56-60):
+//! [Fossen1999, sec. 4-5, eqs. (22)-(26), (40)-(48)] and the Northern Clipper settings of
+//! [Fossen1999, sec. 6, eqs. (56)-(60)]:
 //! ```text
-//! ỹ = y − η̂ − ξ̂₂                      (Eq. 26, Γ = [0 I]; ỹ₃ wrapped to (−π, π])
-//! ξ̂₁' = ξ̂₂ + k1 ỹ,  ξ̂₂' = −ω₀² ξ̂₁ − 2ζω₀ ξ̂₂ + k2 ỹ     (Eq. 22, per DOF)
-//! η̂' = J(y₃) ν̂ + K₂ ỹ                   (Eq. 23)
-//! b̂' = −T⁻¹ b̂ + (1/γ) Λ ỹ               (Eq. 24)
-//! M ν̂' = −D ν̂ + Jᵀ(y₃) b̂ + τ + (1/γ) Jᵀ(y₃) 𝒦 ỹ      (Eq. 25)
-//! k1 = −2(ζ_n − ζ) ω_c/ω₀,  k2 = 2ω₀(ζ_n − ζ),  k3 = ω_c   (Eqs. 45-47)
+//! ỹ = y − η̂ − ξ̂₂                      ([Fossen1999, eq. (26)], Γ = [0 I]; ỹ₃ wrapped to (−π, π])
+//! ξ̂₁' = ξ̂₂ + k1 ỹ,  ξ̂₂' = −ω₀² ξ̂₁ − 2ζω₀ ξ̂₂ + k2 ỹ     ([Fossen1999, eq. (22)], per DOF)
+//! η̂' = J(y₃) ν̂ + K₂ ỹ                   [Fossen1999, eq. (23)]
+//! b̂' = −T⁻¹ b̂ + (1/γ) Λ ỹ               [Fossen1999, eq. (24)]
+//! M ν̂' = −D ν̂ + Jᵀ(y₃) b̂ + τ + (1/γ) Jᵀ(y₃) 𝒦 ỹ      [Fossen1999, eq. (25)]
+//! k1 = −2(ζ_n − ζ) ω_c/ω₀,  k2 = 2ω₀(ζ_n − ζ),  k3 = ω_c   [Fossen1999, eqs. (45)-(47)]
 //! ```
 //!
 //! # Readings taken
-//! * Eq. 45: the OCR prints `k1 = −2ω_c(ζ_n − ζ)/ω_c` (−1.8 with the paper's numbers); the
-//!   coefficient-matching form −2(ζ_n − ζ)ω_c/ω₀ reproduces the paper's Eq. 59 value −2.2059 and
-//!   is used (spec §2.10; checked against the original, seed 001 lines 325 and 408-414).
-//! * Scaling of the velocity and bias injection (spec §6.1 item 1): 𝒦 = diag(0.1, 0.1, 0.01) and
-//!   Λ = 0.1𝒦 are negligible against the SI M (10⁶-10⁹) if Eq. 25 is taken literally (the bias
+//! * [Fossen1999, eq. (45)]: the OCR text prints `k1 = −2ω_c(ζ_n − ζ)/ω_c` (−1.8 with the paper's numbers); the
+//!   coefficient-matching form −2(ζ_n − ζ)ω_c/ω₀ reproduces the paper's [Fossen1999, eq. (59)] value −2.2059 and
+//!   is used.
+//! * Scaling of the velocity and bias injection: 𝒦 = diag(0.1, 0.1, 0.01) and
+//!   Λ = 0.1𝒦 are negligible against the SI M (10⁶-10⁹) if [Fossen1999, eq. (25)] is taken literally (the bias
 //!   error then decays only at 1/T = 1000 s). [`Injection::MassNormalised`] (default) applies the
 //!   injection as an acceleration, `ν̂' = M⁻¹(−Dν̂ + τ) + Jᵀb̂ + (1/γ)Jᵀ𝒦ỹ`, with b̂ in m/s² and
-//!   rad/s² (the normalised-model reading); [`Injection::Literal`] is Eq. 25 with b̂ in N, N·m. The
+//!   rad/s² (the normalised-model reading); [`Injection::Literal`] is [Fossen1999, eq. (25)] with b̂ in N, N·m. The
 //!   bias output is always given as an earth-fixed force: J M Jᵀ b̂ in the normalised form.
 //! * Integration: RK4 with sub-steps ≤ `max_substep` (default 0.1 s), measurements and τ held over
 //!   the step (the paper samples at 1 Hz).
 
+use crate::error::{check_finite, check_non_negative, check_positive, require, ParamError};
 use crate::hull::wrap_pi;
 use crate::integrate::rk4_advance;
-use crate::steering_gear::ParamError;
 use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 
 /// How the velocity and bias injections enter (see the module docs).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub enum Injection {
-    /// Eq. 25 literally with SI M and D; b̂ in N, N, N·m.
+    /// [Fossen1999, eq. (25)] literally with SI M and D; b̂ in N, N, N·m.
     Literal,
     /// Injection as an acceleration; b̂ in m/s², m/s², rad/s².
     MassNormalised,
 }
 
-/// Notch-filter gains of Eqs. 45-47 for one DOF: (k1, k2, k3).
+/// Notch-filter gains of [Fossen1999, eqs. (45)-(47)] for one DOF: (k1, k2, k3).
 pub fn notch_gains(zeta: f64, omega0: f64, zeta_n: f64, omega_c: f64) -> (f64, f64, f64) {
     (
         -2.0 * (zeta_n - zeta) * omega_c / omega0,
@@ -56,7 +55,7 @@ pub fn notch_gains(zeta: f64, omega0: f64, zeta_n: f64, omega_c: f64) -> (f64, f
 pub struct PassiveObserverParams {
     pub m: [[f64; 3]; 3],
     pub d: [[f64; 3]; 3],
-    /// Bias time constants T [s] (Eq. 58: 1000).
+    /// Bias time constants T [s] ([Fossen1999, eq. (58)]: 1000).
     pub t_bias: [f64; 3],
     /// WF model: relative damping ζ and dominant frequency ω₀ [rad/s] (0.1, 0.8976).
     pub zeta: [f64; 3],
@@ -73,7 +72,7 @@ pub struct PassiveObserverParams {
 }
 
 impl PassiveObserverParams {
-    /// Northern Clipper with the paper's gains (§3.1-3.3), mass-normalised injection.
+    /// Northern Clipper with the paper's gains [Fossen1999, sec. 6, eqs. (56)-(60)], mass-normalised injection.
     pub fn northern_clipper() -> Self {
         let v = crate::hull::supply_vessel::SupplyVessel::northern_clipper();
         PassiveObserverParams {
@@ -93,58 +92,33 @@ impl PassiveObserverParams {
     }
 
     pub fn validate(&self) -> Result<(), ParamError> {
-        let pos = |name: &'static str, v: f64| {
-            if v > 0.0 && v.is_finite() {
-                Ok(())
-            } else {
-                Err(ParamError {
-                    name,
-                    value: v,
-                    rule: "must be finite and > 0",
-                })
-            }
-        };
         for i in 0..3 {
-            pos("t_bias", self.t_bias[i])?;
-            pos("zeta", self.zeta[i])?;
-            pos("omega0", self.omega0[i])?;
-            pos("zeta_n", self.zeta_n[i])?;
-            pos("omega_c", self.omega_c[i])?;
+            check_positive("t_bias", self.t_bias[i])?;
+            check_positive("zeta", self.zeta[i])?;
+            check_positive("omega0", self.omega0[i])?;
+            check_positive("zeta_n", self.zeta_n[i])?;
+            check_positive("omega_c", self.omega_c[i])?;
             for j in 0..3 {
-                if !self.m[i][j].is_finite() || !self.d[i][j].is_finite() {
-                    return Err(ParamError {
-                        name: "m/d",
-                        value: f64::NAN,
-                        rule: "must be finite",
-                    });
-                }
+                check_finite("m", self.m[i][j])?;
+                check_finite("d", self.d[i][j])?;
             }
-            if !(self.kappa[i] >= 0.0 && self.lambda[i] >= 0.0) {
-                return Err(ParamError {
-                    name: "kappa/lambda",
-                    value: self.kappa[i].min(self.lambda[i]),
-                    rule: "must be >= 0",
-                });
-            }
+            check_non_negative("kappa", self.kappa[i])?;
+            check_non_negative("lambda", self.lambda[i])?;
         }
-        pos("gamma", self.gamma)?;
-        pos("max_substep", self.max_substep)?;
-        if Matrix3::from_fn(|i, j| self.m[i][j])
-            .try_inverse()
-            .is_none()
-        {
-            return Err(ParamError {
-                name: "m",
-                value: 0.0,
-                rule: "must be invertible",
-            });
-        }
-        Ok(())
+        check_positive("gamma", self.gamma)?;
+        check_positive("max_substep", self.max_substep)?;
+        let m = Matrix3::from_fn(|i, j| self.m[i][j]);
+        require(
+            m.try_inverse().is_some(),
+            "m (determinant)",
+            m.determinant(),
+            "must be invertible",
+        )
     }
 
-    /// Eq. 48 tuning rule 1/T ≪ λ/κ < ω₀ < ω_c per DOF ("≪" taken as a factor 10). The paper's own
-    /// numbers pass the rule, but the exact SPR phase condition is violated marginally (spec T7,
-    /// −94.85°); this is a check to warn on, not a reason to reject.
+    /// [Fossen1999, eq. (48)] tuning rule 1/T ≪ λ/κ < ω₀ < ω_c per DOF ("≪" taken as a factor 10). The paper's own
+    /// numbers pass the rule, but the exact SPR phase condition is violated marginally (derived
+    /// here: −94.85°); this is a check to warn on, not a reason to reject.
     pub fn tuning_rule_holds(&self) -> bool {
         (0..3).all(|i| {
             let r = self.lambda[i] / self.kappa[i];
@@ -174,7 +148,7 @@ fn rot(psi: f64) -> Matrix3<f64> {
 impl PassiveObserver {
     /// An observer with η̂(0) = `eta0`, the other states 0.
     pub fn new(params: PassiveObserverParams, eta0: [f64; 3]) -> Result<Self, String> {
-        params.validate().map_err(|e| e.to_string())?;
+        params.validate()?;
         let mut o = PassiveObserver {
             k1: [0.0; 3],
             k2: [0.0; 3],
@@ -191,7 +165,7 @@ impl PassiveObserver {
 
     /// Replaces the parameters (gain scheduling on ω₀, Remark 2); the state carries over.
     pub fn set_params(&mut self, params: PassiveObserverParams) -> Result<(), String> {
-        params.validate().map_err(|e| e.to_string())?;
+        params.validate()?;
         for i in 0..3 {
             let (a, b, c) = notch_gains(
                 params.zeta[i],
@@ -323,7 +297,7 @@ mod tests {
     use crate::disturbances::waves::{WaveParams, Waves};
     use crate::hull::supply_vessel::{SupplyVessel, SupplyVesselInputs};
 
-    /// T1 (Eq. 59): K₁ = [−2.2059; 1.6157], K₂ = 1.1 to 4 decimals; exact −2.2058824.
+    /// [Fossen1999, eq. (59)]: K₁ = [−2.2059; 1.6157], K₂ = 1.1 to 4 decimals; exact −2.2058824.
     /// T2/T3: the tuning rule holds for the paper's set and fails for λ/κ ≥ ω₀ or ω_c ≤ ω₀.
     #[test]
     fn gains_eq_59() {
@@ -388,13 +362,13 @@ mod tests {
         }
     }
 
-    /// Closed loop SupplyVessel + Waves (001 WF model, 5 m / 5 m / 0.5° std at ω₀ = 0.8976) +
+    /// Closed loop SupplyVessel + Waves (WF model of [Fossen1999, sec. 2.4], 5 m / 5 m / 0.5° std at ω₀ = 0.8976) +
     /// this observer at 1 Hz + a slow PD station-keeping law on (η̂, ν̂), constant earth-fixed
     /// bias b = (8e4 N, −6e4 N, 2e6 N·m). Acceptance (issue 6): WF power in the estimate < 5 % of
     /// that in the measurement (power in the wave band 0.45-1.8 rad/s of η̂ against that of y, over
     /// the last 4096 s), and the bias estimate converges to the applied force.
     ///
-    /// The bias cannot converge exactly: Eq. 24's leak −b̂/T leaves, at equilibrium, a relative
+    /// The bias cannot converge exactly: [Fossen1999, eq. (24)]'s leak −b̂/T leaves, at equilibrium, a relative
     /// error (κ + M⁻¹D K₂)/(Tλ + κ + M⁻¹D K₂) per DOF ≈ 1 % in surge and sway but ≈ 12 % in yaw
     /// (Tλ = 1 there). The instantaneous b̂ carries the wave-frequency residual of ỹ integrated by
     /// λ, so its mean over the last 4096 s is compared. Ours (seed 11): WF band-power ratios

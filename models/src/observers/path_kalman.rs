@@ -1,41 +1,41 @@
-//! Steady-state Kalman-Bucy filter of the Tokyo Maru path-control loop (Parsons & Cuong 1980).
+//! Steady-state Kalman-Bucy filter of the Tokyo Maru path-control loop [Parsons1980, sec. 3].
 //!
 //! # Source
-//! Seed 004, spec `adaptive_path_control.md` §2.8-2.9 and §5.5: the continuous filter (Eq. 47)
+//! [Parsons1980, sec. 3.2-3.3]: the continuous filter [Parsons1980, eq. (47)]
 //! `dx̂′/dt′ = F_e x̂′ + G_e δ′_c + K (z − H_e x̂′)` on the 7-state design model
 //! [`PathDesignModel`] (x̂′ = [ψ′, r′, β′, η′, δ′, N′, Y′]) with the steady-state gain
-//! K = P∞H_eᵀR⁻¹ of Eqs. 48-52, stepped with fixed-step forward Euler at the report's step
-//! Δt′ = 0.005 (lines 495, 1275; §4 "reference discretisation", step 4).
+//! K = P∞H_eᵀR⁻¹ of [Parsons1980, eqs. (48)-(52)], stepped with fixed-step forward Euler at the report's step
+//! Δt′ = 0.005 [Parsons1980, sec. 2.2 and 4.4].
 //!
 //! # Readings taken
 //! * Random-walk design: −ε (1e-4) on the N′, Y′ diagonal for the gain design only; the running
-//!   filter uses F_e(6,6) = F_e(7,7) = 0 (line 768, spec §5.5).
+//!   filter uses F_e(6,6) = F_e(7,7) = 0 (after [Parsons1980, eq. (60)]).
 //! * A co-simulation step h (seconds) is covered with n = ⌈h′/Δt′⌉ equal Euler sub-steps
 //!   (h′ = hU/L), inputs held; with h = Δt′L/U (≈ 0.2349 s) this is exactly the report's scheme.
 //! * The gains are recomputed only when the design changes (gain-update event of the adaptive
-//!   loop, §2.11/§5.5); the estimate carries over.
+//!   loop, [Parsons1980, sec. 1 and 6]); the estimate carries over.
 //!
 //! # Innovation statistics
 //! The innovation ν = z − H_e x̂′ at the start of each sub-step, and its exponentially weighted
 //! mean square with forgetting time `innovation_window` (in t′).
 
 use super::path_model::{DisturbanceModel, PathDesignModel, NX, NZ};
-use crate::control::riccati::RiccatiError;
+use crate::error::{check_positive, check_positive_or_infinite, require, ParamError};
 use crate::hull::tokyo_maru::TokyoMaruCoefficients;
 use crate::hull::tokyo_maru::{L, U};
 use crate::integrate::substeps;
-use crate::steering_gear::ParamError;
+use crate::riccati::RiccatiError;
 use nalgebra::{SMatrix, SVector};
 use serde::{Deserialize, Serialize};
 
 /// Parameters from which a [`PathDesignModel`] is built (the FMU's parameter set).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct PathKalmanConfig {
-    /// Design (assumed) depth ratio H/T of the Table 2 coefficients (∞ allowed).
+    /// Design (assumed) depth ratio H/T of the [Parsons1980, Table 2] coefficients (∞ allowed).
     pub design_depth_ratio: f64,
-    /// When > 0: f23 and f25 are taken at this H/T instead (Table 8 partial adaptation).
+    /// When > 0: f23 and f25 are taken at this H/T instead ([Parsons1980, Table 8] partial adaptation).
     pub adapted_depth_ratio: f64,
-    /// true: random-walk N′, Y′ (Eqs. 56-59); false: first-order shaping filters (Eqs. 39-41).
+    /// true: random-walk N′, Y′ [Parsons1980, eqs. (56)-(59)]; false: first-order shaping filters [Parsons1980, eqs. (39)-(41)].
     pub random_walk: bool,
     /// Steering time constant T_r (nondimensional; 0.212874 = 10 s).
     pub t_r: f64,
@@ -44,14 +44,14 @@ pub struct PathKalmanConfig {
     /// Random-walk design regulariser ε.
     pub epsilon: f64,
     /// Disturbance intensities [q11, q22]; a value ≤ 0 takes the report's value for the chosen
-    /// model (Eqs. 53-54 or 67-68).
+    /// model ([Parsons1980, eqs. (53)-(54)] or 67-68).
     pub q: [f64; 2],
-    /// Measurement noise intensities [r_ψ, r_r, r_η] (Table 3 by default).
+    /// Measurement noise intensities [r_ψ, r_r, r_η] ([Parsons1980, Table 3] by default).
     pub r: [f64; 3],
 }
 
 impl Default for PathKalmanConfig {
-    /// The report's adaptive design: random walk at H/T = 1.89 (Table 5).
+    /// The report's adaptive design: random walk at H/T = 1.89 [Parsons1980, Table 5].
     fn default() -> Self {
         PathKalmanConfig {
             design_depth_ratio: 1.89,
@@ -69,45 +69,26 @@ impl Default for PathKalmanConfig {
 impl PathKalmanConfig {
     /// Validates and builds the design model.
     pub fn design(&self) -> Result<PathDesignModel, ParamError> {
-        let pos = |name: &'static str, v: f64| {
-            if v > 0.0 {
-                Ok(())
-            } else {
-                Err(ParamError {
-                    name,
-                    value: v,
-                    rule: "must be > 0",
-                })
-            }
-        };
-        pos("design_depth_ratio", self.design_depth_ratio)?;
-        pos("t_r", self.t_r)?;
-        if self.adapted_depth_ratio.is_nan() {
-            return Err(ParamError {
-                name: "adapted_depth_ratio",
-                value: self.adapted_depth_ratio,
-                rule: "must be a number (<= 0: not used)",
-            });
-        }
+        check_positive_or_infinite("design_depth_ratio", self.design_depth_ratio)?;
+        check_positive("t_r", self.t_r)?;
+        require(
+            !self.adapted_depth_ratio.is_nan(),
+            "adapted_depth_ratio",
+            self.adapted_depth_ratio,
+            "must be a number (<= 0: not used)",
+        )?;
         for (name, v) in [
             ("r_heading", self.r[0]),
             ("r_yaw_rate", self.r[1]),
             ("r_cross_track", self.r[2]),
         ] {
-            pos(name, v)?;
-            if !v.is_finite() {
-                return Err(ParamError {
-                    name,
-                    value: v,
-                    rule: "must be finite",
-                });
-            }
+            check_positive(name, v)?;
         }
         let mut m = if self.random_walk {
-            pos("epsilon", self.epsilon)?;
+            check_positive("epsilon", self.epsilon)?;
             PathDesignModel::random_walk(self.design_depth_ratio)
         } else {
-            pos("shaping_time_constant", self.shaping_time_constant)?;
+            check_positive("shaping_time_constant", self.shaping_time_constant)?;
             PathDesignModel::shaping_filter(self.design_depth_ratio)
         };
         if self.random_walk {
@@ -249,11 +230,11 @@ mod tests {
     use super::*;
     use crate::hull::tokyo_maru::{TokyoMaru, TokyoMaruInputs, TokyoMaruIntegration};
 
-    /// U9 (spec §4.1, line 1145, Appendix C): truth at H/T = ∞ under the constant design current
-    /// forces N′ = 0.0010262, Y′ = 0.0023277, Table 5 controller and filter (design 1.89), Euler at
+    /// Constant-disturbance equilibrium [Parsons1980, sec. 4.2.2]: truth at H/T = ∞ under the constant design current
+    /// forces N′ = 0.0010262, Y′ = 0.0023277, [Parsons1980, Table 5] controller and filter (design 1.89), Euler at
     /// Δt′ = 0.005. Steady state: N̂′ = 0.001992, Ŷ′ = 0.003437 (±1 in the last digit);
     /// ψ′ = β′ = −0.1428, δ′ = 0.1310 (printed; re-computation 0.13093, so ±1e-4), r′ = 0, η′ ≈ 0
-    /// (Appendix C: 3.9e-5, the Euler-discretised loop is not exactly offset-free).
+    /// (an independent re-computation found 3.9e-5 too: the Euler-discretised loop is not exactly offset-free).
     #[test]
     fn u9_steady_state_under_design_current() {
         let design = PathDesignModel::random_walk(1.89);
@@ -318,7 +299,7 @@ mod tests {
         assert!(f.innovation().norm() < 1e-12);
     }
 
-    /// The default config is the Table 5 design; q ≤ 0 takes the report's value per model.
+    /// The default config is the [Parsons1980, Table 5] design; q ≤ 0 takes the report's value per model.
     #[test]
     fn config_builds_the_report_designs() {
         let c = PathKalmanConfig::default();

@@ -1,36 +1,40 @@
-//! The Tokyo Maru 7-state *design* model of Parsons & Cuong (1980), shared by the path Kalman
+//! The Tokyo Maru 7-state *design* model of [Parsons1980, sec. 3], shared by the path Kalman
 //! filter ([`super::path_kalman`]) and the LQ path controller (`controllers`).
 //!
 //! # Source
-//! Seed 004, spec `adaptive_path_control.md`:
-//! * §2.2 Eq. 11 (5-state plant F_s, G_s, Γ_s; coefficients of Table 2 in
+//! [Parsons1980]:
+//! * [Parsons1980, eq. (11)] (5-state plant F_s, G_s, Γ_s; coefficients of [Parsons1980, Table 2] in
 //!   [`crate::hull::tokyo_maru`]);
-//! * §2.5 Eq. 13 measurements z = [ψ′, r′, η′] (H_e = [H_s 0₃ₓ₂]), noise intensities of Table 3;
-//! * §2.7 Eqs. 29-34 and 45: LQ weights a44 = 772.463, a55 = b11 = 131.332, C = −B⁻¹G_eᵀS∞;
-//! * §2.8 the two disturbance models for N′, Y′ appended as states 6 and 7:
-//!   - first-order shaping filter, Eqs. 39-41: T_N dN′/dt′ = −N′ + w₁, T_Y likewise, T = 1 ship
-//!     length, Γ_e = [0; diag(1/T_N, 1/T_Y)], Q = diag(1.548e-8, 8.970e-8) (Eqs. 53-54);
-//!   - random walk, Eqs. 56-59: dN′/dt′ = w_N, F_e(6,6) = F_e(7,7) = −ε only for the gain design
-//!     (ε = 1e-4, line 768; "not necessary to include ε ≠ 0 in the implementation of the filter"),
-//!     Γ_e = [0; I₂], Q = diag(2e-8, 1.25e-7) from q = Δt S² (Eqs. 66-68);
-//! * §2.9 Eqs. 47-52: K = P∞ H_eᵀ R⁻¹ with P∞ the stabilising solution of the filter CARE.
+//! * [Parsons1980, eq. (13)] measurements z = [ψ′, r′, η′] (H_e = [H_s 0₃ₓ₂]), noise intensities of [Parsons1980, Table 3]
+//!   [Parsons1980, sec. 2.2];
+//! * [Parsons1980, eqs. (29)-(34) and (45)]: LQ weights a44 = 772.463, a55 = b11 = 131.332, C = −B⁻¹G_eᵀS∞
+//!   [Parsons1980, sec. 3.1];
+//! * the two disturbance models for N′, Y′ appended as states 6 and 7:
+//!   - first-order shaping filter [Parsons1980, sec. 3.2, eqs. (39)-(41)]: T_N dN′/dt′ = −N′ + w₁,
+//!     T_Y likewise, T = 1 ship length, Γ_e = [0; diag(1/T_N, 1/T_Y)],
+//!     Q = diag(1.548e-8, 8.970e-8) [Parsons1980, eqs. (53)-(54)];
+//!   - random walk [Parsons1980, sec. 3.3, eqs. (56)-(59)]: dN′/dt′ = w_N, F_e(6,6) = F_e(7,7) = −ε
+//!     only for the gain design (ε = 1e-4; "not necessary to include ε ≠ 0 in the
+//!     implementation of the filter", after [Parsons1980, eq. (60)]), Γ_e = [0; I₂],
+//!     Q = diag(2e-8, 1.25e-7) from q = Δt S² [Parsons1980, eqs. (66)-(68)];
+//! * [Parsons1980, eqs. (47)-(52)]: K = P∞ H_eᵀ R⁻¹ with P∞ the stabilising solution of the filter CARE.
 //!
 //! # Readings taken
-//! * T_r is never printed; the [DERIVED] value T_r = 0.212874 (10 s full scale,
-//!   [`crate::hull::tokyo_maru::T_R`]) is the default (spec §2.4, Appendix C).
-//! * Eq. 59 prints `f_{23}` in row 3, column 2; the original (seed 004 line ~760) is an OCR/typo
-//!   for f32, which is what is used (the structure of Eq. 41).
-//! * Eq. 36 prints the lower-right Hamiltonian block as −F_s; −F_sᵀ is used (any CARE solver).
+//! * T_r is never printed; the value T_r = 0.212874 derived from 10 s full scale
+//!   ([`crate::hull::tokyo_maru::T_R`]) is the default; it reproduces the printed gains.
+//! * [Parsons1980, eq. (59)] prints `f_{23}` in row 3, column 2: an OCR error or typo for f32 (the structure of
+//!   [Parsons1980, eq. (41)]), which is what is used.
+//! * [Parsons1980, eq. (36)] prints the lower-right Hamiltonian block as −F_s; −F_sᵀ is used (any CARE solver).
 //!
 //! All quantities are nondimensional (t′ = tU/L, r′ = rL/U, η′ = η/L, angles in rad).
 
-use crate::control::riccati::{self, RiccatiError};
 use crate::hull::tokyo_maru::{TokyoMaruCoefficients, T_R};
+use crate::riccati::{self, RiccatiError};
 use nalgebra::{DMatrix, SMatrix};
 use serde::{Deserialize, Serialize};
 
 /// SI measurements [ψ rad, r rad/s, β rad, η m] in the prime system [ψ′, r′ = rL/U, β′, η′ = η/L]
-/// (ship length `length` m, speed `speed` m/s), the state order of the estimators' eq. (75).
+/// (ship length `length` m, speed `speed` m/s), the state order of the estimators' [Parsons1980, eq. (75)].
 pub fn states_prime(si: &[f64; 4], length: f64, speed: f64) -> [f64; 4] {
     [si[0], si[1] * length / speed, si[2], si[3] / length]
 }
@@ -40,37 +44,37 @@ pub const NX: usize = 7;
 /// Number of measurements: [ψ′, r′, η′].
 pub const NZ: usize = 3;
 
-/// Report step Δt′ = 0.005 (≈ 0.235 s full scale), the Euler step of plant and filter (§2.5).
+/// Report step Δt′ = 0.005 (≈ 0.235 s full scale), the Euler step of plant and filter [Parsons1980, sec. 2.2].
 pub const DT_PRIME: f64 = 0.005;
-/// Table 3 noise intensities r_jj for ψ′, r′, η′ (nondimensional PSD).
+/// [Parsons1980, Table 3] noise intensities r_jj for ψ′, r′, η′ (nondimensional PSD).
 pub const R_TABLE_3: [f64; 3] = [1.298e-8, 2.860e-7, 4.559e-7];
-/// Eqs. 53-54: shaping-filter disturbance intensities q11 = 2T_Nσ_N², q22 = 2T_Yσ_Y².
+/// [Parsons1980, eqs. (53)-(54)]: shaping-filter disturbance intensities q11 = 2T_Nσ_N², q22 = 2T_Yσ_Y².
 pub const Q_SHAPING: [f64; 2] = [1.548e-8, 8.970e-8];
-/// Eqs. 67-68: random-walk diffusion q = Δt S² with S_N = 0.002, S_Y = 0.005.
+/// [Parsons1980, eqs. (67)-(68)]: random-walk diffusion q = Δt S² with S_N = 0.002, S_Y = 0.005.
 pub const Q_RANDOM_WALK: [f64; 2] = [2.0e-8, 1.25e-7];
-/// Eq. 31: a44 = (η′₀)⁻².
+/// [Parsons1980, eq. (31)]: a44 = (η′₀)⁻².
 pub const A44: f64 = 772.463;
-/// Eq. 32: a55 = (δ′₀)⁻².
+/// [Parsons1980, eq. (32)]: a55 = (δ′₀)⁻².
 pub const A55: f64 = 131.332;
-/// Eq. 33: b11 = (δ′_c0)⁻².
+/// [Parsons1980, eq. (33)]: b11 = (δ′_c0)⁻².
 pub const B11: f64 = 131.332;
-/// Potter regulariser ε of the random-walk design (line 768).
+/// Potter regulariser ε of the random-walk design [Parsons1980, sec. 3.3].
 pub const EPSILON: f64 = 1e-4;
 
 /// How the external yaw moment N′ and sway force Y′ are modelled inside the design model.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub enum DisturbanceModel {
-    /// First-order shaping filters (Eqs. 39-41): T_N dN′/dt′ = −N′ + w₁, T_Y dY′/dt′ = −Y′ + w₂.
+    /// First-order shaping filters [Parsons1980, eqs. (39)-(41)]: T_N dN′/dt′ = −N′ + w₁, T_Y dY′/dt′ = −Y′ + w₂.
     ShapingFilter { t_n: f64, t_y: f64 },
-    /// Brownian motion (Eqs. 56-59); `epsilon` is the −ε on the diagonal used for the gain design
+    /// Brownian motion [Parsons1980, eqs. (56)-(59)]; `epsilon` is the −ε on the diagonal used for the gain design
     /// only (the running filter uses 0).
     RandomWalk { epsilon: f64 },
 }
 
-/// The 7-state design model of §2.8 with its noise and weighting data.
+/// The 7-state design model of [Parsons1980, sec. 3.2-3.3] with its noise and weighting data.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct PathDesignModel {
-    /// Table 2 coefficients of the *design* (assumed) depth or estimated values.
+    /// [Parsons1980, Table 2] coefficients of the *design* (assumed) depth or estimated values.
     pub coefficients: TokyoMaruCoefficients,
     /// Steering time constant T_r (nondimensional).
     pub t_r: f64,
@@ -79,7 +83,7 @@ pub struct PathDesignModel {
     pub q: [f64; 2],
     /// Measurement noise intensities [r_ψ, r_r, r_η].
     pub r: [f64; 3],
-    /// LQ weights a44 (η′²), a55 (δ′²) and b11 (δ′_c²); every other a_ij is 0 (§2.7).
+    /// LQ weights a44 (η′²), a55 (δ′²) and b11 (δ′_c²); every other a_ij is 0 [Parsons1980, sec. 3.1].
     pub a44: f64,
     pub a55: f64,
     pub b11: f64,
@@ -104,7 +108,7 @@ impl PathDesignModel {
         }
     }
 
-    /// The report's shaping-filter design (T_N = T_Y = 1) at depth ratio `ht` (Table 4 at 1.89).
+    /// The report's shaping-filter design (T_N = T_Y = 1) at depth ratio `ht` ([Parsons1980, Table 4] at 1.89).
     pub fn shaping_filter(ht: f64) -> Self {
         Self::new(
             TokyoMaruCoefficients::at_depth_ratio(ht),
@@ -112,8 +116,8 @@ impl PathDesignModel {
         )
     }
 
-    /// The report's random-walk design (ε = 1e-4) at depth ratio `ht` (Table 5 at 1.89,
-    /// Table 6 at ∞).
+    /// The report's random-walk design (ε = 1e-4) at depth ratio `ht` ([Parsons1980, Table 5] at 1.89,
+    /// [Parsons1980, Table 6] at ∞).
     pub fn random_walk(ht: f64) -> Self {
         Self::new(
             TokyoMaruCoefficients::at_depth_ratio(ht),
@@ -121,7 +125,7 @@ impl PathDesignModel {
         )
     }
 
-    /// Table 8: the partially adapted random-walk design, f23 and f25 at H/T = `adapted_ht`, the
+    /// [Parsons1980, Table 8]: the partially adapted random-walk design, f23 and f25 at H/T = `adapted_ht`, the
     /// other eight coefficients at `design_ht`.
     pub fn partially_adapted(design_ht: f64, adapted_ht: f64) -> Self {
         let mut c = TokyoMaruCoefficients::at_depth_ratio(design_ht);
@@ -131,8 +135,8 @@ impl PathDesignModel {
         Self::new(c, DisturbanceModel::RandomWalk { epsilon: EPSILON })
     }
 
-    /// F_e (Eq. 41 / 59). `for_design`: with the random walk's −ε on the diagonal (gain design);
-    /// otherwise 0 there (the running filter, §5.5).
+    /// F_e [Parsons1980, eqs. (41), (59)]. `for_design`: with the random walk's −ε on the diagonal (gain design);
+    /// otherwise 0 there (the running filter, after [Parsons1980, eq. (60)]).
     pub fn f(&self, for_design: bool) -> SMatrix<f64, NX, NX> {
         let c = &self.coefficients;
         let (f5, _, _) = c.eq11(self.t_r);
@@ -179,7 +183,7 @@ impl PathDesignModel {
         g
     }
 
-    /// H_e = [H_s 0₃ₓ₂]: ψ′, r′ and η′ are measured (Eq. 13).
+    /// H_e = [H_s 0₃ₓ₂]: ψ′, r′ and η′ are measured [Parsons1980, eq. (13)].
     pub fn h() -> SMatrix<f64, NZ, NX> {
         let mut h = SMatrix::<f64, NZ, NX>::zeros();
         h[(0, 0)] = 1.0;
@@ -192,8 +196,8 @@ impl PathDesignModel {
         DMatrix::from_column_slice(R, C, m.as_slice())
     }
 
-    /// Steady-state Kalman-Bucy gain K = P∞H_eᵀR⁻¹ (Eqs. 48-52), 7×3, columns for ψ′, r′, η′.
-    /// The δ′ row is zero (the rudder is known exactly, line 695).
+    /// Steady-state Kalman-Bucy gain K = P∞H_eᵀR⁻¹ [Parsons1980, eqs. (48)-(52)], 7×3, columns for ψ′, r′, η′.
+    /// The δ′ row is zero (the rudder is known exactly, [Parsons1980, sec. 3.2]).
     pub fn kalman_gain(&self) -> Result<SMatrix<f64, NX, NZ>, RiccatiError> {
         let f = Self::dm(&self.f(true));
         let h = Self::dm(&Self::h());
@@ -206,7 +210,7 @@ impl PathDesignModel {
         Ok(out)
     }
 
-    /// Steady-state LQ gain row C (u = C x̂, Eqs. 34 and 45: C = −B⁻¹G_eᵀS∞) with the weights
+    /// Steady-state LQ gain row C (u = C x̂, [Parsons1980, eqs. (34) and (45)]: C = −B⁻¹G_eᵀS∞) with the weights
     /// A = diag(0, 0, 0, a44, a55, 0, 0), B = b11.
     pub fn control_gain(&self) -> Result<SMatrix<f64, 1, NX>, RiccatiError> {
         let f = Self::dm(&self.f(true));
@@ -291,9 +295,9 @@ pub(crate) mod tests {
         (wk, wc)
     }
 
-    /// U1-U4 (spec §4.1, Appendix C): K of Tables 4, 5, 6 and 8 within 1.5 units in the last
-    /// printed digit with the [DERIVED] T_r = 0.212874. The C rows are checked with the same
-    /// tolerance (Appendix C: largest gap 1.11 digit, Table 4 C for Y′).
+    /// K of [Parsons1980, Tables 4, 5, 6 and 8] within 1.5 units in the last printed digit with the derived
+    /// T_r = 0.212874. The C rows are checked with the same tolerance (an independent
+    /// re-computation found the largest gap, 1.11 digit, in [Parsons1980, Table 4] C for Y′).
     #[test]
     fn tables_4_5_6_8() {
         let cases = [
@@ -318,8 +322,9 @@ pub(crate) mod tests {
         }
     }
 
-    /// U5: c16 of the random-walk design for ε = 1e-2, 1e-4, 1e-6: 995.32, 998.50, 998.54
-    /// (Appendix C re-computation: 998.51 at 1e-4, i.e. 1 digit; tolerance 1.5 digits).
+    /// c16 of the random-walk design for ε = 1e-2, 1e-4, 1e-6: 995.32, 998.50, 998.54
+    /// [Parsons1980, sec. 3.3].
+    /// (an independent re-computation gives 998.51 at 1e-4, i.e. 1 digit; tolerance 1.5 digits).
     #[test]
     fn u5_epsilon_convergence() {
         for (eps, want) in [(1e-2, "995.32"), (1e-4, "998.50"), (1e-6, "998.54")] {

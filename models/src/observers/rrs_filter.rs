@@ -1,104 +1,72 @@
-//! Van der Klugt's RRS filters: roll filter (App. E), yaw filter (App. F) and adaptive speed
-//! filter (§4.5, §5.5.3), discretised with the forward-Euler scheme of Eqs. 6.2-6.4.
+//! The RRS filters of [Klugt1987]: roll filter [Klugt1987, App. E], yaw filter [Klugt1987, App. F]
+//! and adaptive speed filter [Klugt1987, sec. 4.5 and 5.5.3], discretised with the forward-Euler
+//! scheme of [Klugt1987, eqs. (6.2)-(6.4)].
 //!
 //! # Source
-//! Seed 003 (van der Klugt, *Rudder Roll Stabilization*, TU Delft 1987); spec
-//! `rrs_models_filters.md` §4.4-4.7 and §6.2, spec `rrs_controller_results.md` §2.7-2.8, §3
-//! (Tables 5.2-5.5) and §4.1 (T5, T7).
+//! [Klugt1987, sec. 4.4-4.5, 5.5 and 6.3, App. E-F, Tables 5.2-5.4].
 //!
-//! # Discretisation (Eqs. 6.1-6.4)
+//! # Discretisation [Klugt1987, eqs. (6.1)-(6.4)]
 //! 1/s → T/(z − 1): `x̂(k) = x̂(k−1) + T [A x̂(k−1) + B u(k−1) + K e(k−1)]`,
 //! `e(k) = y(k) − C x̂(k)`: a one-step predictor, so the estimate at k uses only data up to k−1.
-//! The sample time T is not given in the thesis (spec O1); default 0.1 s, a parameter. A
+//! The sample time T is not given in the thesis; default 0.1 s, a parameter. A
 //! co-simulation step h is covered by ⌈h/T⌉ equal sub-steps with the inputs held.
 //!
-//! # Roll filter (App. E, §4.4.2, §6.3.1)
+//! # Roll filter [Klugt1987, App. E, sec. 4.4.2 and 6.3.1]
 //! Reduced model x = (φ, φ̇, x_v) with the constant heel x_v as integrated white noise in the
 //! *measurement*: `y = φ + x_v + v`; A = [[0,1,0],[−ω_n²,−2z_nω_n,0],[0,0,0]],
 //! B = (0, ω_n², 0)ᵀ, D = [[0,0],[ω_n²,0],[0,1]], C = (1 0 1), Q = diag(q1, q2) normalised by
-//! E[v²] (R = 1); K = PCᵀ from the dual CARE (equals the limit of E.11-E.16, tested). The
+//! E[v²] (R = 1); K = PCᵀ from the dual CARE (equals the limit of [Klugt1987, eqs. (E.11)-(E.16)], tested). The
 //! noise-free rudder→sway submodel v̂_δ' = (−v̂_δ + k_dv δ_φ)/τ_v is propagated open loop, and the
-//! roll-moment input is u_φ = k_dp δ_φ + k_vp v̂_δ (reading of Fig. 4.9/6.3, spec §4.5). The input
-//! is the roll controller's output δ_φ (L 1935). Gains fixed (computed at initialization, L 3075).
+//! roll-moment input is u_φ = k_dp δ_φ + k_vp v̂_δ (our reading of [Klugt1987, Figs. 4.9 and 6.3]).
+//! The input is the roll controller's output δ_φ [Klugt1987, sec. 4.4.1]. Gains fixed (computed
+//! at initialization, [Klugt1987, sec. 6.3.1]).
 //!
-//! # Yaw filter (App. F, §4.4.3, §5.5.4, §6.3.2)
+//! # Yaw filter [Klugt1987, App. F, sec. 4.4.3, 5.5.4 and 6.3.2]
 //! State (ψ, ψ̇, x3 = yaw-moment bias in rate units, x4 = high-frequency state), realised
 //! second-order Nomoto model: A = [[0,1,0,0],[0,−1/τ_r,1/τ_r,0],[0,0,0,0],[0,0,0,−1/τ_f]],
 //! B = (0, 1/τ_r, 0, 0)ᵀ with u = k_dr δ_ψ (+ k_vr x̂1 with the optional noise-free sway
 //! submodel), D = [[0,0,0],[1/τ_r,0,0],[0,1,0],[0,0,1/τ_f]], C = (1 0 0 −1), F = (1 1),
 //! y = Cx + w3 + v (w3 shared with the process ⇒ correlated noise S). Gains
-//! K = (PCᵀ + DSFᵀ)(FRFᵀ)⁻¹ (F.7-F.11) computed on line by the innovation process (Eqs. 6.5-6.6,
+//! K = (PCᵀ + DSFᵀ)(FRFᵀ)⁻¹ [Klugt1987, eqs. (F.7)-(F.11)] computed on line by the innovation
+//! process ([Klugt1987, eqs. (6.5)-(6.6)],
 //! L = 1/T: one Euler step of the Riccati ODE per sample), started from the CARE solution.
-//! Adaptive E[w3²] (Eq. 5.12): E_c = E[z_hf²]/E[z_lf²] from the prediction error z split by a
-//! complementary first-order filter at 1/τ_f (the split filter of Fig. 5.13 is lost; reading of
-//! the spec §2.7.3), variances by first-order low-pass filtered squares; E*[w3²] = E_c/d with
-//! d = 1 as realised (L 3112) or 7 (§5.5.4, L 2885). The input is the course controller's output
-//! δ_ψ (L 1939).
+//! Adaptive E[w3²] [Klugt1987, eq. (5.12)]: E_c = E[z_hf²]/E[z_lf²] from the prediction error z
+//! split by a complementary first-order filter at 1/τ_f (the split filter of
+//! [Klugt1987, Fig. 5.13] is lost in the OCR; this is our reading), variances by first-order
+//! low-pass filtered squares; E*[w3²] = E_c/d with d = 1 as realised [Klugt1987, sec. 6.3.2] or
+//! 7 [Klugt1987, sec. 5.5.4]. The input is the course controller's output δ_ψ
+//! [Klugt1987, sec. 4.4.1].
 //!
-//! **τ_f reading.** The thesis writes τ_f = a·τ_r (Eq. 5.13) and τ_f = a/τ_r (Eq. 6.7); the text
-//! (cut-off a/τ_r rad/s at L 3116, corner 1/τ_f at L 2058, and the adjustment rule L 2897-2900)
-//! supports **τ_f = τ_r/a**, a = 5 (spec appendix): that is the default, with a a parameter. The
-//! [DERIVED] gain check K = (0.29589, 0.04623, 0.00995, 0.02601) of spec §6.2 uses τ_f = 5.9 s
-//! = 5·τ_r (τ_r = 1.18 s), i.e. a = 0.2 in this reading.
+//! **τ_f reading.** The thesis writes τ_f = a·τ_r [Klugt1987, eq. (5.13)] and τ_f = a/τ_r
+//! [Klugt1987, eq. (6.7)]; the text (cut-off a/τ_r rad/s [Klugt1987, sec. 6.3.2], corner 1/τ_f
+//! [Klugt1987, sec. 4.4.3], and the adjustment rule after [Klugt1987, eq. (5.13)]) supports
+//! **τ_f = τ_r/a**, a = 5 [Klugt1987, eq. (6.7)]: that is the default, with a a parameter. The
+//! [DERIVED] gain check K = (0.29589, 0.04623, 0.00995, 0.02601) (computed from [Klugt1987, App. F], not
+//! printed in the thesis) uses τ_f = 5.9 s = 5·τ_r (τ_r = 1.18 s), i.e. a = 0.2 in this reading.
 //!
-//! **L matrix.** Eq. 6.5 prints L = diag(5/T, 5/T, 1/T, 1/T) for a 10-element x_m: the mapping is
-//! unrecoverable (spec O5); L = 1/T for all elements is used.
+//! **L matrix.** [Klugt1987, eq. (6.5)] prints L = diag(5/T, 5/T, 1/T, 1/T) for a 10-element
+//! x_m: the mapping is unrecoverable; L = 1/T for all elements is used.
 //!
-//! # Speed filter (§4.5.1, §5.5.3, §6.3.3)
-//! C-filter: first-order low-pass with τ0 = sqrt(E[v²]/E[w²]) (Eq. 4.90 / 5.9). Adaptation on
-//! the prediction error e_z = U_meas − Û with threshold p1 = c·σ_z (Eq. 5.10): |e_z| ≤ p1 ⇒
+//! # Speed filter [Klugt1987, sec. 4.5.1, 5.5.3 and 6.3.3]
+//! C-filter: first-order low-pass with τ0 = sqrt(E[v²]/E[w²]) [Klugt1987, eqs. (4.90), (5.9)].
+//! Adaptation on the prediction error e_z = U_meas − Û with threshold p1 = c·σ_z
+//! [Klugt1987, eq. (5.10)]: |e_z| ≤ p1 ⇒
 //! τ_f = τ0, else τ_f = τ0 (p1/|e_z|)^n (Q → Q(|e_z|/p1)^{2n}), τ_f ≥ τ_f,min (Q ≤ Q_max);
 //! n = 0 C, 1 L, 2 Q, ∞ S (switch to τ_f,min). Update Û(k) = Û(k−1) + T/τ_f (U(k−1) − Û(k−1)).
-//! The realised autopilot is the L-filter with p1 = 2 (§6.3.3); the study of Tables 5.2-5.4
-//! used τ0 = 100 s, τ_f,min = 10 s. The second-order (HF-coloured noise) gains of
-//! Eqs. 4.100-4.101 are [`second_order_speed_gains`].
+//! The realised autopilot is the L-filter with p1 = 2 [Klugt1987, sec. 6.3.3]; the study of
+//! [Klugt1987, Tables 5.2-5.4] used τ0 = 100 s, τ_f,min = 10 s. The second-order (HF-coloured
+//! noise) gains of [Klugt1987, eqs. (4.100)-(4.101)] are [`second_order_speed_gains`].
 
-use crate::control::riccati::{self, RiccatiError};
-use crate::steering_gear::ParamError;
+use crate::error::{check_finite, check_non_negative, check_positive, require, ParamError};
+use crate::riccati::{self, RiccatiError};
 use nalgebra::{DMatrix, SMatrix, SVector};
 use serde::{Deserialize, Serialize};
-
-fn positive(name: &'static str, v: f64) -> Result<(), ParamError> {
-    if v > 0.0 && v.is_finite() {
-        Ok(())
-    } else {
-        Err(ParamError {
-            name,
-            value: v,
-            rule: "must be finite and > 0",
-        })
-    }
-}
-
-fn finite(name: &'static str, v: f64) -> Result<(), ParamError> {
-    if v.is_finite() {
-        Ok(())
-    } else {
-        Err(ParamError {
-            name,
-            value: v,
-            rule: "must be finite",
-        })
-    }
-}
-
-fn nonneg(name: &'static str, v: f64) -> Result<(), ParamError> {
-    if v >= 0.0 && v.is_finite() {
-        Ok(())
-    } else {
-        Err(ParamError {
-            name,
-            value: v,
-            rule: "must be finite and >= 0",
-        })
-    }
-}
 
 // ---------------------------------------------------------------------------------------------
 // Roll filter
 // ---------------------------------------------------------------------------------------------
 
-/// Roll-filter parameters (model of Table 2.4 at the design speed, noise ratios q1, q2).
+/// Roll-filter parameters (model of [Klugt1987, Table 2.4] at the design speed, noise ratios q1, q2).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct RollFilterParams {
     /// Roll natural frequency ω_n [rad/s] and relative damping z_n.
@@ -115,8 +83,8 @@ pub struct RollFilterParams {
 }
 
 impl RollFilterParams {
-    /// Table 2.4 at speed `u` [m/s] with noise ratios (q1, q2). (No numeric q1, q2 are given in
-    /// the thesis, spec O8; (1, 0.01) is the spec's first [DERIVED] check.)
+    /// [Klugt1987, Table 2.4] at speed `u` [m/s] with noise ratios (q1, q2). (No numeric q1, q2 are given in
+    /// the thesis; (1, 0.01) is the first case of the [DERIVED] gain check in the tests.)
     pub fn table_2_4(u: f64, q1: f64, q2: f64) -> Self {
         let c = crate::hull::rrs_ship::RrsSpeedLaws::table_2_4().at(u);
         RollFilterParams {
@@ -132,19 +100,19 @@ impl RollFilterParams {
     }
 
     pub fn validate(&self) -> Result<(), ParamError> {
-        positive("omega_n", self.omega_n)?;
-        nonneg("z_n", self.z_n)?;
-        finite("k_dp", self.k_dp)?;
-        finite("k_vp", self.k_vp)?;
-        finite("k_dv", self.k_dv)?;
-        positive("tau_v", self.tau_v)?;
-        positive("roll_q1", self.q1)?;
-        positive("roll_q2", self.q2)?;
+        check_positive("omega_n", self.omega_n)?;
+        check_non_negative("z_n", self.z_n)?;
+        check_finite("k_dp", self.k_dp)?;
+        check_finite("k_vp", self.k_vp)?;
+        check_finite("k_dv", self.k_dv)?;
+        check_positive("tau_v", self.tau_v)?;
+        check_positive("roll_q1", self.q1)?;
+        check_positive("roll_q2", self.q2)?;
         Ok(())
     }
 }
 
-/// App. E steady-state roll-filter gains (k1, k2, k3) for (ω_n, z_n, q1, q2), R = 1.
+/// [Klugt1987, App. E] steady-state roll-filter gains (k1, k2, k3) for (ω_n, z_n, q1, q2), R = 1.
 pub fn roll_filter_gains(
     omega_n: f64,
     z_n: f64,
@@ -177,7 +145,7 @@ pub struct RollFilter {
 
 impl RollFilter {
     pub fn new(params: RollFilterParams) -> Result<Self, String> {
-        params.validate().map_err(|e| e.to_string())?;
+        params.validate()?;
         let k = roll_filter_gains(params.omega_n, params.z_n, params.q1, params.q2)
             .map_err(|e| format!("roll-filter gains: {e}"))?;
         Ok(RollFilter {
@@ -211,7 +179,7 @@ impl RollFilter {
         self.innovation
     }
 
-    /// One sample (Eq. 6.2): measured roll `y` and roll-controller output `delta_phi`, both of
+    /// One sample [Klugt1987, eq. (6.2)]: measured roll `y` and roll-controller output `delta_phi`, both of
     /// sample k−1; advances the estimate to k.
     #[inline]
     pub fn sample(&mut self, y: f64, delta_phi: f64, t: f64) {
@@ -252,18 +220,18 @@ pub struct YawFilterParams {
     pub e_v: f64,
     /// E[w3²]: the fixed value, or the start value when adaptive.
     pub e_w3: f64,
-    /// Adapt E*[w3²] = E_c / `ec_divisor` (Eq. 5.12).
+    /// Adapt E*[w3²] = E_c / `ec_divisor` [Klugt1987, eq. (5.12)].
     pub adaptive: bool,
-    /// 1 as realised (L 3112); 7 as suggested in §5.5.4 (L 2885).
+    /// 1 as realised [Klugt1987, sec. 6.3.2]; 7 as suggested in [Klugt1987, sec. 5.5.4].
     pub ec_divisor: f64,
     /// Time constant [s] of the low-pass filters that estimate E[z_hf²] and E[z_lf²].
     pub variance_time_constant: f64,
     /// Bounds on the adapted E*[w3²].
     pub e_w3_min: f64,
     pub e_w3_max: f64,
-    /// Optional noise-free rudder→sway submodel (third-order yaw model, §4.4.3): u = k_dr δ_ψ +
+    /// Optional noise-free rudder→sway submodel (third-order yaw model, [Klugt1987, sec. 4.4.3]): u = k_dr δ_ψ +
     /// k_vr x̂1, x̂1' = (−x̂1 + k_dv δ_ψ)/τ_v. With `third_order` false (the realised second-order
-    /// model, §6.3.2) k_vr is not used.
+    /// model, [Klugt1987, sec. 6.3.2]) k_vr is not used.
     pub third_order: bool,
     pub k_vr: f64,
     pub k_dv: f64,
@@ -271,8 +239,8 @@ pub struct YawFilterParams {
 }
 
 impl YawFilterParams {
-    /// The realised settings (§6.3.2): E[v²] = 0.01, E[w1²] = 0.1, E[w2²] = 1e-4, adaptive E[w3²]
-    /// (start 1), a = 5, with the Table 2.4 Nomoto parameters at speed `u` [m/s].
+    /// The realised settings [Klugt1987, sec. 6.3.2]: E[v²] = 0.01, E[w1²] = 0.1, E[w2²] = 1e-4, adaptive E[w3²]
+    /// (start 1), a = 5, with the [Klugt1987, Table 2.4] Nomoto parameters at speed `u` [m/s].
     pub fn realised(u: f64) -> Self {
         let c = crate::hull::rrs_ship::RrsSpeedLaws::table_2_4().at(u);
         YawFilterParams {
@@ -301,27 +269,26 @@ impl YawFilterParams {
     }
 
     pub fn validate(&self) -> Result<(), ParamError> {
-        positive("tau_r", self.tau_r)?;
-        finite("k_dr", self.k_dr)?;
-        positive("a", self.a)?;
-        nonneg("e_w1", self.e_w1)?;
-        nonneg("e_w2", self.e_w2)?;
-        nonneg("e_v", self.e_v)?;
-        positive("e_w3", self.e_w3)?;
-        positive("ec_divisor", self.ec_divisor)?;
-        positive("variance_time_constant", self.variance_time_constant)?;
-        positive("e_w3_min", self.e_w3_min)?;
-        positive("e_w3_max", self.e_w3_max)?;
-        if self.e_w3_min > self.e_w3_max {
-            return Err(ParamError {
-                name: "e_w3_min",
-                value: self.e_w3_min,
-                rule: "must be <= e_w3_max",
-            });
-        }
-        finite("k_vr", self.k_vr)?;
-        finite("k_dv", self.k_dv)?;
-        positive("tau_v", self.tau_v)?;
+        check_positive("tau_r", self.tau_r)?;
+        check_finite("k_dr", self.k_dr)?;
+        check_positive("a", self.a)?;
+        check_non_negative("e_w1", self.e_w1)?;
+        check_non_negative("e_w2", self.e_w2)?;
+        check_non_negative("e_v", self.e_v)?;
+        check_positive("e_w3", self.e_w3)?;
+        check_positive("ec_divisor", self.ec_divisor)?;
+        check_positive("variance_time_constant", self.variance_time_constant)?;
+        check_positive("e_w3_min", self.e_w3_min)?;
+        check_positive("e_w3_max", self.e_w3_max)?;
+        require(
+            self.e_w3_min <= self.e_w3_max,
+            "e_w3_min",
+            self.e_w3_min,
+            "must be <= e_w3_max",
+        )?;
+        check_finite("k_vr", self.k_vr)?;
+        check_finite("k_dv", self.k_dv)?;
+        check_positive("tau_v", self.tau_v)?;
         Ok(())
     }
 }
@@ -329,7 +296,7 @@ impl YawFilterParams {
 type M4 = SMatrix<f64, 4, 4>;
 type V4 = SVector<f64, 4>;
 
-/// (A, DQDᵀ, N = DSFᵀ, r = FRFᵀ) of App. F for (τ_r, τ_f, E1, E2, E3, Ev).
+/// (A, DQDᵀ, N = DSFᵀ, r = FRFᵀ) of [Klugt1987, App. F] for (τ_r, τ_f, E1, E2, E3, Ev).
 fn yaw_matrices(tau_r: f64, tau_f: f64, e1: f64, e2: f64, e3: f64, ev: f64) -> (M4, M4, V4, f64) {
     let mut a = M4::zeros();
     a[(0, 1)] = 1.0;
@@ -344,7 +311,7 @@ fn yaw_matrices(tau_r: f64, tau_f: f64, e1: f64, e2: f64, e3: f64, ev: f64) -> (
     (a, qd, n, e3 + ev)
 }
 
-/// App. F steady-state yaw-filter gains (k1..k4) and P for τ_r, τ_f and the noise intensities.
+/// [Klugt1987, App. F] steady-state yaw-filter gains (k1..k4) and P for τ_r, τ_f and the noise intensities.
 pub fn yaw_filter_gains(
     tau_r: f64,
     tau_f: f64,
@@ -389,7 +356,7 @@ pub struct YawFilter {
 impl YawFilter {
     /// Gains and P start at the CARE solution for the start E[w3²].
     pub fn new(params: YawFilterParams) -> Result<Self, String> {
-        params.validate().map_err(|e| e.to_string())?;
+        params.validate()?;
         let (k, p) = yaw_filter_gains(
             params.tau_r,
             params.tau_f(),
@@ -420,7 +387,7 @@ impl YawFilter {
     /// Replaces the model parameters (e.g. on-line τ_r, k_dr estimates or a new a); the state,
     /// P and the adaptation carry over.
     pub fn set_params(&mut self, params: YawFilterParams) -> Result<(), String> {
-        params.validate().map_err(|e| e.to_string())?;
+        params.validate()?;
         if params.adaptive != self.params.adaptive || !params.adaptive {
             self.e_w3 = params.e_w3;
         }
@@ -440,11 +407,6 @@ impl YawFilter {
 
     pub fn set_state(&mut self, x: [f64; 4]) {
         self.x = V4::from_row_slice(&x);
-    }
-
-    /// Noise-free sway state x̂1 (third-order model).
-    pub fn sway_state(&self) -> f64 {
-        self.x1
     }
 
     /// Prediction error z = y − (ψ̂ − x̂4) of the last sample.
@@ -472,8 +434,8 @@ impl YawFilter {
     }
 
     /// One sample: measured heading `y` and course-controller output `delta_psi` of sample k−1.
-    /// Order: innovation; state update with the gains of k−1 (Eq. 6.2); adaptation of E*[w3²];
-    /// one innovation-process step (Eq. 6.5 with L = 1/T) giving the gains for the next sample.
+    /// Order: innovation; state update with the gains of k−1 [Klugt1987, eq. (6.2)]; adaptation of E*[w3²];
+    /// one innovation-process step ([Klugt1987, eq. (6.5)] with L = 1/T) giving the gains for the next sample.
     #[inline]
     pub fn sample(&mut self, y: f64, delta_psi: f64, t: f64) {
         let p = self.params;
@@ -489,7 +451,7 @@ impl YawFilter {
             self.x1 += t * (-self.x1 + p.k_dv * delta_psi) / p.tau_v;
         }
         self.innovation = z;
-        // Eq. 5.12: complementary first-order split at 1/τ_f, low-pass filtered squares.
+        // [Klugt1987, eq. (5.12)]: complementary first-order split at 1/τ_f, low-pass filtered squares.
         let alpha = (t / tau_f).min(1.0);
         self.z_lf += alpha * (z - self.z_lf);
         let z_hf = z - self.z_lf;
@@ -529,39 +491,17 @@ impl YawFilter {
 // Speed filter
 // ---------------------------------------------------------------------------------------------
 
-/// Adaptation law of the speed filter (§5.5.3): exponent n of τ_f = τ0 (p1/|e_z|)^n.
+/// Adaptation law of the speed filter [Klugt1987, sec. 5.5.3]: exponent n of τ_f = τ0 (p1/|e_z|)^n.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub enum SpeedAdaptation {
     /// n = 0: C-filter (no adaptation).
     Constant,
-    /// n = 1: L-filter (the realised autopilot, §6.3.3).
+    /// n = 1: L-filter (the realised autopilot, [Klugt1987, sec. 6.3.3]).
     Linear,
     /// n = 2: Q-filter (the study's best compromise, c = 3).
     Quadratic,
     /// n = ∞: S-filter, switches between τ0 and τ_f,min.
     Switch,
-}
-
-impl SpeedAdaptation {
-    /// 0 C, 1 L, 2 Q, 3 S (the FMU's integer parameter).
-    pub fn from_index(i: i32) -> Option<Self> {
-        match i {
-            0 => Some(Self::Constant),
-            1 => Some(Self::Linear),
-            2 => Some(Self::Quadratic),
-            3 => Some(Self::Switch),
-            _ => None,
-        }
-    }
-
-    pub fn index(self) -> i32 {
-        match self {
-            Self::Constant => 0,
-            Self::Linear => 1,
-            Self::Quadratic => 2,
-            Self::Switch => 3,
-        }
-    }
 }
 
 /// Speed-filter parameters.
@@ -578,7 +518,7 @@ pub struct SpeedFilterParams {
 }
 
 impl SpeedFilterParams {
-    /// The simulation study of §5.5.3 (τ0 = 100 s, τ_min = 10 s, σ_z = 1) with law and c.
+    /// The simulation study of [Klugt1987, sec. 5.5.3] (τ0 = 100 s, τ_min = 10 s, σ_z = 1) with law and c.
     pub fn study(adaptation: SpeedAdaptation, c: f64) -> Self {
         SpeedFilterParams {
             tau0: 100.0,
@@ -589,24 +529,23 @@ impl SpeedFilterParams {
         }
     }
 
-    /// The realised autopilot (§6.3.3): L-filter with p1 = 2 (c = 2, σ_z = 1 speed unit); τ0 and
+    /// The realised autopilot [Klugt1987, sec. 6.3.3]: L-filter with p1 = 2 (c = 2, σ_z = 1 speed unit); τ0 and
     /// τ_min are not given, the study's 100 s and 10 s are used.
     pub fn realised() -> Self {
         Self::study(SpeedAdaptation::Linear, 2.0)
     }
 
     pub fn validate(&self) -> Result<(), ParamError> {
-        positive("speed_tau0", self.tau0)?;
-        positive("speed_tau_min", self.tau_min)?;
-        if self.tau_min > self.tau0 {
-            return Err(ParamError {
-                name: "speed_tau_min",
-                value: self.tau_min,
-                rule: "must be <= speed_tau0",
-            });
-        }
-        nonneg("speed_c", self.c)?;
-        positive("speed_sigma_z", self.sigma_z)?;
+        check_positive("speed_tau0", self.tau0)?;
+        check_positive("speed_tau_min", self.tau_min)?;
+        require(
+            self.tau_min <= self.tau0,
+            "speed_tau_min",
+            self.tau_min,
+            "must be <= speed_tau0",
+        )?;
+        check_non_negative("speed_c", self.c)?;
+        check_positive("speed_sigma_z", self.sigma_z)?;
         Ok(())
     }
 
@@ -639,7 +578,7 @@ pub struct SpeedFilter {
 
 impl SpeedFilter {
     pub fn new(params: SpeedFilterParams, u0: f64) -> Result<Self, String> {
-        params.validate().map_err(|e| e.to_string())?;
+        params.validate()?;
         Ok(SpeedFilter {
             tau_f: params.tau0,
             params,
@@ -667,7 +606,7 @@ impl SpeedFilter {
         self.innovation
     }
 
-    /// One sample: Û(k) = Û(k−1) + T/τ_f (U(k−1) − Û(k−1)) (Euler, Eq. 6.2; the gain T/τ_f is
+    /// One sample: Û(k) = Û(k−1) + T/τ_f (U(k−1) − Û(k−1)) (Euler, [Klugt1987, eq. (6.2)]; the gain T/τ_f is
     /// capped at 1).
     #[inline]
     pub fn sample(&mut self, u_meas: f64, t: f64) {
@@ -678,7 +617,7 @@ impl SpeedFilter {
     }
 }
 
-/// Eqs. 4.100-4.101: gains (k1, k2) of the second-order speed filter with high-pass coloured
+/// [Klugt1987, eqs. (4.100)-(4.101)]: gains (k1, k2) of the second-order speed filter with high-pass coloured
 /// measurement noise, for E[w²], E[v²] and the colouring time constant τ.
 pub fn second_order_speed_gains(e_w: f64, e_v: f64, tau: f64) -> (f64, f64) {
     let k1 = (e_w / e_v).sqrt();
@@ -720,7 +659,7 @@ impl RrsFilter {
         sample_time: f64,
         u0: f64,
     ) -> Result<Self, String> {
-        positive("sample_time", sample_time).map_err(|e| e.to_string())?;
+        check_positive("sample_time", sample_time)?;
         Ok(RrsFilter {
             roll: RollFilter::new(roll)?,
             yaw: YawFilter::new(yaw)?,
@@ -753,7 +692,7 @@ mod tests {
         (a - b).abs() <= tol
     }
 
-    /// Spec rrs_models_filters.md §6.2 [DERIVED]: ω_n = 0.63, z_n = 0.1058 (Table 2.4 at 11 m/s):
+    /// [DERIVED] from [Klugt1987, App. E] (not printed in the thesis): ω_n = 0.63, z_n = 0.1058 ([Klugt1987, Table 2.4] at 11 m/s):
     /// (q1, q2) = (1, 0.01) ⇒ K = (0.42488, 0.13275, 0.10000); (10, 0.001) ⇒ (1.20735, 0.76703,
     /// 0.03162); k3 = sqrt(q2). Tolerance: half a unit in the 5th decimal.
     #[test]
@@ -767,12 +706,12 @@ mod tests {
             assert!(close(*a, b, 0.5e-5), "{k:?}");
         }
         assert!(close(k[2], 0.001f64.sqrt(), 1e-10));
-        // Table 2.4 at 11 m/s gives the same ω_n, z_n
+        // [Klugt1987, Table 2.4] at 11 m/s gives the same ω_n, z_n
         let p = RollFilterParams::table_2_4(11.0, 1.0, 0.01);
         assert!(close(p.z_n, 0.1058, 1e-12) && p.omega_n == 0.63);
     }
 
-    /// The App. E element equations E.8-E.16 (the innovation process, forward-integrated from
+    /// The element equations [Klugt1987, eqs. (E.8)-(E.16)] (the innovation process, forward-integrated from
     /// P = 0) converge to the CARE gains.
     #[test]
     fn roll_innovation_process_e11_e16() {
@@ -806,7 +745,7 @@ mod tests {
     }
 
     /// The roll filter rejects a constant heel: y = φ_true + 0.1 with φ_true a roll oscillation;
-    /// after the transient φ̂ follows φ_true and x̂_v → 0.1 (the zero at s = 0 of φ̂/y, §6.2).
+    /// after the transient φ̂ follows φ_true and x̂_v → 0.1 (the zero at s = 0 of φ̂/y, derived here).
     #[test]
     fn roll_filter_rejects_constant_heel() {
         let p = RollFilterParams {
@@ -830,7 +769,7 @@ mod tests {
         assert!(worst < 0.01, "{worst}");
     }
 
-    /// Spec §6.2 [DERIVED] / appendix: τ_r = 1.18 s, τ_f = 5.9 s, E1 = 0.1, E2 = 1e-4, E3 = 1,
+    /// [DERIVED] from [Klugt1987, App. F] (not printed in the thesis): τ_r = 1.18 s, τ_f = 5.9 s, E1 = 0.1, E2 = 1e-4, E3 = 1,
     /// Ev = 0.01 ⇒ K = (0.29589, 0.04623, 0.00995, 0.02601); k3 = sqrt(E2/(E3 + Ev)).
     /// Tolerance half a unit in the 5th decimal. τ_f = 5.9 s is a = 0.2 in the τ_f = τ_r/a reading.
     #[test]
@@ -854,7 +793,7 @@ mod tests {
     }
 
     /// The on-line innovation process (one Euler step of the Riccati ODE per sample) started from
-    /// P = 0 converges to the App. F CARE gains (F.8-F.11).
+    /// P = 0 converges to the CARE gains of [Klugt1987, eqs. (F.8)-(F.11)].
     #[test]
     fn yaw_innovation_process_converges() {
         let p = YawFilterParams {
@@ -879,11 +818,12 @@ mod tests {
         }
     }
 
-    /// Spec §6.2: speed-filter gains of Eqs. 4.100-4.101 agree with the CARE with cross term:
+    /// Speed-filter gains of [Klugt1987, eqs. (4.100)-(4.101)] agree with the CARE with cross term (reference
+    /// values computed from the closed form, not printed in the thesis):
     /// (1e-4, 1, 20) ⇒ (0.01, 0.026834); (1e-2, 1, 5) ⇒ (0.1, 0.076393); (1, 0.5, 3) ⇒
     /// (1.41421, 0.032085).
     #[test]
-    // 1.41421 is the spec's printed value, not an approximation of √2 to be replaced
+    // 1.41421 is the rounded reference value, not an approximation of √2 to be replaced
     #[allow(clippy::approx_constant)]
     fn second_order_speed_filter_gains() {
         for (ew, ev, tau, k1, k2) in [
@@ -907,7 +847,7 @@ mod tests {
         }
     }
 
-    /// One 500 s step run of the study (§5.5.3): U = 10 + v (v ~ N(0, 1) per sample), Û(0) = 0,
+    /// One 500 s step run of the study [Klugt1987, sec. 5.5.3]: U = 10 + v (v ~ N(0, 1) per sample), Û(0) = 0,
     /// sample time `t`. Returns (mean square of u − Û, t_5% = first time |u − Û| < 0.5).
     fn step_run(params: SpeedFilterParams, t: f64, seed: u64) -> (f64, f64) {
         let mut f = SpeedFilter::new(params, 0.0).unwrap();
@@ -932,15 +872,15 @@ mod tests {
         SpeedAdaptation::Switch,
     ];
 
-    /// Table 5.4 (σ_z² over the 500 s step run, step 0 → 10, τ0 = 100 s, τ_min = 10 s, unit noise),
+    /// [Klugt1987, Table 5.4] (σ_z² over the 500 s step run, step 0 → 10, τ0 = 100 s, τ_min = 10 s, unit noise),
     /// averaged over 200 seeds at T = 0.1 s and T = 0.5 s: C 10.0; L 1.7/3.4/4.9/6.2;
     /// Q 1.1/1.6/2.7/4.2; S 1.0/1.1/1.3/1.7 (c = 1..4).
     /// Ours (T = 0.1 s): C 10.005; L 1.728/3.383/4.888/6.201; Q 1.081/1.621/2.714/4.148;
     /// S 1.014/1.055/1.228/1.609. The S row is not reproduced to its last digit: the literal rule
-    /// gives 1.0/1.1/1.2/1.6 (as the spec's reproduction note, rrs_controller_results.md §4.1, and
-    /// its independent re-computation found; the thesis's noise generation and T are unknown); S is
+    /// gives 1.0/1.1/1.2/1.6 (two independent re-computations found the same; the thesis's noise
+    /// generation and T are unknown); S is
     /// held to ±0.15, the other rows to ±0.1 (the printed precision plus the seed-average spread).
-    /// Table 5.3 (t_5%) is reproduced only in trend (spec appendix): ours C 299 (thesis 289, held
+    /// [Klugt1987, Table 5.3] (t_5%) is reproduced only in trend: ours C 299 (thesis 289, held
     /// within 5 %), L 108/193/239/262 (128/188/245/270), Q 52/139/204/239 (58/159/203/245),
     /// S 32/46/99/163 (37/58/148/182); asserted: for every c the ordering S < Q < L < C, and L and
     /// Q increasing with c.
@@ -991,7 +931,7 @@ mod tests {
     }
 
     /// The realised speed filter (L, p1 = 2) follows a 5 → 20 kn speed change with much less lag
-    /// than the C-filter with the same noise suppression (T6, Fig. 7.24).
+    /// than the C-filter with the same noise suppression [Klugt1987, Fig. 7.24].
     #[test]
     fn l_filter_tracks_a_speed_change_faster_than_c_filter() {
         let mut l = SpeedFilter::new(SpeedFilterParams::realised(), 5.0).unwrap();

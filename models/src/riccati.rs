@@ -1,16 +1,17 @@
-//! Algebraic and differential Riccati equations, Lyapunov equations and the gains built on them.
+//! Algebraic and differential Riccati equations and the LQ and Kalman–Bucy gains built on them.
 //!
 //! Shared by the observers (Kalman gains are the dual problem) and the controllers (LQ gains).
 //!
 //! * CARE `AᵀP + PA − PBR⁻¹BᵀP + Q = 0`: the Hamiltonian matrix sign function with determinant
 //!   scaling (Roberts 1971; Byers 1987; Gardiner & Laub 1986), followed by Newton–Kleinman
-//!   refinement steps (Kleinman 1968) that drive the residual to rounding level.
-//! * Newton–Kleinman alone from a stabilising gain, as an independent second algorithm.
-//! * DARE `P = AᵀPA − AᵀPB(R + BᵀPB)⁻¹BᵀPA + Q`: the structure-preserving doubling algorithm
-//!   (Chu, Fan, Lin & Wang 2004).
-//! * The forward-integrated differential Riccati equation, the "innovation process" of
-//!   van der Klugt (1987) Ch. 3 / App. A–D: `Ṗ = AᵀP + PA − PBR⁻¹BᵀP + Q`, P(0) given, whose
-//!   limit is the CARE solution.
+//!   refinement steps (Kleinman 1968), each a Lyapunov solve, that drive the residual to
+//!   rounding level. The tests cross-check it against Newton–Kleinman alone from a stabilising
+//!   gain, an independent algorithm.
+//! * [`lqr`], [`kalman_bucy`] and [`kalman_bucy_correlated`]: the gains of the controllers and
+//!   observers.
+//! * [`RiccatiFlow`]: the forward-integrated differential Riccati equation, the "innovation
+//!   process" of [Klugt1987, ch. 3 and App. A–D]: `Ṗ = AᵀP + PA − PBR⁻¹BᵀP + Q`, P(0) given,
+//!   whose limit is the CARE solution.
 //!
 //! Matrices are `nalgebra::DMatrix<f64>`; these are design-time computations (at initialization
 //! or on a slow adaptation clock), never in a model's per-step path.
@@ -74,16 +75,10 @@ fn symmetrize(p: &M) -> M {
     (p + p.transpose()) * 0.5
 }
 
-/// Residual `AᵀP + PA − PBR⁻¹BᵀP + Q`.
-pub fn care_residual(a: &M, b: &M, q: &M, r: &M, p: &M) -> Result<M, RiccatiError> {
-    let rinv = r.clone().try_inverse().ok_or(RiccatiError::Singular("R"))?;
-    Ok(a.transpose() * p + p * a - p * b * rinv * b.transpose() * p + q)
-}
-
 /// Solves the continuous Lyapunov equation `A X + X Aᵀ + Q = 0` by the Kronecker form
 /// `(I ⊗ A + A ⊗ I) vec(X) = −vec(Q)` with an LU solve (exact to rounding for the small orders of
 /// ship models, n ≤ ~30).
-pub fn lyapunov(a: &M, q: &M) -> Result<M, RiccatiError> {
+fn lyapunov(a: &M, q: &M) -> Result<M, RiccatiError> {
     let n = a.nrows();
     check_square("A", a, n)?;
     check_square("Q", q, n)?;
@@ -184,27 +179,6 @@ pub fn care(a: &M, b: &M, q: &M, r: &M) -> Result<M, RiccatiError> {
     Ok(p)
 }
 
-/// CARE by Newton–Kleinman iteration alone, from a gain `k0` that makes `A − B k0` stable. An
-/// algorithm independent of [`care`], used to cross-check it.
-pub fn care_newton_kleinman(a: &M, b: &M, q: &M, r: &M, k0: &M) -> Result<M, RiccatiError> {
-    check_care_dims(a, b, q, r)?;
-    let rinv = r.clone().try_inverse().ok_or(RiccatiError::Singular("R"))?;
-    let ac = a - b * k0;
-    let mut p = lyapunov(&ac.transpose(), &(q + k0.transpose() * r * k0))?;
-    let mut last_change = f64::INFINITY;
-    for _ in 0..200 {
-        let next = kleinman_step(a, b, q, r, &rinv, &p)?;
-        let change = (&next - &p).norm() / next.norm().max(1e-300);
-        p = next;
-        // quadratic convergence ends at rounding level: stop when the change stops shrinking
-        if change < 1e-14 || (change < 1e-8 && change >= last_change) {
-            return Ok(p);
-        }
-        last_change = change;
-    }
-    Err(RiccatiError::NoConvergence("Newton–Kleinman"))
-}
-
 /// LQ state-feedback gain `K = R⁻¹BᵀP` for `u = −Kx` minimising ∫ xᵀQx + uᵀRu dt.
 pub fn lqr(a: &M, b: &M, q: &M, r: &M) -> Result<M, RiccatiError> {
     let p = care(a, b, q, r)?;
@@ -229,8 +203,8 @@ pub fn kalman_bucy(a: &M, c: &M, g: &M, qw: &M, rv: &M) -> Result<(M, M), Riccat
     Ok((&p * c.transpose() * rinv, p))
 }
 
-/// Steady-state Kalman–Bucy gain with correlated process and measurement noise (van der Klugt
-/// 1987 eqs. 4.16–4.17 and 4.78–4.79): process noise intensity `DQDᵀ` = `qd`, measurement noise
+/// Steady-state Kalman–Bucy gain with correlated process and measurement noise
+/// [Klugt1987, eqs. (4.16)–(4.17) and (4.78)–(4.79)]: process noise intensity `DQDᵀ` = `qd`, measurement noise
 /// intensity `rv`, cross intensity `n` = E[D w vᵀ] (n × p). `K = (PCᵀ + N) Rv⁻¹` with P the
 /// stabilising solution of `AP + PAᵀ + DQDᵀ − (PCᵀ + N) Rv⁻¹ (PCᵀ + N)ᵀ = 0`, solved as the
 /// standard problem with `Ā = A − N Rv⁻¹ C` and `Q̄ = DQDᵀ − N Rv⁻¹ Nᵀ`. Returns (K, P).
@@ -257,53 +231,8 @@ pub fn kalman_bucy_correlated(a: &M, c: &M, qd: &M, rv: &M, n: &M) -> Result<(M,
     Ok(((&p * c.transpose() + n) * rinv, p))
 }
 
-/// Stabilising solution of the DARE `P = AᵀPA − AᵀPB(R + BᵀPB)⁻¹BᵀPA + Q` by the
-/// structure-preserving doubling algorithm.
-pub fn dare(a: &M, b: &M, q: &M, r: &M) -> Result<M, RiccatiError> {
-    let (n, _) = check_care_dims(a, b, q, r)?;
-    let rinv = r.clone().try_inverse().ok_or(RiccatiError::Singular("R"))?;
-    let eye = M::identity(n, n);
-    let mut ak = a.clone();
-    let mut gk = b * rinv * b.transpose();
-    let mut hk = q.clone();
-    for _ in 0..100 {
-        let w = (&eye + &gk * &hk)
-            .try_inverse()
-            .ok_or(RiccatiError::NoConvergence("doubling: I + GH singular"))?;
-        let aw = &ak * &w;
-        let a_next = &aw * &ak;
-        let g_next = &gk + &aw * &gk * ak.transpose();
-        let h_next = &hk + ak.transpose() * &hk * &w * &ak;
-        let change = (&h_next - &hk).norm() / h_next.norm().max(1e-300);
-        ak = a_next;
-        gk = symmetrize(&g_next);
-        hk = symmetrize(&h_next);
-        if change < 1e-15 {
-            return Ok(hk);
-        }
-    }
-    Err(RiccatiError::NoConvergence("doubling algorithm"))
-}
-
-/// Residual of the DARE.
-pub fn dare_residual(a: &M, b: &M, q: &M, r: &M, p: &M) -> Result<M, RiccatiError> {
-    let s = (r + b.transpose() * p * b)
-        .try_inverse()
-        .ok_or(RiccatiError::Singular("R + BᵀPB"))?;
-    Ok(a.transpose() * p * a - a.transpose() * p * b * s * b.transpose() * p * a + q - p)
-}
-
-/// Discrete LQ gain `K = (R + BᵀPB)⁻¹BᵀPA` for `u_k = −K x_k`.
-pub fn dlqr(a: &M, b: &M, q: &M, r: &M) -> Result<M, RiccatiError> {
-    let p = dare(a, b, q, r)?;
-    let s = (r + b.transpose() * &p * b)
-        .try_inverse()
-        .ok_or(RiccatiError::Singular("R + BᵀPB"))?;
-    Ok(s * b.transpose() * p * a)
-}
-
-/// The differential Riccati equation integrated forward in time (van der Klugt's "innovation
-/// process", thesis Ch. 3, App. A–D): `Ṗ = AᵀP + PA − PBR⁻¹BᵀP + Q`.
+/// The differential Riccati equation integrated forward in time (the "innovation process" of
+/// [Klugt1987, ch. 3 and App. A–D]): `Ṗ = AᵀP + PA − PBR⁻¹BᵀP + Q`.
 #[derive(Clone, Debug)]
 pub struct RiccatiFlow {
     a: M,
@@ -341,30 +270,6 @@ impl RiccatiFlow {
     }
 }
 
-/// Zero-order-hold discretisation of `ẋ = Ax + Bu` over `t`: (Φ, Γ) from the exponential of
-/// `[[A, B], [0, 0]]·t`.
-pub fn zoh(a: &M, b: &M, t: f64) -> Result<(M, M), RiccatiError> {
-    let n = a.nrows();
-    check_square("A", a, n)?;
-    if b.nrows() != n {
-        return Err(RiccatiError::Dimension("B rows".into()));
-    }
-    let m = b.ncols();
-    let mut aug = M::zeros(n + m, n + m);
-    aug.view_mut((0, 0), (n, n)).copy_from(&(a * t));
-    aug.view_mut((0, n), (n, m)).copy_from(&(b * t));
-    let e = aug.exp();
-    Ok((
-        e.view((0, 0), (n, n)).clone_owned(),
-        e.view((0, n), (n, m)).clone_owned(),
-    ))
-}
-
-/// Forward-Euler discretisation over `t`: (I + At, Bt).
-pub fn euler(a: &M, b: &M, t: f64) -> (M, M) {
-    (M::identity(a.nrows(), a.ncols()) + a * t, b * t)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -372,6 +277,33 @@ mod tests {
 
     fn rel(a: &M, b: &M) -> f64 {
         (a - b).norm() / b.norm()
+    }
+
+    /// Residual `AᵀP + PA − PBR⁻¹BᵀP + Q`.
+    fn care_residual(a: &M, b: &M, q: &M, r: &M, p: &M) -> Result<M, RiccatiError> {
+        let rinv = r.clone().try_inverse().ok_or(RiccatiError::Singular("R"))?;
+        Ok(a.transpose() * p + p * a - p * b * rinv * b.transpose() * p + q)
+    }
+
+    /// CARE by Newton–Kleinman iteration alone, from a gain `k0` that makes `A − B k0` stable. An
+    /// algorithm independent of [`care`], used to cross-check it.
+    fn care_newton_kleinman(a: &M, b: &M, q: &M, r: &M, k0: &M) -> Result<M, RiccatiError> {
+        check_care_dims(a, b, q, r)?;
+        let rinv = r.clone().try_inverse().ok_or(RiccatiError::Singular("R"))?;
+        let ac = a - b * k0;
+        let mut p = lyapunov(&ac.transpose(), &(q + k0.transpose() * r * k0))?;
+        let mut last_change = f64::INFINITY;
+        for _ in 0..200 {
+            let next = kleinman_step(a, b, q, r, &rinv, &p)?;
+            let change = (&next - &p).norm() / next.norm().max(1e-300);
+            p = next;
+            // quadratic convergence ends at rounding level: stop when the change stops shrinking
+            if change < 1e-14 || (change < 1e-8 && change >= last_change) {
+                return Ok(p);
+            }
+            last_change = change;
+        }
+        Err(RiccatiError::NoConvergence("Newton–Kleinman"))
     }
 
     /// Double integrator, Q = I, R = 1: P = [[√3, 1], [1, √3]] (closed form).
@@ -405,17 +337,6 @@ mod tests {
         }
     }
 
-    /// Scalar DARE: p = a²p − a²p²b²/(r + b²p) + q, solved in closed form as a quadratic.
-    #[test]
-    fn dare_scalar_closed_form() {
-        let (a, b, q, r) = (1.2f64, 0.5f64, 1.0f64, 2.0f64);
-        // b²p² + (r − a²r − qb²)p − qr = 0
-        let (qa, qb, qc) = (b * b, r - a * a * r - q * b * b, -q * r);
-        let expected = (-qb + (qb * qb - 4.0 * qa * qc).sqrt()) / (2.0 * qa);
-        let p = dare(&dmatrix![a], &dmatrix![b], &dmatrix![q], &dmatrix![r]).unwrap()[(0, 0)];
-        assert!((p - expected).abs() < 1e-12 * expected, "{p} vs {expected}");
-    }
-
     /// Lyapunov: A X + X Aᵀ + Q = 0 for a diagonal A has X_ij = −Q_ij/(a_i + a_j).
     #[test]
     fn lyapunov_diagonal_closed_form() {
@@ -446,8 +367,7 @@ mod tests {
 
     /// Random (generically stabilisable, often open-loop unstable) systems of order 1..=10: the
     /// sign-function CARE agrees with Newton–Kleinman (an independent algorithm) to 1e-9 relative,
-    /// leaves a residual at rounding level and gives a stable closed loop; the DARE solution of
-    /// the ZOH-discretised system is checked by its residual and closed-loop stability.
+    /// leaves a residual at rounding level and gives a stable closed loop.
     #[test]
     fn random_systems_up_to_order_10() {
         let mut rng = Rng(0x9e3779b97f4a7c15);
@@ -482,18 +402,6 @@ mod tests {
                 );
                 let cl = &a - &b * k;
                 assert!(cl.complex_eigenvalues().iter().all(|l| l.re < 0.0));
-                // discrete problem
-                let (phi, gam) = zoh(&a, &b, 0.1).unwrap();
-                let pd = dare(&phi, &gam, &q, &r).unwrap();
-                let resd = dare_residual(&phi, &gam, &q, &r, &pd).unwrap();
-                assert!(
-                    resd.norm() < 1e-9 * pd.norm().max(1.0),
-                    "n={n}: dare residual {}",
-                    resd.norm()
-                );
-                let kd = dlqr(&phi, &gam, &q, &r).unwrap();
-                let cld = &phi - &gam * kd;
-                assert!(cld.complex_eigenvalues().iter().all(|l| l.norm() < 1.0));
             }
         }
     }
@@ -513,23 +421,15 @@ mod tests {
         assert!(rel(&flow.p, &p_inf) < 1e-8, "{}", rel(&flow.p, &p_inf));
     }
 
-    /// ZOH of a first-order lag 1/(τs + 1): Φ = e^(−T/τ), Γ = 1 − e^(−T/τ).
-    #[test]
-    fn zoh_first_order_closed_form() {
-        let tau = 2.0;
-        let (phi, gam) = zoh(&dmatrix![-1.0 / tau], &dmatrix![1.0 / tau], 0.5).unwrap();
-        let e = (-0.25f64).exp();
-        assert!((phi[(0, 0)] - e).abs() < 1e-15 && (gam[(0, 0)] - (1.0 - e)).abs() < 1e-15);
-    }
-
-    /// Speed filter with high-pass coloured measurement noise (van der Klugt 1987 §4.5.2,
-    /// eqs. 4.91–4.101): x = (speed, x_v), A = [[0,0],[0,−1/τ]], D = [[1,0],[0,1/τ]],
+    /// Speed filter with high-pass coloured measurement noise [Klugt1987, sec. 4.5.2,
+    /// eqs. (4.91)–(4.101)]: x = (speed, x_v), A = [[0,0],[0,−1/τ]], D = [[1,0],[0,1/τ]],
     /// C = (1 −1), w = (w, v), R = E[v²], S = (0, E[v²])ᵀ. Closed form k1 = √(E[w²]/E[v²]),
-    /// k2 = (k1τ + 1 − √(k1²τ² + 2k1τ))/τ; spec rrs_models_filters.md §6.2 lists
+    /// k2 = (k1τ + 1 − √(k1²τ² + 2k1τ))/τ ([Klugt1987, eqs. (4.100)–(4.101)]); reference values
+    /// computed from that closed form (not printed in the thesis), rounded:
     /// (1e−4, 1, 20) ⇒ (0.01, 0.026834), (1e−2, 1, 5) ⇒ (0.1, 0.076393), (1, 0.5, 3) ⇒
     /// (1.41421, 0.032085).
     #[test]
-    // 1.41421 is the spec's printed value, not an approximation of √2 to be replaced
+    // 1.41421 is the rounded reference value, not an approximation of √2 to be replaced
     #[allow(clippy::approx_constant)]
     fn correlated_noise_speed_filter_gains() {
         for (ew, ev, tau, k1_ref, k2_ref) in [
@@ -551,13 +451,13 @@ mod tests {
                 (k[(0, 0)] - k1).abs() < 1e-10 && (k[(1, 0)] - k2).abs() < 1e-10,
                 "{k}"
             );
-            // the spec's printed values, to their last digit
+            // the rounded reference values, to their last digit
             assert!((k[(0, 0)] - k1_ref).abs() < 6e-6 && (k[(1, 0)] - k2_ref).abs() < 6e-7);
         }
     }
 
     /// A stable but uncontrollable mode at −ε puts Hamiltonian eigenvalues at ±ε (as the random
-    /// walk disturbance states of the 004 design do). Closed form: P = diag(1/(2ε), 1).
+    /// walk disturbance states of the design of [Parsons1980, sec. 3.3] do). Closed form: P = diag(1/(2ε), 1).
     #[test]
     fn care_with_hamiltonian_eigenvalues_near_the_axis() {
         for eps in [1e-2, 1e-4, 1e-6] {
