@@ -16,8 +16,9 @@
 //!   ParameterEkf; the identified linear model's 10° turning circle against the plant's
 //!   (computed here with the models crate from the FMU's identified coefficients): AT-11.
 
-use crate::study::{after, series, Check, Env, Report};
+use crate::study::{after, col, last, max_abs, mean, series, std_dev, Check, Env, Report};
 use models::hull::container_ship::{ContainerShip, L as CS_L, LIN_B, LIN_M};
+use models::hull::{DEG, KNOT};
 use models::hull::nomoto::{NomotoInputs, NomotoModel, NomotoShip};
 use models::manoeuvre::{
     run as run_manoeuvre, turning_circle, ContainerShipRun, ManoeuvreGenerator, ManoeuvreKind,
@@ -25,27 +26,12 @@ use models::manoeuvre::{
 };
 use shipsim::plot::{Panel, Series, Table};
 
-const DEG: f64 = std::f64::consts::PI / 180.0;
 /// DDG-51 length 466 ft [m] and speed 22 kn [m/s] of the time base t' = tU/L.
 const L: f64 = 142.0368;
 const U: f64 = 11.317777777777778;
-const KNOT: f64 = 1852.0 / 3600.0;
 const T_NOMOTO: f64 = 1.9287;
 /// Rudder-equivalent wave yaw gain of systems/autopilot_track_offset.toml [rad per m].
 const WAVE_YAW_GAIN: f64 = 0.0745;
-
-fn col<'a>(t: &'a Table, c: &str) -> Result<&'a [f64], String> {
-    t.column(c).map_err(|e| e.to_string())
-}
-
-fn max_abs(v: &[f64]) -> f64 {
-    v.iter().fold(0.0_f64, |a, x| a.max(x.abs()))
-}
-
-fn std(v: &[f64]) -> f64 {
-    let m = v.iter().sum::<f64>() / v.len() as f64;
-    (v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / v.len() as f64).sqrt()
-}
 
 /// Largest peak-to-peak of `v` over consecutive windows of `n` samples.
 fn max_window_p2p(v: &[f64], n: usize) -> f64 {
@@ -126,7 +112,7 @@ fn current_rejection(env: &Env, report: &mut Report) -> Result<(), String> {
         .iter()
         .map(|v| v / DEG)
         .collect();
-    let jitter = std(&rud);
+    let jitter = std_dev(&rud);
     let p2p5 = max_window_p2p(&rud, 100); // 5 s windows at 0.05 s
     report.checks.push(Check::range(
         "AT-6 actual-rudder steady jitter (std, t > 200 s), heading noise 0.05 deg",
@@ -141,12 +127,12 @@ fn current_rejection(env: &Env, report: &mut Report) -> Result<(), String> {
         "commanded rudder very noisy, actual smooth (Fig 5-9)",
         format!(
             "command std {:.3} deg, actual {:.3} deg (ratio {:.2}); largest 5 s peak-to-peak of the actual {:.3} deg",
-            std(&cmd),
+            std_dev(&cmd),
             jitter,
-            jitter / std(&cmd),
+            jitter / std_dev(&cmd),
             p2p5
         ),
-        jitter < 0.5 * std(&cmd),
+        jitter < 0.5 * std_dev(&cmd),
     ));
     let y = col(&t, "ship.y")?;
     let peak = max_abs(y) / L;
@@ -186,7 +172,7 @@ fn current_rejection(env: &Env, report: &mut Report) -> Result<(), String> {
          with sigma = 0.05 deg (our choice, sampled every 1 s) the actual rudder's steady std is {jitter:.3} deg; \
          with the Sensors preset 0.092 deg (0.001611 rad, Parsons & Cuong Table 3) it is {:.3} deg, so \
          AT-6's 0.1 deg holds for heading noise below about {:.3} deg.",
-        std(&rud2),
+        std_dev(&rud2),
         0.1 / jitter * 0.05
     ));
     report.notes.push(format!(
@@ -339,7 +325,7 @@ fn current_rejection_nonlinear(env: &Env, report: &mut Report) -> Result<(), Str
         .iter()
         .map(|v| v / DEG)
         .collect();
-    let jitter = std(&rud);
+    let jitter = std_dev(&rud);
     report.checks.push(Check::range(
         "AT-6 (nonlinear plant) actual-rudder steady jitter (std, t > 200 s)",
         "< 0.1 deg (L2433-2437)",
@@ -516,7 +502,7 @@ fn track_offset(env: &Env, report: &mut Report) -> Result<(), String> {
         "yd",
     ));
     let psi = after(&t, "ship.heading", 1200.0)?;
-    let psi_mean = psi.iter().sum::<f64>() / psi.len() as f64 / DEG;
+    let psi_mean = mean(psi) / DEG;
     let crab = -(5.0 / 22.0_f64).asin() / DEG;
     report.checks.push(Check::abs(
         "AT-9 steady heading offset into the current (current to starboard: negative)",
@@ -551,12 +537,12 @@ fn track_offset(env: &Env, report: &mut Report) -> Result<(), String> {
             .collect();
         Ok((
             max_abs(&d) / 0.9144,
-            std(after(&tw, "waves.yaw_moment", 900.0)?) / DEG,
+            std_dev(after(&tw, "waves.yaw_moment", 900.0)?) / DEG,
         ))
     };
     let (osc_calm, _) = osc_at(0.0, "calm")?;
     let (osc_10, dist_10) = osc_at(10.0 * WAVE_YAW_GAIN, "waves_x10")?;
-    let dist = std(after(&t, "waves.yaw_moment", 900.0)?) / DEG;
+    let dist = std_dev(after(&t, "waves.yaw_moment", 900.0)?) / DEG;
     report.checks.push(Check::holds(
         "AT-9 the wave disturbance acts on the loop (SS4 vs calm water, same noise)",
         "waves move the ship about the track (Figs 5-22 to 5-24)",
@@ -654,12 +640,11 @@ fn identification(env: &Env, report: &mut Report) -> Result<(), String> {
         &[],
         "identification_zigzag.csv",
     )?;
-    let last = |c: &str| -> Result<f64, String> { Ok(*col(&t, c)?.last().unwrap()) };
     let n = [
-        last("kf.neg_y_v_mean")?,
-        last("kf.m_minus_y_r_mean")?,
-        last("kf.neg_n_v_mean")?,
-        last("kf.mxg_minus_n_r_mean")?,
+        last(&t, "kf.neg_y_v_mean")?,
+        last(&t, "kf.m_minus_y_r_mean")?,
+        last(&t, "kf.neg_n_v_mean")?,
+        last(&t, "kf.mxg_minus_n_r_mean")?,
     ];
     let plant = ContainerShip::at_equilibrium(80.0).map_err(|e| format!("{e:?}"))?;
     let u0 = plant.outputs().u;
@@ -716,8 +701,8 @@ fn identification(env: &Env, report: &mut Report) -> Result<(), String> {
         n[1],
         n[2],
         n[3],
-        last("kf.nomoto_time_constant_prime")?,
-        last("kf.nomoto_gain_prime")?,
+        last(&t, "kf.nomoto_time_constant_prime")?,
+        last(&t, "kf.nomoto_gain_prime")?,
         tp.tactical_diameter,
         tp.steady_diameter,
         100.0 * tact,

@@ -3,11 +3,11 @@
 //! a zig-zag and a coasting stop of the ContainerShip, for S_p = 0.001, 0.01, 0.1, through the
 //! master (`systems/dgps_trial.toml`, `systems/dgps_stopping.toml`).
 
-use crate::study::{series, Check, Env, Report};
+use crate::study::{col, series, Check, Env, Report};
+use models::hull::DEG;
 use shipsim::plot::{Panel, Series, Table};
 use std::f64::consts::PI;
 
-const DEG: f64 = PI / 180.0;
 /// [DERIVED] steady-state velocity lag of the filter per unit acceleration / turn rate [s]
 /// (spec §3.4) for S_p = 0.001, 0.01, 0.1.
 const LAG: [f64; 3] = [10.76, 5.85, 3.10];
@@ -17,10 +17,6 @@ const KF: [&str; 3] = ["kf_low", "kf", "kf_high"];
 const SP: [&str; 3] = ["0.001", "0.01", "0.1"];
 /// Length ratio of the ContainerShip (175 m) to the paper's tanker (~100 m).
 const SCALE: f64 = 1.75;
-
-fn col<'a>(t: &'a Table, name: &str) -> Result<&'a [f64], String> {
-    t.column(name).map_err(|e| e.to_string())
-}
 
 fn wrap(a: f64) -> f64 {
     (a + PI).rem_euclid(2.0 * PI) - PI

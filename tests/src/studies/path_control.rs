@@ -13,17 +13,16 @@
 //! S5 (ABC harbour, Fig. 5 lost) and S8 (Table 7, a covariance analysis, not a simulation) are
 //! not run; the estimator scenarios (WLS S9-S13, MVE S14) are the `path_estimation` study.
 
-use crate::study::{Check, Env, Report};
+use super::path_common::{run_until, DT};
+use crate::study::{col, half_digit, last, max_abs, overrides_text, Check, Env, Report, Spread};
 use models::controllers::path::{path_gains, PathDesignModel};
 use models::disturbances::current::{design_current_profile, passing_ship};
 use models::hull::tokyo_maru::{TokyoMaruCoefficients, L, T_R, U};
+use models::hull::DEG;
 use shipsim::plot::{Panel, Series, Table};
 
-const DEG: f64 = std::f64::consts::PI / 180.0;
 /// Half beam B/2 [m]: the initial offset of S1/S3.
 const HALF_BEAM: f64 = 23.75;
-/// Δt′ of the report (one communication step).
-const DT: f64 = 0.005;
 const SEEDS: u64 = 20;
 const CURRENT: &str = "path_control_current.toml";
 const PASSING: &str = "path_control_passing_ship.toml";
@@ -112,10 +111,6 @@ struct Run {
     table: Table,
 }
 
-fn col<'a>(t: &'a Table, name: &str) -> Result<&'a [f64], String> {
-    t.column(name).map_err(|e| e.to_string())
-}
-
 impl Run {
     fn new(table: Table, eta_offset: f64) -> Result<Run, String> {
         let scale = |name: &str, s: f64, o: f64| -> Result<Vec<f64>, String> {
@@ -187,17 +182,6 @@ fn run_scenario(env: &Env, s: &Scenario, extra: &[String], csv: &str) -> Result<
     Run::new(table, if s.file == PASSING { HALF_BEAM } else { 0.0 })
 }
 
-/// [`Env::run`] stopped at t′ = `stop_prime` ship lengths (one base step is Δt′ = DT).
-fn run_until(
-    env: &Env,
-    file: &str,
-    sets: &[String],
-    csv: &str,
-    stop_prime: f64,
-) -> Result<Table, String> {
-    env.run_steps(file, sets, csv, Some((stop_prime / DT).round() as u64))
-}
-
 fn noise_free(env: &Env, s: &Scenario, csv: &str) -> Result<Run, String> {
     run_scenario(env, s, &["sensors.noise_scale=0".to_string()], csv)
 }
@@ -211,40 +195,17 @@ fn rel2(quantity: &str, published: f64, ours: f64, scale: f64, unit: &str) -> Ch
     c
 }
 
-/// Spread of a statistic over the seeds.
-struct Spread {
-    min: f64,
-    max: f64,
-    mean: f64,
-}
-
-fn spread(v: &[f64]) -> Spread {
-    Spread {
-        min: v.iter().cloned().fold(f64::INFINITY, f64::min),
-        max: v.iter().cloned().fold(f64::NEG_INFINITY, f64::max),
-        mean: v.iter().sum::<f64>() / v.len() as f64,
-    }
-}
-
-/// The printed value lies within the seeds' min..max, widened by `half_digit` (half a unit of
-/// the printed last digit).
-fn within_seeds(quantity: &str, printed: &str, s: &Spread, half_digit: f64, unit: &str) -> Check {
-    let p: f64 = printed.parse().unwrap_or(f64::NAN);
-    let lo = s.min - half_digit;
-    let hi = s.max + half_digit;
+/// The printed value lies within the seeds' min..max, widened by half a unit of its last digit.
+fn within_seeds(quantity: &str, printed: &str, s: &Spread, unit: &str) -> Check {
     Check {
         quantity: quantity.to_string(),
         published: format!("{printed} {unit}").trim().to_string(),
-        ours: format!(
-            "{} .. {} (mean {}) {unit}",
-            crate::study::fmt_num(s.min),
-            crate::study::fmt_num(s.max),
-            crate::study::fmt_num(s.mean)
-        )
-        .trim()
-        .to_string(),
-        tolerance: format!("printed value within the {SEEDS} seeds' range ±{half_digit}"),
-        pass: (lo..=hi).contains(&p),
+        ours: format!("{s} {unit}").trim().to_string(),
+        tolerance: format!(
+            "printed value within the {SEEDS} seeds' range ±{}",
+            half_digit(printed)
+        ),
+        pass: s.covers(printed),
     }
 }
 
@@ -621,20 +582,17 @@ pub fn run(env: &Env) -> Result<Report, String> {
         "deg",
     ));
     // S7 really ran the Table 8 design (spec §3, ±1.5 in the last printed digit).
-    let last = |r: &Run, name: &str| -> Result<f64, String> {
-        Ok(*col(&r.table, name)?.last().ok_or("empty run")?)
-    };
     c.push(Check::abs(
         "S7 controller gain c13 (β′) after the adaptation = Table 8",
         1.8986,
-        last(&s7, "ctl.gain_drift_angle")?,
+        last(&s7.table, "ctl.gain_drift_angle")?,
         1.5e-4,
         "",
     ));
     c.push(Check::abs(
         "S7 controller design f23 = Table 2 at ∞",
         3.1591,
-        last(&s7, "ctl.design_f23")?,
+        last(&s7.table, "ctl.design_f23")?,
         1e-12,
         "",
     ));
@@ -692,7 +650,7 @@ pub fn run(env: &Env) -> Result<Report, String> {
     };
     let a1 = appendix_a(truth189, sf, HALF_BEAM, &passing, 3000, false)?;
     let a1c = appendix_a(truth189, sf, HALF_BEAM, &passing, 3000, true)?;
-    let peak = |v: &[[f64; 3]]| v.iter().fold(0.0f64, |m, p| m.max(p[2].abs()));
+    let peak = |v: &[[f64; 3]]| max_abs(&v.iter().map(|p| p[2]).collect::<Vec<_>>());
     c.push(Check::rel(
         "S1 max |δ|, Appendix-A loop (the report's discretisation) [DERIVED]",
         4.66,
@@ -776,19 +734,17 @@ pub fn run(env: &Env) -> Result<Report, String> {
         c.push(within_seeds(
             &format!("{name} overshoot (Fig. {})", if i == 0 { 6 } else { 11 }),
             os,
-            &spread(&st[0]),
-            0.05,
+            &Spread::of(&st[0]),
             "m",
         ));
         c.push(within_seeds(
             &format!("{name} t′ of the overshoot"),
             t_os,
-            &spread(&st[1]),
-            0.05,
+            &Spread::of(&st[1]),
             "",
         ));
     }
-    let (p1, p3) = (spread(&passing_stats[0][2]), spread(&passing_stats[1][2]));
+    let (p1, p3) = (Spread::of(&passing_stats[0][2]), Spread::of(&passing_stats[1][2]));
     c.push(Check::holds(
         "passing ship (4x, surrogate of the lost Fig. 3): the random-walk design deviates less",
         "S1 6.2 m > S3 3.5 m",
@@ -822,103 +778,89 @@ pub fn run(env: &Env) -> Result<Report, String> {
         }
         cur_stats.push(st);
     }
-    let sp = |i: usize, j: usize| spread(&cur_stats[i][j]);
+    let sp = |i: usize, j: usize| Spread::of(&cur_stats[i][j]);
     c.push(within_seeds(
         "S2 steady offset, full current (mean η, 10 ≤ t′ ≤ 15; Fig. 8)",
         "54",
         &sp(0, 2),
-        0.5,
         "m",
     ));
     c.push(within_seeds(
         "S2 steady offset, half current (mean η, 30 ≤ t′ ≤ 40)",
         "27",
         &sp(0, 3),
-        0.5,
         "m",
     ));
     c.push(within_seeds(
         "S2 N̂′ on the full-current plateau (Fig. 10)",
         "0.00072",
         &sp(0, 4),
-        0.000005,
         "",
     ));
     c.push(within_seeds(
         "S4 startup peak (Fig. 13)",
         "34.5",
         &sp(1, 0),
-        0.05,
         "m",
     ));
     c.push(within_seeds(
         "S4 peak during the ramp (\"about 9 m\")",
         "9",
         &sp(1, 1),
-        0.5,
         "m",
     ));
     c.push(within_seeds(
         "S4 N̂′, full current (Fig. 15)",
         "0.00103",
         &sp(1, 4),
-        0.000005,
         "",
     ));
     c.push(within_seeds(
         "S4 N̂′, half current",
         "0.000515",
         &sp(1, 5),
-        0.0000005,
         "",
     ));
     c.push(within_seeds(
         "S6 non-adapted startup peak (Fig. 18)",
         "63.5",
         &sp(2, 0),
-        0.05,
         "m",
     ));
     c.push(within_seeds(
         "S6 non-adapted ramp peak",
         "18.5",
         &sp(2, 1),
-        0.05,
         "m",
     ));
     c.push(within_seeds(
         "S6 optimal-at-∞ startup peak (Fig. 18)",
         "50.2",
         &sp(3, 0),
-        0.05,
         "m",
     ));
     c.push(within_seeds(
         "S6 optimal-at-∞ ramp peak",
         "13.8",
         &sp(3, 1),
-        0.05,
         "m",
     ));
     c.push(within_seeds(
         "S7 partially adapted startup peak (Fig. 21)",
         "53.2",
         &sp(4, 0),
-        0.05,
         "m",
     ));
     c.push(within_seeds(
         "S7 partially adapted ramp peak",
         "13.9",
         &sp(4, 1),
-        0.05,
         "m",
     ));
     c.push(within_seeds(
         "S7 mean N̂′ over the first 15 L (Fig. 23)",
         "0.00126",
         &sp(4, 4),
-        0.000005,
         "",
     ));
 
@@ -1030,11 +972,7 @@ pub fn run(env: &Env) -> Result<Report, String> {
             sc.id,
             sc.what,
             sc.file,
-            if sc.sets.is_empty() {
-                "its defaults".to_string()
-            } else {
-                format!("--set {}", sc.sets.join(" --set "))
-            }
+            overrides_text(sc.sets)
         ));
     }
     n.push(
@@ -1065,8 +1003,8 @@ pub fn run(env: &Env) -> Result<Report, String> {
          ordering. Maximum rudder in S3 during the passing: {:.1}-{:.1}° (report: 35°, beyond the \
          linear model's validity); S1 {:.1}-{:.1}°.",
         p1.min, p1.max, p3.min, p3.max,
-        spread(&passing_stats[1][3]).min, spread(&passing_stats[1][3]).max,
-        spread(&passing_stats[0][3]).min, spread(&passing_stats[0][3]).max,
+        Spread::of(&passing_stats[1][3]).min, Spread::of(&passing_stats[1][3]).max,
+        Spread::of(&passing_stats[0][3]).min, Spread::of(&passing_stats[0][3]).max,
     ));
     n.push(
         "S6 N̂′: the report's \"about 0.00199\" (Fig. 20, \"equilibrium\") is the equilibrium of the \

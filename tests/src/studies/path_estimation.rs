@@ -20,21 +20,22 @@
 //! effects from the reproduction. Not reproducible (notes): S9, S10 (the stepped bottom of
 //! Fig. 25 is not given), S12 (the depth-to-coefficient rule behind Table 14 is unknown).
 
-use crate::study::{fmt_num, Check, Env, Report};
+use super::path_common::{run_until, DT};
+use crate::study::{
+    col, constant_series, fmt_num, max_abs, overrides_text, series, Check, Env, Report, Spread,
+};
 use models::controllers::mve::{parameters_of, Mve, MveParams, SIGMA_TABLE_9};
 use models::controllers::path::{
     Adaptation, Dither, PathController, PathControllerParams, PathInputs, UpdateDecision,
 };
 use models::controllers::wls::{WlsEstimator, WlsSchedule, WlsSettings};
 use models::hull::tokyo_maru::{L, TABLE_2, T_R, U};
+use models::hull::DEG;
 use models::observers::path_kalman::PathKalmanFilter;
 use models::observers::path_model::PathDesignModel;
 use models::random::NoiseStream;
 use shipsim::plot::{Panel, Series, Table};
 
-/// Δt′ of the report (one communication step).
-const DT: f64 = 0.005;
-const DEG: f64 = std::f64::consts::PI / 180.0;
 const SEEDS: u64 = 40;
 const MVE: &str = "path_control_mve.toml";
 /// The S14 dither start (half a step early, see the system file).
@@ -43,61 +44,13 @@ const DITHER_START: f64 = -0.0025;
 const CYCLE: f64 = 6.25;
 const NAMES: [&str; 6] = ["f22", "f23", "f25", "f32", "f33", "f35"];
 
-fn col<'a>(t: &'a Table, name: &str) -> Result<&'a [f64], String> {
-    t.column(name).map_err(|e| e.to_string())
-}
-
-/// Min, max, mean and median of a statistic over the seeds.
-#[derive(Clone, Copy, Debug)]
-struct Spread {
-    n: usize,
-    min: f64,
-    max: f64,
-    mean: f64,
-    median: f64,
-}
-
-fn spread(v: &[f64]) -> Spread {
-    let mut s = v.to_vec();
-    s.sort_by(|a, b| a.total_cmp(b));
-    let n = s.len();
-    Spread {
-        n,
-        min: s[0],
-        max: s[n - 1],
-        mean: s.iter().sum::<f64>() / n as f64,
-        median: if n % 2 == 1 {
-            s[n / 2]
-        } else {
-            0.5 * (s[n / 2 - 1] + s[n / 2])
-        },
-    }
-}
-
-fn fmt_spread(s: &Spread) -> String {
-    format!(
-        "{} .. {} (mean {})",
-        fmt_num(s.min),
-        fmt_num(s.max),
-        fmt_num(s.mean)
-    )
-}
-
-/// Half a unit of the last digit of a printed number.
-fn half_digit(printed: &str) -> f64 {
-    let d = printed.split('.').nth(1).map_or(0, |f| f.len() as i32);
-    0.5 * 10f64.powi(-d)
-}
-
 /// The printed values lie within the seeds' min..max, each widened by half a unit of its last
 /// printed digit.
 fn within_seeds(quantity: &str, printed: &[&str], spreads: &[Spread], unit: &str) -> Check {
     let mut pass = true;
     let mut ours = Vec::new();
     for (p, s) in printed.iter().zip(spreads) {
-        let v: f64 = p.parse().unwrap_or(f64::NAN);
-        let h = half_digit(p);
-        pass &= (s.min - h..=s.max + h).contains(&v);
+        pass &= s.covers(p);
         ours.push(format!("{} .. {}", fmt_num(s.min), fmt_num(s.max)));
     }
     Check {
@@ -646,7 +599,7 @@ fn s14(env: &Env, report: &mut Report) -> Result<(), String> {
         all.push(v);
     }
     let sp = |c: usize, f: &dyn Fn(&MveStats) -> f64| -> Spread {
-        spread(&all[c].iter().map(f).collect::<Vec<_>>())
+        Spread::over(&all[c], f)
     };
     let c = &mut report.checks;
 
@@ -822,22 +775,22 @@ fn s14(env: &Env, report: &mut Report) -> Result<(), String> {
         test500.push(s14_loop(Some(seed), true, false)?);
     }
     let lsp = |v: &[LoopRun], f: &dyn Fn(&LoopRun) -> f64| -> Spread {
-        spread(&v.iter().map(f).collect::<Vec<_>>())
+        Spread::over(&v, f)
     };
     let (k_eta, r_eta) = (lsp(&kept, &|r| r.eta_max), lsp(&redesigned, &|r| r.eta_max));
     let (k_rms, r_rms) = (lsp(&kept, &|r| r.rms[1]), lsp(&redesigned, &|r| r.rms[1]));
-    let tl_eta = spread(&test.iter().map(|r| r.0).collect::<Vec<_>>());
-    let tl_rms = spread(&test.iter().map(|r| r.1).collect::<Vec<_>>());
+    let tl_eta = Spread::over(&test, |r| r.0);
+    let tl_rms = Spread::over(&test, |r| r.1);
     let rms23 = sp(0, &|s| s.stats[4][1]);
-    let t5_eta = spread(&test500.iter().map(|r| r.eta_max).collect::<Vec<_>>());
-    let t5_t = spread(&test500.iter().map(|r| r.t_eta_max).collect::<Vec<_>>());
+    let t5_eta = Spread::over(&test500, |r| r.eta_max);
+    let t5_t = Spread::over(&test500, |r| r.t_eta_max);
     c.push(Check::holds(
         "S14 max |η′| in the first cycle, model loop with the report's structure (filter \
          re-designed, no exchange delays), 20 seeds vs [DERIVED] (3 seeds): ranges overlap",
         "0.178-0.205, at t′ ≈ 3.9",
         format!(
             "{} at t′ {}..{}",
-            fmt_spread(&t5_eta),
+            t5_eta,
             fmt_num(t5_t.min),
             fmt_num(t5_t.max)
         ),
@@ -845,34 +798,22 @@ fn s14(env: &Env, report: &mut Report) -> Result<(), String> {
     ));
 
     // ---- figures (seed 1): Figs. 28-31
-    let time = col(&seed1[0], "time")?.to_vec();
-    let line = |y: f64, label: &str| Series {
-        label: label.into(),
-        t: time.clone(),
-        y: vec![y; time.len()],
-    };
-    let ser = |t: &Table, name: &str, label: &str, scale: f64| -> Result<Series, String> {
-        Ok(Series {
-            label: label.into(),
-            t: col(t, "time")?.to_vec(),
-            y: col(t, name)?.iter().map(|v| v * scale).collect(),
-        })
-    };
+    let time = seed1[0].time();
     let mut panels = vec![Panel {
         y_label: "η′ = η/L".into(),
         series: MVE_CASES
             .iter()
             .zip(&seed1)
-            .map(|(cs, t)| ser(t, "ship.cross_track", cs.id, 1.0 / L))
+            .map(|(cs, t)| series(t, "ship.cross_track", cs.id, 1.0 / L))
             .collect::<Result<_, _>>()?,
     }];
     for (i, name) in [(1usize, "f23"), (2, "f25"), (3, "f32")] {
         let mut s: Vec<Series> = MVE_CASES
             .iter()
             .zip(&seed1)
-            .map(|(cs, t)| ser(t, &format!("est.{name}_estimate"), cs.id, 1.0))
+            .map(|(cs, t)| series(t, &format!("est.{name}_estimate"), cs.id, 1.0))
             .collect::<Result<_, _>>()?;
-        s.push(line(truth[i], "true (H/T = 1.89)"));
+        s.push(constant_series(time, truth[i], "true (H/T = 1.89)"));
         panels.push(Panel {
             y_label: format!("{name} estimate"),
             series: s,
@@ -903,11 +844,7 @@ fn s14(env: &Env, report: &mut Report) -> Result<(), String> {
             "S14 {}: {}: systems/{MVE} with {}.",
             case.id,
             case.what,
-            if case.sets.is_empty() {
-                "its defaults".to_string()
-            } else {
-                format!("--set {}", case.sets.join(" --set "))
-            }
+            overrides_text(case.sets)
         ));
     }
     n.push(format!(
@@ -918,7 +855,7 @@ fn s14(env: &Env, report: &mut Report) -> Result<(), String> {
          point gives when the window ends exactly on the grid) raises it by about 2 %; see the \
          system file on dither_start. The control-loop noise of the report's adaptive runs is not \
          stated (Table 3 assumed).",
-        fmt_spread(&eta),
+        eta,
         fmt_num(t_eta.min),
         fmt_num(t_eta.max)
     ));
@@ -946,9 +883,9 @@ fn s14(env: &Env, report: &mut Report) -> Result<(), String> {
          in most seeds; a reading of the MVE (§2.13) that differs from the report's program \
          cannot be excluded. The printed minimum, mean, maximum and final f̂25 are within the \
          seeds' ranges.",
-        fmt_spread(&r25[0]),
-        fmt_spread(&r25[1]),
-        fmt_spread(&r25[2]),
+        r25[0],
+        r25[1],
+        r25[2],
         fmt_num(r25[0].median),
         fmt_num(r25[1].median),
         fmt_num(r25[2].median),
@@ -966,15 +903,15 @@ fn s14(env: &Env, report: &mut Report) -> Result<(), String> {
          see the max |η′| note) gives {} and RMS f̂23 {}; the master: {} and {}.",
         fmt_num(d_eta),
         fmt_num(d_est),
-        fmt_spread(&r_eta),
-        fmt_spread(&k_eta),
-        fmt_spread(&r_rms),
-        fmt_spread(&k_rms),
-        fmt_spread(&t5_eta),
-        fmt_spread(&tl_eta),
-        fmt_spread(&tl_rms),
-        fmt_spread(&eta),
-        fmt_spread(&rms23),
+        r_eta,
+        k_eta,
+        r_rms,
+        k_rms,
+        t5_eta,
+        tl_eta,
+        tl_rms,
+        eta,
+        rms23,
     ));
     n.push(
         "S14 estimator data: the rudder angle (\"known exactly\") reaches the PathEstimator \
@@ -1162,9 +1099,7 @@ fn wls_stats(t: &Table, eta_offset: f64, lu: f64) -> Result<WlsStats, String> {
         col(t, "est.validity")?,
     );
     let mut s = WlsStats {
-        max_command: col(t, "ctl.rudder_command")?
-            .iter()
-            .fold(0.0f64, |m, v| m.max(v.abs())),
+        max_command: max_abs(col(t, "ctl.rudder_command")?),
         ..Default::default()
     };
     for k in 1..tp.len() {
@@ -1340,7 +1275,7 @@ fn s11(env: &Env, report: &mut Report) -> Result<(), String> {
         accepted.iter().all(|&a| a == SEEDS as usize),
     ));
     let offs: Vec<Spread> = (0..3)
-        .map(|cy| spread(&runs.iter().map(|r| r.max_offset[cy]).collect::<Vec<_>>()))
+        .map(|cy| Spread::over(&runs, |r| r.max_offset[cy]))
         .collect();
     for (cy, printed) in TABLE_13_OFFSET.iter().enumerate() {
         let p: f64 = printed.parse().unwrap_or(f64::NAN);
@@ -1377,14 +1312,7 @@ fn s11(env: &Env, report: &mut Report) -> Result<(), String> {
     ));
     // the cost scale: ratios of the final costs between the updates (the printed J's
     // normalisation is unknown, spec §6 item 13)
-    let ratio = |u: usize| -> Spread {
-        spread(
-            &runs
-                .iter()
-                .map(|r| r.fits[u].2 / r.fits[0].2)
-                .collect::<Vec<_>>(),
-        )
-    };
+    let ratio = |u: usize| Spread::over(&runs, |r| r.fits[u].2 / r.fits[0].2);
     c.push(within_seeds(
         "Table 13 final cost of updates 2 / 3 relative to update 1 (0.1012/0.1059, 0.1035/0.1059)",
         &["0.956", "0.977"],
@@ -1392,10 +1320,10 @@ fn s11(env: &Env, report: &mut Report) -> Result<(), String> {
         "",
     ));
     let costs: Vec<Spread> = (0..3)
-        .map(|u| spread(&runs.iter().map(|r| r.fits[u].2).collect::<Vec<_>>()))
+        .map(|u| Spread::over(&runs, |r| r.fits[u].2))
         .collect();
     let evals: Vec<Spread> = (0..3)
-        .map(|u| spread(&runs.iter().map(|r| r.fits[u].1).collect::<Vec<_>>()))
+        .map(|u| Spread::over(&runs, |r| r.fits[u].1))
         .collect();
 
     // ---- Table 12: 5.0-L windows (first update only)
@@ -1427,7 +1355,7 @@ fn s11(env: &Env, report: &mut Report) -> Result<(), String> {
             &[0],
             ("×10²", 1.0),
         )?;
-        let end = spread(&v.iter().map(|r| r.end_offset[0]).collect::<Vec<_>>());
+        let end = Spread::over(&v, |r| r.end_offset[0]);
         c.push(Check::rel(
             &format!(
                 "Table 12 window 5.0 / dither {period}: offset η′ at the end of the cycle (seed \
@@ -1456,8 +1384,8 @@ fn s11(env: &Env, report: &mut Report) -> Result<(), String> {
         let t = run_until(env, WLS, &sets, "s11_table_3.csv", 6.0)?;
         t3.push(wls_stats(&t, eta_eq, 6.0)?);
     }
-    let t3_f23 = spread(&t3.iter().map(|r| r.fits[0].0[1]).collect::<Vec<_>>());
-    let t3_f32 = spread(&t3.iter().map(|r| r.fits[0].0[3]).collect::<Vec<_>>());
+    let t3_f23 = Spread::over(&t3, |r| r.fits[0].0[1]);
+    let t3_f32 = Spread::over(&t3, |r| r.fits[0].0[3]);
     let t3_all = t3.iter().filter(|r| r.fits[0].3 == 2.0).count();
     let t3_rej = t3.iter().filter(|r| r.fits[0].3 == 0.0).count();
 
@@ -1467,33 +1395,23 @@ fn s11(env: &Env, report: &mut Report) -> Result<(), String> {
         .collect::<Result<_, _>>()?;
     let rep_offs: Vec<Spread> = (0..3)
         .map(|cy| {
-            spread(
-                &lr.iter()
-                    .map(|r| {
-                        let b = ((cy + 1) * 1200).min(r.eta.len() - 1);
-                        r.eta[cy * 1200..=b]
-                            .iter()
-                            .fold(0.0f64, |m, e| m.max(e.abs()))
-                    })
-                    .collect::<Vec<_>>(),
-            )
+            Spread::over(&lr, |r| {
+                let b = ((cy + 1) * 1200).min(r.eta.len() - 1);
+                max_abs(&r.eta[cy * 1200..=b])
+            })
         })
         .collect();
 
     // ---- figure (seed 1)
     let t1 = env.run(WLS, &wls_seed(1), "s11_seed1.csv")?;
-    let time = col(&t1, "time")?.to_vec();
-    let ser = |name: &str, label: &str, scale: f64, off: f64| -> Result<Series, String> {
+    let time = t1.time();
+    // the plant's deviations from the operating point, made absolute
+    let absolute = |name: &str, label: &str, scale: f64, off: f64| -> Result<Series, String> {
         Ok(Series {
             label: label.into(),
-            t: time.clone(),
+            t: time.to_vec(),
             y: col(&t1, name)?.iter().map(|v| (v + off) * scale).collect(),
         })
-    };
-    let line = |y: f64, label: &str| Series {
-        label: label.into(),
-        t: time.clone(),
-        y: vec![y; time.len()],
     };
     let deep_p = parameters_of(&TABLE_2[4]);
     let f = env.figure(
@@ -1502,25 +1420,25 @@ fn s11(env: &Env, report: &mut Report) -> Result<(), String> {
         &[
             Panel {
                 y_label: "η′ = η/L".into(),
-                series: vec![ser("ship.cross_track", "η′", 1.0 / L, eta_eq)?],
+                series: vec![absolute("ship.cross_track", "η′", 1.0 / L, eta_eq)?],
             },
             Panel {
                 y_label: "rudder δ [deg]".into(),
-                series: vec![ser("gear.rudder_angle", "δ", 1.0 / DEG, x_eq[4])?],
+                series: vec![absolute("gear.rudder_angle", "δ", 1.0 / DEG, x_eq[4])?],
             },
             Panel {
                 y_label: "f23".into(),
                 series: vec![
-                    ser("est.f23_estimate", "WLS estimate", 1.0, 0.0)?,
-                    ser("ctl.design_f23", "controller design", 1.0, 0.0)?,
-                    line(deep_p[1], "true (H/T = inf)"),
+                    series(&t1, "est.f23_estimate", "WLS estimate", 1.0)?,
+                    series(&t1, "ctl.design_f23", "controller design", 1.0)?,
+                    constant_series(time, deep_p[1], "true (H/T = inf)"),
                 ],
             },
             Panel {
                 y_label: "f32".into(),
                 series: vec![
-                    ser("est.f32_estimate", "WLS estimate", 1.0, 0.0)?,
-                    line(deep_p[3], "true (H/T = inf)"),
+                    series(&t1, "est.f32_estimate", "WLS estimate", 1.0)?,
+                    constant_series(time, deep_p[3], "true (H/T = inf)"),
                 ],
             },
         ],
@@ -1559,12 +1477,12 @@ fn s11(env: &Env, report: &mut Report) -> Result<(), String> {
          still drifting at t′ = 6: here the controller applies the estimates at the end of its \
          dither window (t′ = 5.95) and closes the loop then, where the report updates at t′ = 6 \
          after the batch period LB, whose rudder is not stated. Cycle 3 lies within the seeds.",
-        fmt_spread(&offs[0]),
-        fmt_spread(&offs[1]),
-        fmt_spread(&offs[2]),
-        fmt_spread(&rep_offs[0]),
-        fmt_spread(&rep_offs[1]),
-        fmt_spread(&rep_offs[2]),
+        offs[0],
+        offs[1],
+        offs[2],
+        rep_offs[0],
+        rep_offs[1],
+        rep_offs[2],
     ));
     n.push(format!(
         "S11 cost and evaluations: final Σ|e|² ×10² (W = I, no ½) of updates 1-3: {} / {} / {}, \
@@ -1575,19 +1493,19 @@ fn s11(env: &Env, report: &mut Report) -> Result<(), String> {
          evaluations (Levenberg-Marquardt, 9 per Jacobian): {} / {} / {}; the report's DUD \
          needed 113 / 22 / 19 (warm starts are cheap for DUD, not for a finite-difference \
          Jacobian).",
-        fmt_spread(&costs[0]),
-        fmt_spread(&costs[1]),
-        fmt_spread(&costs[2]),
-        fmt_spread(&evals[0]),
-        fmt_spread(&evals[1]),
-        fmt_spread(&evals[2]),
+        costs[0],
+        costs[1],
+        costs[2],
+        evals[0],
+        evals[1],
+        evals[2],
     ));
     for (period, end, _) in &t12 {
         n.push(format!(
             "S11 with 5.0-L windows, dither period {period} (Table 12; windows from t′ = 0.95, \
              one update at t′ = 6, run to t′ = 6): offset at the end of the cycle {} (the \
              control loop closes at 5.95, see the offsets note).",
-            fmt_spread(end)
+            end
         ));
     }
     n.push(format!(
@@ -1601,14 +1519,10 @@ fn s11(env: &Env, report: &mut Report) -> Result<(), String> {
          design's feedforward on the filter's N̂′, Ŷ′ (still the 1.89 equilibrium values) \
          commands up to {} rad (the report's loop is linear; the gear limit is set to its \
          largest value, π).",
-        fmt_spread(&t3_f23),
-        fmt_spread(&t3_f32),
-        fmt_spread(&spread(
-            &runs.iter().map(|r| r.fits[0].0[1]).collect::<Vec<_>>()
-        )),
-        fmt_spread(&spread(
-            &runs.iter().map(|r| r.fits[0].0[3]).collect::<Vec<_>>()
-        )),
+        t3_f23,
+        t3_f32,
+        Spread::over(&runs, |r| r.fits[0].0[1]),
+        Spread::over(&runs, |r| r.fits[0].0[3]),
         fmt_num(max_cmd)
     ));
     Ok(())
@@ -1687,7 +1601,7 @@ fn s13(env: &Env, report: &mut Report) -> Result<(), String> {
         format!("update 1 all in range in {all1}, update 3 accepted in {ok3} of {SEEDS}"),
         all1 == SEEDS as usize && ok3 == SEEDS as usize,
     ));
-    let med = |u: usize| spread(&runs.iter().map(|r| r.fits[u].1).collect::<Vec<_>>()).median;
+    let med = |u: usize| Spread::over(&runs, |r| r.fits[u].1).median;
     let (e1, e2, e3) = (med(0), med(1), med(2));
     c.push(Check::holds(
         "S13 update 2 needs the most cost evaluations (seed medians)",
@@ -1695,14 +1609,7 @@ fn s13(env: &Env, report: &mut Report) -> Result<(), String> {
         format!("{e1} / {e2} / {e3}"),
         e2 > e1 && e2 > e3,
     ));
-    let ratio = |u: usize| -> Spread {
-        spread(
-            &runs
-                .iter()
-                .map(|r| r.fits[u].2 / r.fits[0].2)
-                .collect::<Vec<_>>(),
-        )
-    };
+    let ratio = |u: usize| Spread::over(&runs, |r| r.fits[u].2 / r.fits[0].2);
     c.push(within_seeds(
         "Table 15 final cost of updates 2 / 3 relative to update 1 (0.3642/0.1022, 0.1031/0.1022)",
         &["3.564", "1.009"],
@@ -1711,12 +1618,7 @@ fn s13(env: &Env, report: &mut Report) -> Result<(), String> {
     ));
     // cycle 1 (before the passing ship): the first dither's sign follows the noise-driven rudder
     // before the window, so |η′| is compared
-    let c1 = spread(
-        &runs
-            .iter()
-            .map(|r| r.max_offset[0].abs())
-            .collect::<Vec<_>>(),
-    );
+    let c1 = Spread::over(&runs, |r| r.max_offset[0].abs());
     c.push(Check::rel(
         "Table 15 |maximum offset η′| in cycle 1 (seed mean; update instant within LB, see S11 note)",
         0.0698,
@@ -1731,31 +1633,19 @@ fn s13(env: &Env, report: &mut Report) -> Result<(), String> {
         format!("max |δ_c| {} rad (limit π)", fmt_num(max_cmd)),
         max_cmd < std::f64::consts::PI,
     ));
-    let sp2 = |i: usize| spread(&runs.iter().map(|r| r.fits[1].0[i]).collect::<Vec<_>>());
+    let sp2 = |i: usize| Spread::over(&runs, |r| r.fits[1].0[i]);
     let off = |cy: usize, end: bool| {
-        spread(
-            &runs
-                .iter()
-                .map(|r| {
-                    if end {
-                        r.end_offset[cy]
-                    } else {
-                        r.max_offset[cy]
-                    }
-                })
-                .collect::<Vec<_>>(),
-        )
+        Spread::over(&runs, |r| {
+            if end {
+                r.end_offset[cy]
+            } else {
+                r.max_offset[cy]
+            }
+        })
     };
     // figure (seed 1)
     let t1 = env.run(WLS_PS, &wls_seed(1), "s13_seed1.csv")?;
-    let time = col(&t1, "time")?.to_vec();
-    let ser = |name: &str, label: &str, scale: f64| -> Result<Series, String> {
-        Ok(Series {
-            label: label.into(),
-            t: time.clone(),
-            y: col(&t1, name)?.iter().map(|v| v * scale).collect(),
-        })
-    };
+    let ser = |name: &str, label: &str, scale: f64| series(&t1, name, label, scale);
     let f = env.figure(
         "s13_wls_passing_ship.png",
         "S13: WLS in the loop, deep water, ship passing at t' = 7, seed 1 (t' = t/46.98 s)",
@@ -1795,17 +1685,17 @@ fn s13(env: &Env, report: &mut Report) -> Result<(), String> {
          compared; nor are the offsets after t′ = 5: max |η′| in cycles 2 / 3 {} / {} (printed \
          0.1394 / −0.2154), at the cycle ends {} / {} (−0.0953 / 0.1511). Cost evaluations \
          (medians) {e1} / {e2} / {e3}.",
-        fmt_spread(&sp2(0)),
-        fmt_spread(&sp2(1)),
-        fmt_spread(&sp2(3)),
-        fmt_spread(&sp2(4)),
-        fmt_spread(&off(1, false)),
-        fmt_spread(&off(2, false)),
-        fmt_spread(&off(1, true)),
-        fmt_spread(&off(2, true)),
+        sp2(0),
+        sp2(1),
+        sp2(3),
+        sp2(4),
+        off(1, false),
+        off(2, false),
+        off(1, true),
+        off(2, true),
     ));
     if !rejected.is_empty() {
-        let u3 = |i: usize| spread(&rejected.iter().map(|r| r.fits[2].0[i]).collect::<Vec<_>>());
+        let u3 = |i: usize| Spread::over(&rejected, |r| r.fits[2].0[i]);
         n.push(format!(
             "S13 update 3 in the {} seeds with update 2 rejected: f̂23 {} (median {}), f̂32 {} \
              (median {}), f̂33 {} (median {}) (printed 3.0732, 0.30193, −0.70178): f̂23 is near the \
@@ -1823,11 +1713,11 @@ fn s13(env: &Env, report: &mut Report) -> Result<(), String> {
              seeds, both close in 2 of 24 (8 %), a plausible but fortunate realisation. The passing \
              ship itself does not reach the window (|N′|, |Y′| < 1e-27).",
             rejected.len(),
-            fmt_spread(&u3(1)),
+            u3(1),
             fmt_num(u3(1).median),
-            fmt_spread(&u3(3)),
+            u3(3),
             fmt_num(u3(3).median),
-            fmt_spread(&u3(4)),
+            u3(4),
             fmt_num(u3(4).median),
         ));
     }
@@ -1835,7 +1725,7 @@ fn s13(env: &Env, report: &mut Report) -> Result<(), String> {
         "S13 cycle 1: |max η′| {} (printed 0.0698, also the offset at the cycle end); the sign of \
          the first dither is opposite to the rudder just before the window, which on the track \
          is noise, so the sign of the offset differs between seeds.",
-        fmt_spread(&c1)
+        c1
     ));
     Ok(())
 }
@@ -1902,12 +1792,7 @@ fn wls_table_checks(
                 continue;
             }
             ps.push(printed[i][u]);
-            ss.push(spread(
-                &runs
-                    .iter()
-                    .map(|r| r.fits[u].0[i] * scale)
-                    .collect::<Vec<_>>(),
-            ));
+            ss.push(Spread::over(runs, |r| r.fits[u].0[i] * scale));
         }
         let label = if updates.len() > 1 {
             format!(
@@ -1924,17 +1809,6 @@ fn wls_table_checks(
         c.push(within_seeds(&label, &ps, &ss, ""));
     }
     Ok(())
-}
-
-/// [`Env::run`] stopped at t′ = `stop_prime` ship lengths (one base step is Δt′ = DT).
-fn run_until(
-    env: &Env,
-    file: &str,
-    sets: &[String],
-    csv: &str,
-    stop_prime: f64,
-) -> Result<Table, String> {
-    env.run_steps(file, sets, csv, Some((stop_prime / DT).round() as u64))
 }
 
 pub fn run(env: &Env) -> Result<Report, String> {

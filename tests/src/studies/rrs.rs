@@ -9,10 +9,9 @@
 //! spec prescribe, the open-loop roll is tuned to the reported variances (16 and 47 deg²) by the
 //! wave roll gain, and the closed-loop reduction is the result compared.
 
-use crate::study::{after, series_window, variance, Check, Env, Report};
+use crate::study::{after, mean, series_window, variance, Check, Env, Report};
+use models::hull::DEG;
 use shipsim::plot::{Panel, Table};
-
-const DEG: f64 = std::f64::consts::PI / 180.0;
 const SYSTEM: &str = "rrs.toml";
 /// The robustness system: plant = the 22-knot simulation model (RrsShip model 1, Tables 2.1/2.2)
 /// driven by the wave height; its wave connection gain (0.014670) is tuned for 16 deg² open loop.
@@ -54,13 +53,10 @@ fn stats(t: &Table) -> Result<RunStats, String> {
             last = (*tk, *ck);
         }
     }
-    let mean = |c: &str| -> Result<f64, String> {
-        let v = after(t, c, SETTLE)?;
-        Ok(v.iter().sum::<f64>() / v.len() as f64 / DEG)
-    };
+    let mean_deg = |c: &str| -> Result<f64, String> { Ok(mean(after(t, c, SETTLE)?) / DEG) };
     Ok(RunStats {
-        mean_roll: mean("ship.roll")?,
-        mean_rudder: mean("gear.rudder_angle")?,
+        mean_roll: mean_deg("ship.roll")?,
+        mean_rudder: mean_deg("gear.rudder_angle")?,
         roll_var: deg2("ship.roll")?,
         heading_var: deg2("ship.heading")?,
         rudder_var: deg2("gear.rudder_angle")?,
