@@ -6,11 +6,12 @@
 //! loop under the Eq. 61 thrust with a Markov bias (T = 1000 s, Eq. 58); (3) noise-free, no waves,
 //! matched bias model, initial estimation errors (T9).
 
-use crate::study::{series, Check, Env, Report};
-use shipsim::plot::{Panel, Series, Table};
+use crate::study::{col, mean, rms_diff, series, window, Check, Env, Report};
+use models::hull::DEG;
+use nalgebra::{Complex, Matrix3, Vector3};
+use shipsim::plot::{Panel, Table};
 use std::f64::consts::PI;
 
-const DEG: f64 = PI / 180.0;
 /// Samples (1 Hz) of the analysis window at the end of a run.
 const N: usize = 4096;
 /// Wave band of the band-power ratios [rad/s] (as in the observer model's own test).
@@ -59,29 +60,12 @@ const BIAS_EST: [&str; 3] = [
     "observer.bias_yaw_estimate",
 ];
 
-/// Minimal complex arithmetic for the frequency responses.
-#[derive(Clone, Copy, Debug)]
-struct C(f64, f64);
-impl C {
-    fn add(self, o: C) -> C {
-        C(self.0 + o.0, self.1 + o.1)
-    }
-    fn mul(self, o: C) -> C {
-        C(self.0 * o.0 - self.1 * o.1, self.0 * o.1 + self.1 * o.0)
-    }
-    fn div(self, o: C) -> C {
-        let d = o.0 * o.0 + o.1 * o.1;
-        C(
-            (self.0 * o.0 + self.1 * o.1) / d,
-            (self.1 * o.0 - self.0 * o.1) / d,
-        )
-    }
-    fn scale(self, k: f64) -> C {
-        C(self.0 * k, self.1 * k)
-    }
-    fn norm2(self) -> f64 {
-        self.0 * self.0 + self.1 * self.1
-    }
+/// A complex number of the frequency responses (nalgebra's re-export of num-complex).
+type C = Complex<f64>;
+
+/// The complex number re + j im.
+fn c(re: f64, im: f64) -> C {
+    C::new(re, im)
 }
 
 /// Continuous y → η̂ of one DOF of the linear observer (J = I, τ = 0, mass-normalised injection,
@@ -91,17 +75,16 @@ fn observer_response(w: f64, dof: usize) -> C {
     let k1 = -2.0 * (ZETA_N - ZETA) * OMEGA_C / OMEGA0;
     let k2 = 2.0 * OMEGA0 * (ZETA_N - ZETA);
     let k3 = OMEGA_C;
-    let s = C(0.0, w);
-    let one = C(1.0, 0.0);
+    // real operands stay complex (re + j0): num-complex's mixed real-complex operators round
+    // differently, and the report's numbers were computed this way
+    let s = c(0.0, w);
+    let one = c(1.0, 0.0);
     let a = D[dof][dof] / M[dof];
-    let hb = C(KAPPA[dof], 0.0).add(C(LAMBDA[dof], 0.0).div(s.add(C(1.0 / T_BIAS, 0.0))));
-    let ge = hb.div(s.add(C(a, 0.0))).add(C(k3, 0.0)).div(s);
-    let den = s
-        .mul(s)
-        .add(s.scale(2.0 * ZETA * OMEGA0))
-        .add(C(OMEGA0 * OMEGA0, 0.0));
-    let gw = s.scale(k2).add(C(-OMEGA0 * OMEGA0 * k1, 0.0)).div(den);
-    ge.div(one.add(ge).add(gw))
+    let hb = c(KAPPA[dof], 0.0) + c(LAMBDA[dof], 0.0) / (s + c(1.0 / T_BIAS, 0.0));
+    let ge = (hb / (s + c(a, 0.0)) + c(k3, 0.0)) / s;
+    let den = s * s + s.scale(2.0 * ZETA * OMEGA0) + c(OMEGA0 * OMEGA0, 0.0);
+    let gw = (s.scale(k2) + c(-OMEGA0 * OMEGA0 * k1, 0.0)) / den;
+    ge / (one + ge + gw)
 }
 
 /// Shape of the WF spectrum of 001 Eq. 10 (|h_w|² without σ²); ∫₀^∞ = π/(4ζω₀).
@@ -123,17 +106,17 @@ fn predicted_band_ratio(dof: usize) -> f64 {
         if !(BAND.0..=BAND.1).contains(&w) {
             continue;
         }
-        let mut hd = C(0.0, 0.0);
+        let mut hd = c(0.0, 0.0);
         let mut sa = 0.0;
         for k in -kmax..=kmax {
             let wk = w + 2.0 * PI * k as f64;
             // (1 − e^{−jω})/(jω)
-            let zoh = C(1.0 - wk.cos(), wk.sin()).div(C(0.0, wk));
-            hd = hd.add(observer_response(wk, dof).mul(zoh));
+            let zoh = c(1.0 - wk.cos(), wk.sin()) / c(0.0, wk);
+            hd = hd + observer_response(wk, dof) * zoh;
             sa += wf_shape(wk.abs());
         }
         let sy = WF_STD[dof].powi(2) * sa / c_norm + NOISE_STD[dof].powi(2) / PI;
-        num += hd.norm2() * sy;
+        num += hd.norm_sqr() * sy;
         den += sy;
     }
     num / den
@@ -160,10 +143,6 @@ fn band_power(x: &[f64]) -> f64 {
     p
 }
 
-fn col<'a>(t: &'a Table, name: &str) -> Result<&'a [f64], String> {
-    t.column(name).map_err(|e| e.to_string())
-}
-
 /// Wave-band power of η̂ − η over that of y − η (the true LF motion removed from both, so that
 /// a drifting ship leaks no power into the band through the window edges).
 fn wf_ratio(t: &Table, i: usize) -> Result<f64, String> {
@@ -174,38 +153,18 @@ fn wf_ratio(t: &Table, i: usize) -> Result<f64, String> {
     Ok(band_power(&diff(EST[i])?) / band_power(&diff(MEAS[i])?))
 }
 
-fn mean(x: &[f64]) -> f64 {
-    x.iter().sum::<f64>() / x.len() as f64
-}
-
-fn rms_diff(a: &[f64], b: &[f64]) -> f64 {
-    (a.iter().zip(b).map(|(x, y)| (x - y).powi(2)).sum::<f64>() / a.len() as f64).sqrt()
-}
-
 /// [DERIVED] equilibrium of the observer under a constant bias b (J = I, held position): Eq. 24's
 /// leak −b̂/T leaves b̂ = TΛỹ with (TΛ + 𝒦 + M⁻¹D K₂) ỹ = M⁻¹ b; returned as the force M b̂.
 fn bias_equilibrium(b: [f64; 3]) -> [f64; 3] {
-    let mut a = [[0.0; 3]; 3];
-    for i in 0..3 {
-        for j in 0..3 {
-            a[i][j] = D[i][j] / M[i] * OMEGA_C;
-        }
-        a[i][i] += T_BIAS * LAMBDA[i] + KAPPA[i];
-    }
-    let rhs: [f64; 3] = std::array::from_fn(|i| b[i] / M[i]);
-    let det3 = |m: &[[f64; 3]; 3]| {
-        m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
-            - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
-            + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
-    };
-    let d = det3(&a);
-    std::array::from_fn(|i| {
-        let mut ai = a;
-        for r in 0..3 {
-            ai[r][i] = rhs[r];
-        }
-        M[i] * T_BIAS * LAMBDA[i] * det3(&ai) / d
-    })
+    let a = Matrix3::from_fn(|i, j| {
+        let leak = if i == j { T_BIAS * LAMBDA[i] + KAPPA[i] } else { 0.0 };
+        D[i][j] / M[i] * OMEGA_C + leak
+    });
+    let y = a
+        .lu()
+        .solve(&Vector3::from_fn(|i, _| b[i] / M[i]))
+        .unwrap_or_else(|| Vector3::repeat(f64::NAN));
+    std::array::from_fn(|i| M[i] * T_BIAS * LAMBDA[i] * y[i])
 }
 
 /// Centered moving average over `w` samples (shorter at the ends).
@@ -233,21 +192,6 @@ fn correlation(a: &[f64], b: &[f64]) -> f64 {
         sbb += (y - mb).powi(2);
     }
     sab / (saa * sbb).sqrt()
-}
-
-/// A series restricted to t in [t0, t1].
-fn window(s: Series, t0: f64, t1: f64) -> Series {
-    let (t, y): (Vec<f64>, Vec<f64>) =
-        s.t.iter()
-            .zip(&s.y)
-            .filter(|(t, _)| (t0..=t1).contains(*t))
-            .map(|(t, y)| (*t, *y))
-            .unzip();
-    Series {
-        label: s.label,
-        t,
-        y,
-    }
 }
 
 fn sets(list: &[(&str, f64)]) -> Vec<String> {
