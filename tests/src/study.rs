@@ -454,7 +454,10 @@ mod tests {
     #[test]
     fn spreads_cover_printed_values() {
         let s = Spread::of(&[3.0, 1.0, 2.0, 4.0]);
-        assert_eq!((s.n, s.min, s.max, s.mean, s.median), (4, 1.0, 4.0, 2.5, 2.5));
+        assert_eq!(
+            (s.n, s.min, s.max, s.mean, s.median),
+            (4, 1.0, 4.0, 2.5, 2.5)
+        );
         assert_eq!(half_digit("0.00072"), 0.000005);
         assert_eq!(half_digit("54"), 0.5);
         // "4.00" ± 0.005 and "1" ± 0.5 touch the range; "4.1" ± 0.05 and "0.9" ± 0.05 do not

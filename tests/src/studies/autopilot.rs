@@ -18,8 +18,8 @@
 
 use crate::study::{after, col, last, max_abs, mean, series, std_dev, Check, Env, Report};
 use models::hull::container_ship::{ContainerShip, L as CS_L, LIN_B, LIN_M};
-use models::hull::{DEG, KNOT};
 use models::hull::nomoto::{NomotoInputs, NomotoModel, NomotoShip};
+use models::hull::{DEG, KNOT};
 use models::manoeuvre::{
     run as run_manoeuvre, turning_circle, ContainerShipRun, ManoeuvreGenerator, ManoeuvreKind,
     ManoeuvreShip, Sample,

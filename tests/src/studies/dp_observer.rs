@@ -112,7 +112,7 @@ fn predicted_band_ratio(dof: usize) -> f64 {
             let wk = w + 2.0 * PI * k as f64;
             // (1 − e^{−jω})/(jω)
             let zoh = c(1.0 - wk.cos(), wk.sin()) / c(0.0, wk);
-            hd = hd + observer_response(wk, dof) * zoh;
+            hd += observer_response(wk, dof) * zoh;
             sa += wf_shape(wk.abs());
         }
         let sy = WF_STD[dof].powi(2) * sa / c_norm + NOISE_STD[dof].powi(2) / PI;
@@ -157,7 +157,11 @@ fn wf_ratio(t: &Table, i: usize) -> Result<f64, String> {
 /// leak −b̂/T leaves b̂ = TΛỹ with (TΛ + 𝒦 + M⁻¹D K₂) ỹ = M⁻¹ b; returned as the force M b̂.
 fn bias_equilibrium(b: [f64; 3]) -> [f64; 3] {
     let a = Matrix3::from_fn(|i, j| {
-        let leak = if i == j { T_BIAS * LAMBDA[i] + KAPPA[i] } else { 0.0 };
+        let leak = if i == j {
+            T_BIAS * LAMBDA[i] + KAPPA[i]
+        } else {
+            0.0
+        };
         D[i][j] / M[i] * OMEGA_C + leak
     });
     let y = a

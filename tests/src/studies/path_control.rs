@@ -744,7 +744,10 @@ pub fn run(env: &Env) -> Result<Report, String> {
             "",
         ));
     }
-    let (p1, p3) = (Spread::of(&passing_stats[0][2]), Spread::of(&passing_stats[1][2]));
+    let (p1, p3) = (
+        Spread::of(&passing_stats[0][2]),
+        Spread::of(&passing_stats[1][2]),
+    );
     c.push(Check::holds(
         "passing ship (4x, surrogate of the lost Fig. 3): the random-walk design deviates less",
         "S1 6.2 m > S3 3.5 m",
