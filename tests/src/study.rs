@@ -123,7 +123,7 @@ pub fn series_window(
 }
 
 /// The part of a curve with t0 ≤ t ≤ t1.
-pub fn window(s: Series, t0: f64, t1: f64) -> Series {
+fn window(s: Series, t0: f64, t1: f64) -> Series {
     let (t, y): (Vec<f64>, Vec<f64>) =
         s.t.iter()
             .zip(&s.y)
