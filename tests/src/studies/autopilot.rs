@@ -184,22 +184,27 @@ fn current_rejection(env: &Env, report: &mut Report) -> Result<(), String> {
          heading is unaffected by a kinematic current, so the thesis's heading excursion (Fig 5-8, +2..-4 deg) \
          is not reproduced either. A sway time constant of 16.6 s would give 0.3 L."
     ));
+    current_rejection_figure(env, &t, report)
+}
+
+/// The current-rejection figure: offset, heading (measured and actual), rudder.
+fn current_rejection_figure(env: &Env, t: &Table, report: &mut Report) -> Result<(), String> {
     let fig = env.figure(
         "autopilot_current.png",
         "Heading autopilot, 5-kn decaying beam current (AT-6, AT-7)",
         &[
             Panel {
                 y_label: "lateral offset [L]".into(),
-                series: vec![series(&t, "ship.y", "y / L", 1.0 / L)?],
+                series: vec![series(t, "ship.y", "y / L", 1.0 / L)?],
             },
             Panel {
                 y_label: "heading [deg]".into(),
                 series: vec![
-                    series(&t, "sensors.heading_measured", "measured", 1.0 / DEG)?,
-                    series(&t, "ship.heading", "actual", 1.0 / DEG)?,
+                    series(t, "sensors.heading_measured", "measured", 1.0 / DEG)?,
+                    series(t, "ship.heading", "actual", 1.0 / DEG)?,
                 ],
             },
-            rudder_panel(&t, "ap.rudder_command")?,
+            rudder_panel(t, "ap.rudder_command")?,
         ],
     )?;
     report
@@ -449,11 +454,22 @@ fn track_change_nonlinear(env: &Env, report: &mut Report) -> Result<(), String> 
         ((y[k1] - yd[k1]) / CS_L).abs(),
         xte2.abs()
     ));
+    track_change_nonlinear_figure(env, &t, &xd, report)
+}
+
+/// The track change on the nonlinear plant: heading, offset from dead reckoning, speed, rudder.
+fn track_change_nonlinear_figure(
+    env: &Env,
+    t: &Table,
+    xd: &[f64],
+    report: &mut Report,
+) -> Result<(), String> {
+    let (time, x) = (t.time(), col(t, "ship.x")?);
     let fig = env.figure(
         "autopilot_track_change_nonlinear.png",
         "Heading autopilot on the nonlinear plant, 90 deg track change (AT-8)",
         &[
-            heading_panel(&t)?,
+            heading_panel(t)?,
             Panel {
                 y_label: "north offset from dead reckoning [L]".into(),
                 series: vec![Series {
@@ -464,9 +480,9 @@ fn track_change_nonlinear(env: &Env, report: &mut Report) -> Result<(), String> 
             },
             Panel {
                 y_label: "speed [m/s]".into(),
-                series: vec![series(&t, "ship.speed", "speed", 1.0)?],
+                series: vec![series(t, "ship.speed", "speed", 1.0)?],
             },
-            rudder_panel(&t, "ap.rudder_command")?,
+            rudder_panel(t, "ap.rudder_command")?,
         ],
     )?;
     report.figures.push((
@@ -488,11 +504,7 @@ fn track_offset(env: &Env, report: &mut Report) -> Result<(), String> {
         col(&t, "ship.y")?,
         col(&t, "ctl.cross_track_reference_used")?,
     );
-    let dev: Vec<f64> = (0..time.len())
-        .filter(|&k| time[k] > 900.0)
-        .map(|k| y[k] - yr[k])
-        .collect();
-    let osc = max_abs(&dev) / 0.9144;
+    let (osc, dist) = steady_leg(&t)?;
     report.checks.push(Check::range(
         "AT-9 oscillation about the track on the steady leg (t > 900 s, SS4 + 5-kn current, noisy y)",
         "< 20 yd (L2792; with SS4)",
@@ -520,29 +532,15 @@ fn track_offset(env: &Env, report: &mut Report) -> Result<(), String> {
         .map(|k| y[k] - yr[k])
         .collect();
     // Sweep of the (assumed) wave level: calm water and ten times the system's yaw gain.
-    let osc_at = |gain: f64, tag: &str| -> Result<(f64, f64), String> {
-        let tw = env.run(
+    let at_wave_level = |gain: f64, tag: &str| -> Result<(f64, f64), String> {
+        steady_leg(&env.run(
             "autopilot_track_offset.toml",
             &[format!("waves.yaw_gain={gain}")],
             &format!("autopilot_track_offset_{tag}.csv"),
-        )?;
-        let tt = tw.time();
-        let (yw, yrw) = (
-            col(&tw, "ship.y")?,
-            col(&tw, "ctl.cross_track_reference_used")?,
-        );
-        let d: Vec<f64> = (0..tt.len())
-            .filter(|&k| tt[k] > 900.0)
-            .map(|k| yw[k] - yrw[k])
-            .collect();
-        Ok((
-            max_abs(&d) / 0.9144,
-            std_dev(after(&tw, "waves.yaw_moment", 900.0)?) / DEG,
-        ))
+        )?)
     };
-    let (osc_calm, _) = osc_at(0.0, "calm")?;
-    let (osc_10, dist_10) = osc_at(10.0 * WAVE_YAW_GAIN, "waves_x10")?;
-    let dist = std_dev(after(&t, "waves.yaw_moment", 900.0)?) / DEG;
+    let (osc_calm, _) = at_wave_level(0.0, "calm")?;
+    let (osc_10, dist_10) = at_wave_level(10.0 * WAVE_YAW_GAIN, "waves_x10")?;
     report.checks.push(Check::holds(
         "AT-9 the wave disturbance acts on the loop (SS4 vs calm water, same noise)",
         "waves move the ship about the track (Figs 5-22 to 5-24)",
@@ -572,6 +570,26 @@ fn track_offset(env: &Env, report: &mut Report) -> Result<(), String> {
         max_abs(&pre) / L,
         max_abs(&during)
     ));
+    track_offset_figure(env, &t, report)
+}
+
+/// The steady leg of a track-offset run (t > 900 s): the largest deviation from the track [yd]
+/// and the std of the rudder-equivalent wave yaw disturbance [deg].
+fn steady_leg(t: &Table) -> Result<(f64, f64), String> {
+    let time = t.time();
+    let (y, yr) = (col(t, "ship.y")?, col(t, "ctl.cross_track_reference_used")?);
+    let dev: Vec<f64> = (0..time.len())
+        .filter(|&k| time[k] > 900.0)
+        .map(|k| y[k] - yr[k])
+        .collect();
+    Ok((
+        max_abs(&dev) / 0.9144,
+        std_dev(after(t, "waves.yaw_moment", 900.0)?) / DEG,
+    ))
+}
+
+/// The lateral offset: track, heading, rudder.
+fn track_offset_figure(env: &Env, t: &Table, report: &mut Report) -> Result<(), String> {
     let fig = env.figure(
         "autopilot_track_offset.png",
         "Track controller: SS4, 5-kn gust and 2 L offset to port (AT-9)",
@@ -579,15 +597,15 @@ fn track_offset(env: &Env, report: &mut Report) -> Result<(), String> {
             Panel {
                 y_label: "cross-track [L]".into(),
                 series: vec![
-                    series(&t, "ctl.cross_track_reference_used", "desired", 1.0 / L)?,
-                    series(&t, "ship.y", "actual", 1.0 / L)?,
+                    series(t, "ctl.cross_track_reference_used", "desired", 1.0 / L)?,
+                    series(t, "ship.y", "actual", 1.0 / L)?,
                 ],
             },
             Panel {
                 y_label: "heading [deg]".into(),
-                series: vec![series(&t, "ship.heading", "heading", 1.0 / DEG)?],
+                series: vec![series(t, "ship.heading", "heading", 1.0 / DEG)?],
             },
-            rudder_panel(&t, "ctl.rudder_command")?,
+            rudder_panel(t, "ctl.rudder_command")?,
         ],
     )?;
     report
@@ -708,6 +726,11 @@ fn identification(env: &Env, report: &mut Report) -> Result<(), String> {
         100.0 * tact,
         100.0 * steady
     ));
+    identification_figure(env, &t, report)
+}
+
+/// The identification run: zig-zag and the estimates.
+fn identification_figure(env: &Env, t: &Table, report: &mut Report) -> Result<(), String> {
     let fig = env.figure(
         "identification_zigzag.png",
         "10/10 zig-zag on ContainerShip feeding ParameterEkf (AT-11)",
@@ -715,17 +738,17 @@ fn identification(env: &Env, report: &mut Report) -> Result<(), String> {
             Panel {
                 y_label: "heading, rudder [deg]".into(),
                 series: vec![
-                    series(&t, "ship.heading", "heading", 1.0 / DEG)?,
-                    series(&t, "ship.rudder_angle", "rudder", 1.0 / DEG)?,
+                    series(t, "ship.heading", "heading", 1.0 / DEG)?,
+                    series(t, "ship.rudder_angle", "rudder", 1.0 / DEG)?,
                 ],
             },
             Panel {
                 y_label: "estimate / mean".into(),
                 series: vec![
-                    series(&t, "kf.neg_y_v_estimate", "-Y_v' x100", 100.0)?,
-                    series(&t, "kf.m_minus_y_r_estimate", "m'-Y_r' x100", 100.0)?,
-                    series(&t, "kf.neg_n_v_estimate", "-N_v' x100", 100.0)?,
-                    series(&t, "kf.mxg_minus_n_r_estimate", "m'x_G'-N_r' x100", 100.0)?,
+                    series(t, "kf.neg_y_v_estimate", "-Y_v' x100", 100.0)?,
+                    series(t, "kf.m_minus_y_r_estimate", "m'-Y_r' x100", 100.0)?,
+                    series(t, "kf.neg_n_v_estimate", "-N_v' x100", 100.0)?,
+                    series(t, "kf.mxg_minus_n_r_estimate", "m'x_G'-N_r' x100", 100.0)?,
                 ],
             },
         ],
