@@ -1,6 +1,7 @@
 //! Coupled-system studies: each runs one or more system files from `systems/` through the
 //! shipsim master (in process, the same code as `shipsim run`), computes the quantities a source
-//! publishes, and compares them with the published (or [DERIVED]) values.
+//! publishes, and compares them with the published values, or with [DERIVED] ones: values
+//! computed from a source's equations where the source prints none.
 //!
 //! The same study functions serve the system tests (`tests/tests/studies.rs` asserts that every
 //! check passes) and the validation report (`cargo xtask report`, which writes every study's
@@ -150,7 +151,8 @@ pub fn constant_series(t: &[f64], y: f64, label: &str) -> Series {
 #[derive(Clone, Debug)]
 pub struct Check {
     pub quantity: String,
-    /// The published value as the source prints it (with [DERIVED] where the spec derived it).
+    /// The published value as the source prints it ([DERIVED] where it was computed from the
+    /// source's equations).
     pub published: String,
     pub ours: String,
     /// The acceptance rule, in words.

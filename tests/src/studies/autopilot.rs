@@ -1,20 +1,22 @@
-//! Autopilot and track keeping of the DDG-51 EKF thesis (source 000, spec
-//! `ddg51_ekf_autopilot.md` §4.7-4.11 and §4.5, AT-6 to AT-9 and AT-11), through the master:
+//! Autopilot and track keeping of the DDG-51 EKF thesis [Taylor2000, secs. 4.3.4, 5.2.3, 5.3.3]
+//! (the checks named AT-6 to AT-9 and AT-11 in the report), through the master:
 //!
 //! * `autopilot_current.toml`: NomotoShip (DDG-51 first-order Nomoto) + SteeringGear (6/(s+6) in
 //!   t') + Current (5 kn on the beam, decaying) + Sensors (noisy heading) + HeadingAutopilot:
-//!   AT-6 (gear filters the noise) and AT-7 (current offset);
+//!   AT-6 (gear filters the noise) and AT-7 (current offset) [Taylor2000, sec. 5.2.3.1];
 //! * `autopilot_track_change.toml`: the same loop with the autopilot's 90° track-change
-//!   generator: AT-8;
+//!   generator: AT-8 [Taylor2000, sec. 5.2.3.2];
 //! * `autopilot_current_nonlinear.toml`, `autopilot_track_change_nonlinear.toml`: AT-7 and AT-8
 //!   again on a nonlinear plant with sway and speed loss (ContainerShip standing in for the
-//!   thesis's plant [43], which is not given), the current as an initial sway velocity as the
-//!   thesis applied it;
+//!   thesis's nonlinear plant, its reference [43], which is not given), the current as an initial
+//!   sway velocity as the thesis applied it;
 //! * `autopilot_track_offset.toml`: TrackController, sea state 4 (Waves, rudder-equivalent yaw
-//!   disturbance), 5-kn beam current gust and a 2 L lateral offset to port: AT-9;
+//!   disturbance), 5-kn beam current gust and a 2 L lateral offset to port: AT-9
+//!   [Taylor2000, sec. 5.3.3];
 //! * `identification_zigzag.toml`: ContainerShip + Manoeuvre (10/10 zig-zag) + Sensors +
 //!   ParameterEkf; the identified linear model's 10° turning circle against the plant's
-//!   (computed here with the models crate from the FMU's identified coefficients): AT-11.
+//!   (computed here with the models crate from the FMU's identified coefficients): AT-11
+//!   [Taylor2000, sec. 4.3.4].
 
 use crate::study::{after, col, last, max_abs, mean, series, std_dev, Check, Env, Report};
 use models::hull::container_ship::{ContainerShip, L as CS_L, LIN_B, LIN_M};

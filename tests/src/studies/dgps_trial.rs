@@ -1,17 +1,17 @@
-//! DGPS manoeuvring trial (seed 002, Artyszuk; spec `dgps_kalman.md` §2.5, §3.4, §4 T4-T7): the
-//! velocity and drift-angle bias of the receiver's steady-state PV Kalman filter during turns,
-//! a zig-zag and a coasting stop of the ContainerShip, for S_p = 0.001, 0.01, 0.1, through the
-//! master (`systems/dgps_trial.toml`, `systems/dgps_stopping.toml`).
+//! DGPS manoeuvring trial [Artyszuk2003, secs. 2-3]: the velocity and drift-angle bias of the
+//! receiver's steady-state PV Kalman filter during turns, a zig-zag and a coasting stop of the
+//! ContainerShip, for S_p = 0.001, 0.01, 0.1, through the master (`systems/dgps_trial.toml`,
+//! `systems/dgps_stopping.toml`; the checks named T4-T7 in the report).
 
 use crate::study::{col, series, Check, Env, Report};
 use models::hull::DEG;
 use shipsim::plot::{Panel, Series, Table};
 use std::f64::consts::PI;
 
-/// [DERIVED] steady-state velocity lag of the filter per unit acceleration / turn rate [s]
-/// (spec §3.4) for S_p = 0.001, 0.01, 0.1.
+/// [DERIVED] steady-state velocity lag of the filter per unit acceleration / turn rate [s] for
+/// S_p = 0.001, 0.01, 0.1: computed from the filter of [Artyszuk2003, sec. 2] (not in the paper).
 const LAG: [f64; 3] = [10.76, 5.85, 3.10];
-/// [DERIVED] noise-only output std of v̂ per axis at σ_z = 2 m (spec §3.4).
+/// [DERIVED] noise-only output std of v̂ per axis at σ_z = 2 m, computed from the same filter.
 const NOISE_V: [f64; 3] = [0.053, 0.126, 0.296];
 const KF: [&str; 3] = ["kf_low", "kf", "kf_high"];
 const SP: [&str; 3] = ["0.001", "0.01", "0.1"];
@@ -412,7 +412,7 @@ fn velocity_noise_checks(straight: &Table, c: &mut Vec<Check>) -> Result<(), Str
     Ok(())
 }
 
-/// The turning test, noise free and with the DGPS noise (as the paper's Figs. 2-3).
+/// The turning test, noise free and with the DGPS noise (as [Artyszuk2003, Figs. 2-3]).
 fn turning_figures(env: &Env, r: &Runs, report: &mut Report) -> Result<(), String> {
     let t = &r.at_turn.t;
     let mut beta_series = vec![aligned_series("true β", t, &r.at_turn.beta, 1.0 / DEG)];
@@ -481,7 +481,7 @@ fn turning_figures(env: &Env, r: &Runs, report: &mut Report) -> Result<(), Strin
     Ok(())
 }
 
-/// The coasting stop (as the paper's Fig. 7).
+/// The coasting stop (as [Artyszuk2003, Fig. 7]).
 fn coasting_stop_figure(env: &Env, r: &Runs, report: &mut Report) -> Result<(), String> {
     let s_stop = at(&r.stop, &r.at_stop, "kf.speed_over_ground")?;
     let ts = &r.at_stop.t;

@@ -1,10 +1,11 @@
-//! Dynamic positioning with Fossen & Strand's passive observer (seed 001, spec
-//! `passive_observer_dp.md` §4.1 and T1, T6, T9, T10): wave filtering, bias estimation and
-//! position keeping through the master, in `systems/dp_observer.toml`.
+//! Dynamic positioning with the passive nonlinear observer of [Fossen1999, sec. 4.1]: wave
+//! filtering, bias estimation and position keeping through the master, in
+//! `systems/dp_observer.toml` (the checks named T1, T6, T9 and T10 in the report).
 //!
-//! Runs: (1) DP closed loop with a constant bias (8000 s); (2) the paper's simulation study: open
-//! loop under the Eq. 61 thrust with a Markov bias (T = 1000 s, Eq. 58); (3) noise-free, no waves,
-//! matched bias model, initial estimation errors (T9).
+//! Runs: (1) DP closed loop with a constant bias (8000 s); (2) the paper's simulation study
+//! [Fossen1999, sec. 6.1]: open loop under the thrust of [Fossen1999, eq. (61)] with a Markov bias
+//! (T = 1000 s, [Fossen1999, eq. (58)]); (3) noise-free, no waves, matched bias model, initial
+//! estimation errors (T9).
 
 use crate::study::{col, last, mean, rms_diff, series, series_window, Check, Env, Report};
 use models::hull::DEG;
@@ -17,7 +18,7 @@ const N: usize = 4096;
 /// Wave band of the band-power ratios [rad/s] (as in the observer model's own test).
 const BAND: (f64, f64) = (0.45, 1.8);
 
-// Paper data (001 §3.1-3.3) and the system file's settings.
+// Paper data [Fossen1999, sec. 6, eqs. (56)-(60)] and the system file's settings.
 const M: [f64; 3] = [5.3122e6, 8.2831e6, 3.7454e9];
 const D: [[f64; 3]; 3] = [
     [5.0242e4, 0.0, 0.0],
@@ -87,16 +88,16 @@ fn observer_response(w: f64, dof: usize) -> C {
     ge / (one + ge + gw)
 }
 
-/// Shape of the WF spectrum of 001 Eq. 10 (|h_w|² without σ²); ∫₀^∞ = π/(4ζω₀).
+/// Shape of the WF spectrum of [Fossen1999, eq. (10)] (|h_w|² without σ²); ∫₀^∞ = π/(4ζω₀).
 fn wf_shape(w: f64) -> f64 {
     let w2 = w * w;
     w2 / ((OMEGA0 * OMEGA0 - w2).powi(2) + (2.0 * ZETA * OMEGA0 * w).powi(2))
 }
 
-/// [DERIVED] expected band-power ratio η̂/y of one DOF at 1 Hz: the observer driven by the
-/// held 1-Hz samples (zero-order hold) and read at 1 Hz, H_d(ω) = Σ_k H(jω_k)(1 − e^{−jω_k})/(jω_k),
-/// ω_k = ω + 2πk; the sampled measurement is the aliased WF spectrum plus white sensor noise.
-/// Evaluated on the DFT bins of the analysis window.
+/// [DERIVED] expected band-power ratio η̂/y of one DOF at 1 Hz: the observer driven by the held
+/// 1-Hz samples (zero-order hold) and read at 1 Hz, H_d(ω) = Σ_k H(jω_k)(1 − e^{−jω_k})/(jω_k), ω_k
+/// = ω + 2πk; the sampled measurement is the aliased WF spectrum plus white sensor noise. Evaluated
+/// on the DFT bins of the analysis window.
 fn predicted_band_ratio(dof: usize) -> f64 {
     let kmax = 1000i32;
     let c_norm = PI / (4.0 * ZETA * OMEGA0);
@@ -153,8 +154,9 @@ fn wf_ratio(t: &Table, i: usize) -> Result<f64, String> {
     Ok(band_power(&diff(EST[i])?) / band_power(&diff(MEAS[i])?))
 }
 
-/// [DERIVED] equilibrium of the observer under a constant bias b (J = I, held position): Eq. 24's
-/// leak −b̂/T leaves b̂ = TΛỹ with (TΛ + 𝒦 + M⁻¹D K₂) ỹ = M⁻¹ b; returned as the force M b̂.
+/// [DERIVED] equilibrium of the observer under a constant bias b (J = I, held position): the
+/// leak −b̂/T of [Fossen1999, eq. (24)] leaves b̂ = TΛỹ with (TΛ + 𝒦 + M⁻¹D K₂) ỹ = M⁻¹ b;
+/// returned as the force M b̂.
 fn bias_equilibrium(b: [f64; 3]) -> [f64; 3] {
     let a = Matrix3::from_fn(|i, j| {
         let leak = if i == j {
@@ -202,7 +204,8 @@ fn sets(list: &[(&str, f64)]) -> Vec<String> {
     list.iter().map(|(k, v)| format!("{k}={v}")).collect()
 }
 
-/// The paper's simulation study: no feedback, Eq. 61 thrust, Markov bias with T = 1000 s.
+/// The paper's simulation study: no feedback, the thrust of [Fossen1999, eq. (61)], Markov bias
+/// with T = 1000 s.
 fn open_loop_sets() -> Vec<(&'static str, f64)> {
     vec![
         ("dp.bandwidth_surge", 0.0),
@@ -361,7 +364,7 @@ fn station_keeping_checks(cl: &Table, c: &mut Vec<Check>) -> Result<(), String> 
     Ok(())
 }
 
-/// The paper's simulation study: open loop, Eq. 61, Markov bias.
+/// The paper's simulation study [Fossen1999, sec. 6.1]: open loop, eq. (61) thrust, Markov bias.
 fn open_loop_study_sets() -> Vec<(&'static str, f64)> {
     let mut ol_sets = open_loop_sets();
     ol_sets.extend([
@@ -558,7 +561,7 @@ fn closed_loop_figures(env: &Env, cl: &Table, report: &mut Report) -> Result<(),
     Ok(())
 }
 
-/// The open-loop run, surge, as the paper's Fig. 9.
+/// The open-loop run, surge, as [Fossen1999, Fig. 9].
 fn open_loop_figure(env: &Env, ol: &Table, report: &mut Report) -> Result<(), String> {
     let fig = env.figure(
         "paper_surge.png",

@@ -1,17 +1,19 @@
-//! Adaptive path control of the *Tokyo Maru* in restricted water (Parsons & Cuong 1980, seed 004;
-//! spec `adaptive_path_control.md` §4.2, scenarios S1-S7): TokyoMaru + SteeringGear + Current +
-//! Sensors + PathKalmanFilter + PathController through the master.
+//! Adaptive path control of the *Tokyo Maru* in restricted water [Parsons1980, sec. 3], scenarios
+//! S1-S7: TokyoMaru + SteeringGear + Current + Sensors + PathKalmanFilter + PathController through
+//! the master.
 //!
-//! * Noise-free runs against the spec's [DERIVED] trajectories (the report's figures are lost;
-//!   the spec re-simulated its loop, Appendix A), within 2 %.
-//! * Runs with the report's measurement noise (Table 3) over 20 seeds against the numbers the
-//!   report reads off its (noisy) figures: the printed value must lie within the spread of the
-//!   seeds (min..max, widened by half a unit of the printed last digit).
-//! * The co-simulation against the spec's monolithic Appendix-A loop with the exchange delays of
-//!   a Jacobi master, which explains the one quantity outside 2 % (the S1 rudder peak).
+//! * Noise-free runs against [DERIVED] trajectories, within 2 %: the report's figures are lost,
+//!   so its loop was re-simulated from its equations (plant and filter by forward Euler at Δt′,
+//!   u_k = C x̂_k; the report text calls this the Appendix-A loop).
+//! * Runs with the report's measurement noise [Parsons1980, Table 3] over 20 seeds against the
+//!   numbers the report reads off its (noisy) figures: the printed value must lie within the
+//!   spread of the seeds (min..max, widened by half a unit of the printed last digit).
+//! * The co-simulation against that monolithic loop with the exchange delays of a Jacobi master,
+//!   which explains the one quantity outside 2 % (the S1 rudder peak).
 //!
-//! S5 (ABC harbour, Fig. 5 lost) and S8 (Table 7, a covariance analysis, not a simulation) are
-//! not run; the estimator scenarios (WLS S9-S13, MVE S14) are the `path_estimation` study.
+//! S5 (ABC harbour, [Parsons1980, Fig. 5] lost) and S8 ([Parsons1980, Table 7], a covariance
+//! analysis, not a simulation) are not run; the estimator scenarios (WLS S9-S13, MVE S14) are the
+//! `path_estimation` study.
 
 use super::path_common::{run_until, DT};
 use crate::study::{col, half_digit, last, max_abs, overrides_text, Check, Env, Report, Spread};
@@ -27,7 +29,7 @@ const SEEDS: u64 = 20;
 const CURRENT: &str = "path_control_current.toml";
 const PASSING: &str = "path_control_passing_ship.toml";
 
-/// Shaping-filter design (Table 4) in controller and filter.
+/// Shaping-filter design [Parsons1980, Table 4] in controller and filter.
 const SHAPING: &[&str] = &[
     "ctl.disturbance_model=1",
     "ctl.q_n=1.548e-8",
@@ -209,13 +211,14 @@ fn within_seeds(quantity: &str, printed: &str, s: &Spread, unit: &str) -> Check 
     }
 }
 
-/// The spec's Appendix-A loop (plant and filter forward Euler at Δt′, u_k = C x̂_k), optionally
-/// with the exchange of the co-simulation: the Jacobi master hands the filter the measurement of
-/// the previous step (the Sensors output is a direct feedthrough of the hull's output, one
-/// exchange old) and the gear the command of the previous step (the controller output is a
-/// direct feedthrough of the filter's output), the first command is C x̂_0 (the filter's
-/// outputs in initialization mode follow its initial_* parameters), the controller reads the gear's actual
-/// rudder and the gear is integrated exactly (SteeringGear). Returns (t′, η m, δ deg).
+/// The report's loop as re-simulated for the [DERIVED] values ("Appendix-A loop": plant and filter
+/// forward Euler at Δt′, u_k = C x̂_k [Parsons1980, sec. 3.1]), optionally with the exchange of the
+/// co-simulation: the Jacobi master hands the filter the measurement of the previous step (the
+/// Sensors output is a direct feedthrough of the hull's output, one exchange old) and the gear the
+/// command of the previous step (the controller output is a direct feedthrough of the filter's
+/// output), the first command is C x̂_0 (the filter's outputs in initialization mode follow its
+/// initial_* parameters), the controller reads the gear's actual rudder and the gear is integrated
+/// exactly (SteeringGear). Returns (t′, η m, δ deg).
 fn appendix_a(
     truth: TokyoMaruCoefficients,
     design: PathDesignModel,
@@ -622,7 +625,8 @@ fn deep_water_checks(nf: &NoiseFree, c: &mut Vec<Check>) {
     ));
 }
 
-/// S7 really ran the Table 8 design (spec §3, ±1.5 in the last printed digit).
+/// S7 really ran the [Parsons1980, Table 8] design (±1.5 in the last printed digit, as far as the
+/// recomputed gains agree with the printed ones).
 fn s7_design_checks(s7: &Run, c: &mut Vec<Check>) -> Result<(), String> {
     c.push(Check::abs(
         "S7 controller gain c13 (β′) after the adaptation = Table 8",
@@ -641,7 +645,8 @@ fn s7_design_checks(s7: &Run, c: &mut Vec<Check>) -> Result<(), String> {
     Ok(())
 }
 
-/// The line-1145 equilibrium (U9): Table 5 design in deep water, full current held.
+/// The equilibrium of [Parsons1980, sec. 4.2.2] (ψ′ = β′ = −0.1428, δ′ = 0.1310, N̂′ = 0.001992):
+/// [Parsons1980, Table 5] design in deep water, full current held.
 fn held_current_checks(env: &Env, c: &mut Vec<Check>) -> Result<(), String> {
     let u9 = {
         let mut sets = vec![
@@ -963,7 +968,8 @@ fn trajectory_figure(
     env.figure(name, title, &panels)
 }
 
-/// Figs. 6-23: cross-track, heading, rudder (and N̂′) of the noise-free runs and seed 1.
+/// [Parsons1980, Figs. 6-23]: cross-track, heading, rudder (and N̂′) of the noise-free runs and
+/// seed 1.
 fn figures(
     env: &Env,
     nf: &NoiseFree,

@@ -1,24 +1,26 @@
-//! Rudder roll stabilization (van der Klugt 1987, seed 003): systems/rrs.toml with RRS off
-//! (course keeping only, "ASA") and on, same seed; roll reduction 100(1 − σ²_on/σ²_off)
-//! (eq. 5.7); a sweep over steering-gear rate and wave direction for the trends of results R3-R5
-//! and R7 (spec rrs_controller_results.md §4.2); and a robustness run in which the same
-//! autopilot and filters, designed on the control model, steer the thesis's 22-knot simulation
-//! model (systems/rrs_simulation_plant.toml, [`simulation_plant`]).
+//! Rudder roll stabilization [Klugt1987]: systems/rrs.toml with RRS off (course keeping only,
+//! "ASA") and on, same seed; roll reduction 100(1 − σ²_on/σ²_off) [Klugt1987, eq. (5.7)]; a sweep
+//! over steering-gear rate and wave direction for the trends of the MARIN and full-scale results
+//! (named R3-R5 and R7 in the report) [Klugt1987, secs. 7.2.3, 7.4]; and a robustness run in
+//! which the same autopilot and filters, designed on the control model, steer the thesis's
+//! 22-knot simulation model (systems/rrs_simulation_plant.toml, [`simulation_plant`]).
 //!
-//! The thesis gives no sea state for its analog-model trials (Table 7.1): as the issue and the
-//! spec prescribe, the open-loop roll is tuned to the reported variances (16 and 47 deg²) by the
-//! wave roll gain, and the closed-loop reduction is the result compared.
+//! The thesis gives no sea state for its analog-model trials [Klugt1987, sec. 7.2.2, Table 7.1]:
+//! as the issue prescribes, the open-loop roll is tuned to the reported variances (16 and 47 deg²)
+//! by the wave roll gain, and the closed-loop reduction is the result compared.
 
 use crate::study::{after, mean, series_window, variance, Check, Env, Report};
 use models::hull::DEG;
 use shipsim::plot::{Panel, Table};
 const SYSTEM: &str = "rrs.toml";
-/// The robustness system: plant = the 22-knot simulation model (RrsShip model 1, Tables 2.1/2.2)
+/// The robustness system: plant = the 22-knot simulation model (RrsShip model 1,
+/// [Klugt1987, Tables 2.1-2.2])
 /// driven by the wave height; its wave connection gain (0.014670) is tuned for 16 deg² open loop.
 const SYSTEM_SIM: &str = "rrs_simulation_plant.toml";
 /// Statistics skip the start-up transient (filters, innovation process, adaptation).
 const SETTLE: f64 = 200.0;
-/// Wave roll gain for 47 deg² open loop (Table 7.1, exp. 2): the roll gain of systems/rrs.toml
+/// Wave roll gain for 47 deg² open loop ([Klugt1987, Table 7.1], exp. 2): the roll gain of
+/// systems/rrs.toml
 /// (0.034319, tuned for 16 deg² with the wind gusts' 0.31 deg² included) scaled by
 /// √((47 − 0.31)/(16 − 0.31)).
 const GAIN_EXP2: f64 = 0.059201;
@@ -181,7 +183,7 @@ pub fn run(env: &Env) -> Result<Report, String> {
     Ok(report)
 }
 
-/// Table 7.1: the two experiments (off, on) against the thesis, and the wind heel.
+/// [Klugt1987, Table 7.1]: the two experiments (off, on) against the thesis, and the wind heel.
 fn table_7_1_checks([off1, on1]: [&RunStats; 2], [off2, on2]: [&RunStats; 2], c: &mut Vec<Check>) {
     c.push(Check::abs(
         "exp. 1: open-loop (ASA) roll variance, tuned",
@@ -388,19 +390,23 @@ fn experiment_notes([off1, on1]: [&RunStats; 2], [off2, on2]: [&RunStats; 2], n:
 }
 
 /// Robustness run (systems/rrs_simulation_plant.toml): the autopilot and the roll/yaw filters,
-/// designed on the control model of Table 2.4 (evaluated at the plant's 22 kn), steer the
-/// thesis's 22-knot simulation model (Fig. 2.5, Tables 2.1/2.2) driven by the wave height
+/// designed on the control model of [Klugt1987, Table 2.4] (evaluated at the plant's 22 kn),
+/// steer the thesis's 22-knot simulation model [Klugt1987, Fig. 2.5, Tables 2.1-2.2] driven by
+/// the wave height
 /// through its own wave filters; wind as in rrs.toml; same seeds, RRS off and on. Pushes the
 /// checks and notes to `report`; `ctrl_off`/`ctrl_on` are experiment 1 on the control model (same
 /// sea, same tuned 16 deg²) for the comparison. Returns the overlay figure.
 ///
-/// The thesis gives no roll reduction for this model: its digital simulations (PSI, §7.2.1, the
-/// model used is not named) appear only as Fig. 7.2 ("a reasonable roll reduction"). What it does report at 15 deg/s is
-/// 78 % and 68 % on the analog model (Table 7.1), "up to 60 %" on the MARIN simulator with ship 2
-/// (R5) and ≈ 60 % on the scale model and at full scale (R6-R8). The band checked is therefore
+/// The thesis gives no roll reduction for this model: its digital simulations (PSI, the model
+/// used is not named) appear only as [Klugt1987, sec. 7.2.1, Fig. 7.2] ("a reasonable roll
+/// reduction"). What it does report at 15 deg/s is 78 % and 68 % on the analog model
+/// [Klugt1987, Table 7.1], "up to 60 %" on the MARIN simulator with ship 2 [Klugt1987, sec. 7.2.3]
+/// and ≈ 60 % on the scale model and at full scale [Klugt1987, secs. 7.3-7.4]. The band checked
+/// is therefore
 /// the issue's 60-78 % for beam seas, 15 deg/s: from the thesis's typical ≈ 60 % on plants that
 /// differ from the control model to its best laboratory figure. The second check is the thesis's
-/// own criterion for the control model (§7.2): results on a plant with dynamics outside the
+/// own criterion for the control model [Klugt1987, sec. 7.2]: results on a plant with dynamics
+/// outside the
 /// control model must agree with those on the model itself. "Agree" is ±10 points: the seed
 /// spread of one plant is ±3 points (waves.seed 1-8, both systems: control model 69.3-73.8 %,
 /// simulation model 71.2-75.0 %, measured when this run was added), while the thesis's platforms

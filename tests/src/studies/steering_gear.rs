@@ -1,4 +1,4 @@
-//! Steering machine requirements through the master (van der Klugt 1987 §2.3 and §6.5.2):
+//! Steering machine requirements through the master [Klugt1987, secs. 2.3, 6.5.2]:
 //! the classification rule (35° port to 35° starboard within 30 s at 2.5 deg/s) and the RRS gear.
 
 use crate::study::{col, max_abs, series, Check, Env, Report};

@@ -1,18 +1,20 @@
-//! The steady state of line 1145 (spec U9), from which S11 starts: the closed loop of plant,
-//! filter and controller under a constant disturbance, solved from the models.
+//! The steady state from which S11 starts, the initial conditions of [Parsons1980, sec. 4.2.2]:
+//! the closed loop of plant, filter and controller under a constant disturbance, solved from the
+//! models.
 
 use super::err;
 use models::controllers::path::path_gains;
 use models::hull::tokyo_maru::TABLE_2;
 use models::observers::path_model::PathDesignModel;
 
-/// The constant disturbance of Tables 12-13 (N′, Y′).
+/// The constant disturbance of [Parsons1980, Tables 12-13] (N′, Y′).
 pub(super) const W_S11: [f64; 2] = [0.0010262, 0.0023277];
 
-/// The steady state of line 1145 (spec U9): truth at ∞ under the constant N′, Y′, Table 5 filter
-/// and controller (design 1.89, random walk, ε = 0 in the filter). The plant fixes ψ′ = β′, δ′
-/// (r′ = 0); the filter's stationarity with u = C x̂′ = δ′ fixes x̂′ and η′. Returns the plant
-/// state [ψ′, r′, β′, η′, δ′] and x̂′.
+/// The steady state of [Parsons1980, sec. 4.2.2] (ψ′ = β′ = −0.1428, δ′ = 0.1310, N̂′ = 0.001992,
+/// Ŷ′ = 0.003437): truth at ∞ under the constant N′, Y′, [Parsons1980, Table 5] filter and
+/// controller (design 1.89, random walk, ε = 0 in the filter). The plant fixes ψ′ = β′, δ′
+/// (r′ = 0); the filter's stationarity with u = C x̂′ = δ′ fixes x̂′ and η′ (the report prints
+/// η′ = 0; it is 3.9e-5). Returns the plant state [ψ′, r′, β′, η′, δ′] and x̂′.
 pub(super) fn line_1145_equilibrium() -> Result<([f64; 5], [f64; 7]), String> {
     let (beta, delta) = plant_equilibrium()?;
     let (a, b) = filter_equilibrium_system(beta, delta)?;
@@ -126,7 +128,7 @@ mod tests {
                 lu[i]
             );
         }
-        // η′ of the plant and of the filter: the steady offset (line 1145, spec U9)
+        // η′ of the plant and of the filter: the small steady offset of [Parsons1980, sec. 4.2.2]
         assert!((y[7] / 3.8877e-5 - 1.0).abs() < 1e-4 && (y[3] / y[7] - 1.0).abs() < 1e-9);
     }
 }

@@ -1,24 +1,25 @@
-//! Parameter estimation in the adaptive path-control loop of the *Tokyo Maru* (Parsons & Cuong
-//! 1980, seed 004; spec `adaptive_path_control.md` §4.3-§4.4): the estimators of §2.12 (WLS,
-//! PathWlsEstimator) and §2.13 (MVE, PathEstimator) as FMUs feeding the PathController's partial
+//! Parameter estimation in the adaptive path-control loop of the *Tokyo Maru*
+//! [Parsons1980, secs. 4-5]: the estimators of [Parsons1980, sec. 4.1] (WLS, PathWlsEstimator)
+//! and [Parsons1980, sec. 5.1] (MVE, PathEstimator) as FMUs feeding the PathController's partial
 //! adaptation, the PathKalmanFilter following the controller's design, through the master.
 //!
-//! * S14 (Table 16, Figs. 28-31): MVE in the loop, truth at H/T = 1.89, everything initialised
-//!   for deep water, three disturbance cases.
-//! * S11 (Tables 12-13, Fig. 26): WLS in the loop, truth in deep water under a constant
-//!   disturbance from the steady state of line 1145, three updates; and the 5.0-L windows of
-//!   Table 12 (first update).
-//! * S13 (Table 15): WLS with a ship passing during the second window.
+//! * S14 [Parsons1980, sec. 5.3, Table 16, Figs. 28-31]: MVE in the loop, truth at H/T = 1.89,
+//!   everything initialised for deep water, three disturbance cases.
+//! * S11 [Parsons1980, sec. 4.2.2, Tables 12-13, Fig. 26]: WLS in the loop, truth in deep water
+//!   under a constant disturbance from the steady state the report starts from, three updates;
+//!   and the 5.0-L windows of [Parsons1980, Table 12] (first update).
+//! * S13 [Parsons1980, sec. 4.3.2, Table 15]: WLS with a ship passing during the second window.
 //!
 //! The report shows one realisation of unknown seed, so a printed number must lie within the
 //! min..max of 40 noise seeds (`SEEDS`), widened by half a unit of its last digit; where a
 //! printed value lies outside in every seed the check states its own tolerance and a note says
-//! why. The [DERIVED] values of §4.4 (an independent implementation, 3 seeds) are compared by
-//! range.
+//! why. The [DERIVED] values (an independent implementation of the report's loop, 3 seeds; not
+//! in [Parsons1980]) are compared by range.
 //! Model-level loops built from the same models replicate the master's exchange (noise-free:
 //! equal to the master) and run the report's own loop structure, to separate co-simulation
 //! effects from the reproduction. Not reproducible (notes): S9, S10 (the stepped bottom of
-//! Fig. 25 is not given), S12 (the depth-to-coefficient rule behind Table 14 is unknown).
+//! [Parsons1980, Fig. 25] is not given), S12 (the depth-to-coefficient rule behind
+//! [Parsons1980, Table 14] is unknown).
 
 mod equilibrium;
 mod model_loop;

@@ -19,7 +19,7 @@ const H_NS: i64 = 234_881_209;
 
 /// Result of a model-level loop: η′ at every exchange (absolute), the estimates after every
 /// step, max |η′| in the first cycle (S14) and its t′, RMS(118) of the six estimates (S14), and
-/// the estimator's fits (WLS: the step, the 8 parameters and the Table 10 code).
+/// the estimator's fits (WLS: the step, the 8 parameters and the [Parsons1980, Table 10] code).
 pub(super) struct LoopRun {
     pub eta: Vec<f64>,
     pub estimates: Vec<[f64; 6]>,
@@ -72,8 +72,8 @@ pub(super) struct LoopSpec {
     /// old (the first two exchanges both carry the initial state), the controller's output
     /// evaluated after its step from the previous exchange's inputs, the rudder reaching the
     /// estimator with the states it belongs to, the filter re-designed one step after the
-    /// controller. Otherwise the report's loop (spec Appendix A): everything at Δt′ = 0.005 in
-    /// one loop, plant and gear by Euler, no delays.
+    /// controller. Otherwise the report's loop (as re-simulated for the [DERIVED] values):
+    /// everything at Δt′ = 0.005 in one loop, plant and gear by Euler, no delays.
     pub exchange: bool,
 }
 
@@ -100,7 +100,8 @@ struct Loop {
     /// The plant of the exchange loop (TokyoMaru's own Euler) and its gear angle.
     ship: TokyoMaru,
     delta: f64,
-    /// The plant of the report's loop: state [ψ′, r′, β′, η′, δ′] and eq. 11's F, g, Γ.
+    /// The plant of the report's loop: state [ψ′, r′, β′, η′, δ′] and the F, g, Γ of
+    /// [Parsons1980, eq. (11)].
     x: [f64; 5],
     fs: SMatrix<f64, 5, 5>,
     gs: SMatrix<f64, 5, 1>,
@@ -319,7 +320,7 @@ impl Loop {
     }
 
     /// Plant and gear over one step: TokyoMaru and the exact first-order gear (exchange), or
-    /// eq. 11 with the gear by Euler at Δt′ (the report's loop).
+    /// [Parsons1980, eq. (11)] with the gear by Euler at Δt′ (the report's loop).
     fn advance_plant(&mut self, u: f64, h: f64, xs: [f64; 4]) {
         let forces = self.spec.forces;
         if self.spec.exchange {

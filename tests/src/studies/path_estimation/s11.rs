@@ -1,6 +1,7 @@
-//! S11 (Tables 12-13, Fig. 26): the WLS in the loop, truth in deep water under a constant
-//! disturbance from the steady state of line 1145, three updates; and the 5.0-L windows of
-//! Table 12 (first update).
+//! S11 [Parsons1980, sec. 4.2.2, Tables 12-13, Fig. 26]: the WLS in the loop, truth in deep water
+//! under a constant disturbance from the steady state the report starts from (see
+//! [`super::equilibrium`]), three updates; and the 5.0-L windows of [Parsons1980, Table 12] (first
+//! update).
 
 use super::equilibrium::{line_1145_equilibrium, W_S11};
 use super::model_loop::{run_loop, LoopEstimator, LoopRun, LoopSpec};
@@ -15,10 +16,11 @@ use models::hull::DEG;
 use shipsim::plot::{Panel, Series, Table};
 
 pub(super) const WLS: &str = "path_control_wls.toml";
-/// Per-sample σ′ of ψ′, r′, η′ of Table 9 (the S11 filter's noise, see the system file).
+/// Per-sample σ′ of ψ′, r′, η′ of [Parsons1980, Table 9] (the S11 filter's noise, see the system
+/// file).
 const SIGMA_TABLE_9_FILTER: [f64; 3] = [SIGMA_TABLE_9[0], SIGMA_TABLE_9[1], SIGMA_TABLE_9[3]];
 
-/// Table 13, updates 1, 2, 3 (rows: f22, f23, f25, f32, f33, f35, N′×10², Y′×10²).
+/// [Parsons1980, Table 13], updates 1, 2, 3 (rows: f22, f23, f25, f32, f33, f35, N′×10², Y′×10²).
 const TABLE_13: [[&str; 3]; 8] = [
     ["-2.0037", "-1.9258", "-1.9306"],
     ["3.2540", "3.1177", "3.1414"],
@@ -30,7 +32,8 @@ const TABLE_13: [[&str; 3]; 8] = [
     ["0.35415", "0.39149", "0.31570"],
 ];
 const TABLE_13_OFFSET: [&str; 3] = ["0.1745", "0.4779", "0.1257"];
-/// Table 12, the columns 2.5/0.5 (= Table 13 update 1), 5.0/0.5, 5.0/2.5 (rows as Table 13).
+/// [Parsons1980, Table 12], the columns 2.5/0.5 (= Table 13 update 1), 5.0/0.5, 5.0/2.5 (rows as
+/// in Table 13).
 const TABLE_12: [[&str; 3]; 8] = [
     ["-2.0037", "-1.9722", "-1.9505"],
     ["3.2540", "3.2007", "3.1544"],
@@ -41,7 +44,7 @@ const TABLE_12: [[&str; 3]; 8] = [
     ["0.12987", "0.12824", "0.12648"],
     ["0.35415", "0.35960", "0.34070"],
 ];
-/// Table 12 offset η′ at the end of the cycle, 5.0/0.5 and 5.0/2.5.
+/// [Parsons1980, Table 12] offset η′ at the end of the cycle, 5.0/0.5 and 5.0/2.5.
 const TABLE_12_OFFSET: [f64; 2] = [1.273, 2.422];
 
 /// S11 at model level (see [`LoopSpec`]).
@@ -92,7 +95,8 @@ fn s11_loop(noise: Option<u64>, exchange: bool) -> Result<LoopRun, String> {
 }
 
 /// S11: noise-free runs against the equilibrium and the model-level loop, the reference noise
-/// over the seeds (Table 13), the 5.0-L windows (Table 12), the Table 3 noise in the filter and
+/// over the seeds [Parsons1980, Table 13], the 5.0-L windows [Parsons1980, Table 12], the
+/// [Parsons1980, Table 3] noise in the filter and
 /// the report's loop structure, figure and notes.
 pub(super) fn s11(env: &Env, report: &mut Report) -> Result<(), String> {
     let (x_eq, xhat_eq) = line_1145_equilibrium()?;
@@ -121,7 +125,7 @@ struct Results {
     reference: Reference,
     /// Per dither period of the 5.0-L windows: the offset at the end of the cycle.
     t12: Vec<(&'static str, Spread)>,
-    /// The runs with the Table 3 noise in the filter.
+    /// The runs with the [Parsons1980, Table 3] noise in the filter.
     t3: Vec<WlsStats>,
     /// Max |η′| per cycle in the report's loop structure.
     rep_offs: Vec<Spread>,
@@ -258,7 +262,8 @@ fn first_fit_checks(nfs: &WlsStats, c: &mut Vec<Check>) -> Result<(), String> {
     Ok(())
 }
 
-/// The reference noise over the seeds: Table 13 (three updates) and the offsets per cycle.
+/// The reference noise [Parsons1980, Table 9] over the seeds: [Parsons1980, Table 13] (three
+/// updates) and the offsets per cycle.
 struct Reference {
     runs: Vec<WlsStats>,
     offs: Vec<Spread>,
@@ -328,8 +333,8 @@ fn table_13_checks(env: &Env, eta_eq: f64, c: &mut Vec<Check>) -> Result<Referen
         ),
         max_cmd < std::f64::consts::PI,
     ));
-    // the cost scale: ratios of the final costs between the updates (the printed J's
-    // normalisation is unknown, spec §6 item 13)
+    // the cost scale: ratios of the final costs between the updates (the normalisation of the
+    // J printed in [Parsons1980, Table 13] is not stated)
     let ratio = |u: usize| Spread::over(&runs, |r| r.fits[u].2 / r.fits[0].2);
     c.push(within_seeds(
         "Table 13 final cost of updates 2 / 3 relative to update 1 (0.1012/0.1059, 0.1035/0.1059)",
@@ -344,7 +349,8 @@ fn table_13_checks(env: &Env, eta_eq: f64, c: &mut Vec<Check>) -> Result<Referen
     })
 }
 
-/// Table 12: 5.0-L windows (first update only); (dither period, offset at the end of the cycle).
+/// [Parsons1980, Table 12]: 5.0-L windows (first update only); (dither period, offset at the end
+/// of the cycle).
 fn table_12_checks(
     env: &Env,
     eta_eq: f64,
@@ -395,7 +401,7 @@ fn table_12_checks(
     Ok(t12)
 }
 
-/// The alternative reading: Table 3 noise in the filter (first update).
+/// The alternative reading: [Parsons1980, Table 3] noise in the filter (first update).
 fn table_3_noise(env: &Env, eta_eq: f64) -> Result<Vec<WlsStats>, String> {
     let mut t3 = Vec::new();
     for seed in 1..=SEEDS {
@@ -431,7 +437,7 @@ fn report_loop_offsets() -> Result<Vec<Spread>, String> {
     Ok(rep_offs)
 }
 
-/// Fig. 26 (seed 1): offset, rudder, f̂23, f̂32.
+/// [Parsons1980, Fig. 26] (seed 1): offset, rudder, f̂23, f̂32.
 fn figure(env: &Env, x_eq: [f64; 5], report: &mut Report) -> Result<(), String> {
     let eta_eq = x_eq[3] * L;
     let t1 = env.run(WLS, &wls_seed(1), "s11_seed1.csv")?;

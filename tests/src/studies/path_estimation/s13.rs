@@ -1,4 +1,5 @@
-//! S13 (Table 15): the WLS in the loop with a ship passing during the second window.
+//! S13 [Parsons1980, sec. 4.3.2, Table 15]: the WLS in the loop with a ship passing during the
+//! second window.
 
 use super::wls::{wls_seed, wls_stats, wls_table_checks, WlsStats};
 use super::{within_seeds, SEEDS};
@@ -7,7 +8,7 @@ use models::hull::tokyo_maru::L;
 use shipsim::plot::Panel;
 
 pub(super) const WLS_PS: &str = "path_control_wls_passing_ship.toml";
-/// Table 15, updates 1, 2, 3 (rows: f22, f23, f25, f32, f33, f35, N′×10⁵, Y′×10⁵).
+/// [Parsons1980, Table 15], updates 1, 2, 3 (rows: f22, f23, f25, f32, f33, f35, N′×10⁵, Y′×10⁵).
 const TABLE_15: [[&str; 3]; 8] = [
     ["-1.9446", "-0.62936", "-1.9247"],
     ["3.2178", "-1.8532", "3.0732"],
@@ -19,8 +20,8 @@ const TABLE_15: [[&str; 3]; 8] = [
     ["6.6942", "67.778", "-6.9666"],
 ];
 
-/// S13: the runs over the seeds, Table 15, the Table 10 decisions, costs and offsets, figure and
-/// notes.
+/// S13: the runs over the seeds, [Parsons1980, Table 15], the decisions of the Table 10 rule,
+/// costs and offsets, figure and notes.
 pub(super) fn s13(env: &Env, report: &mut Report) -> Result<(), String> {
     let mut runs = Vec::new();
     for seed in 1..=SEEDS {
@@ -36,8 +37,8 @@ pub(super) fn s13(env: &Env, report: &mut Report) -> Result<(), String> {
     Ok(())
 }
 
-/// Table 15: update 1 over all seeds, update 3 over the seeds in which update 2 was rejected;
-/// returns those seeds' runs.
+/// [Parsons1980, Table 15]: update 1 over all seeds, update 3 over the seeds in which update 2 was
+/// rejected; returns those seeds' runs.
 fn table_15_checks(runs: &[WlsStats], c: &mut Vec<Check>) -> Result<Vec<WlsStats>, String> {
     // updates 1 and 3 (N′, Y′ as printed, ×10⁵ = ×10² · 1000)
     // update 1 over all seeds; update 3 over the seeds in which update 2 was rejected, as in
@@ -73,8 +74,8 @@ fn table_15_checks(runs: &[WlsStats], c: &mut Vec<Check>) -> Result<Vec<WlsStats
     Ok(rejected)
 }
 
-/// The Table 10 decisions on the three updates, and the cost evaluations they needed (seed
-/// medians).
+/// The decisions of the [Parsons1980, Table 10] rule on the three updates, and the cost
+/// evaluations they needed (seed medians).
 fn decision_checks(runs: &[WlsStats], c: &mut Vec<Check>) -> (f64, f64, f64) {
     let dec = |u: usize, code: f64| runs.iter().filter(|r| r.fits[u].3 == code).count();
     let (rej2, part2, all2) = (dec(1, 0.0), dec(1, 1.0), dec(1, 2.0));
@@ -134,7 +135,7 @@ fn cost_and_offset_checks(runs: &[WlsStats], c: &mut Vec<Check>) -> Spread {
     c1
 }
 
-/// Table 15 (seed 1): offset, passing-ship disturbance, f̂23.
+/// The S13 figure (seed 1): offset, passing-ship disturbance, f̂23.
 fn figure(env: &Env, report: &mut Report) -> Result<(), String> {
     let t1 = env.run(WLS_PS, &wls_seed(1), "s13_seed1.csv")?;
     let ser = |name: &str, label: &str, scale: f64| series(&t1, name, label, scale);

@@ -1,5 +1,6 @@
-//! S14 (Table 16, Figs. 28-31): the MVE in the loop, truth at H/T = 1.89, everything initialised
-//! for deep water, three disturbance cases; and the same loop at model level.
+//! S14 [Parsons1980, sec. 5.3, Table 16, Figs. 28-31]: the MVE in the loop, truth at H/T = 1.89,
+//! everything initialised for deep water, three disturbance cases; and the same loop at model
+//! level.
 
 use super::model_loop::{run_loop, LoopEstimator, LoopRun, LoopSpec};
 use super::{err, noise_free_sets, within_seeds, CYCLE, DT, SEEDS};
@@ -21,8 +22,8 @@ pub(super) const MVE: &str = "path_control_mve.toml";
 const DITHER_START: f64 = -0.0025;
 const NAMES: [&str; 6] = ["f22", "f23", "f25", "f32", "f33", "f35"];
 
-/// One S14 disturbance case (Table 16 rows): caption, overrides, printed min/mean/max/final/RMS
-/// (rows) of f22..f35 (columns).
+/// One S14 disturbance case ([Parsons1980, Table 16] rows): caption, overrides, printed
+/// min/mean/max/final/RMS (rows) of f22..f35 (columns).
 struct MveCase {
     id: &'static str,
     what: &'static str,
@@ -73,7 +74,7 @@ const MVE_CASES: [MveCase; 3] = [
             [
                 "-1.9020", "5.9162", "-0.92556", "0.19843", "-0.66257", "-0.16176",
             ],
-            // f35: printed "−0.07987" (a negative RMS, spec §6 item 25): read as 0.07987
+            // f35: [Parsons1980, Table 16] prints "−0.07987", a negative RMS: read as 0.07987
             [
                 "2.0896", "12.8430", "0.43989", "1.11448", "1.75410", "0.07987",
             ],
@@ -122,7 +123,7 @@ struct MveStats {
     gain_updates: f64,
 }
 
-/// Table 16 statistics of a sequence of estimates against the truth `p`.
+/// [Parsons1980, Table 16] statistics of a sequence of estimates against the truth `p`.
 fn table_16_stats(est: &[[f64; 6]], fin: [f64; 6], p: [f64; 6]) -> [[f64; 6]; 5] {
     let n = est.len() as f64;
     let mut s = [[0.0; 6]; 5];
@@ -132,7 +133,7 @@ fn table_16_stats(est: &[[f64; 6]], fin: [f64; 6], p: [f64; 6]) -> [[f64; 6]; 5]
         s[1][i] = v.clone().sum::<f64>() / n;
         s[2][i] = v.clone().fold(f64::NEG_INFINITY, f64::max);
         s[3][i] = fin[i];
-        // eq. 118: √Σ without 1/N
+        // [Parsons1980, eq. (118)]: √Σ without 1/N
         s[4][i] = v.map(|x| (x - p[i]).powi(2)).sum::<f64>().sqrt();
     }
     s
@@ -190,7 +191,7 @@ fn seed_sets(case: &MveCase, seed: u64) -> Vec<String> {
     v
 }
 
-/// Per-sample noise σ′ of ψ′, r′, η′: Table 3 (the S14 control loop).
+/// Per-sample noise σ′ of ψ′, r′, η′: [Parsons1980, Table 3] (the S14 control loop).
 const SIGMA_TABLE_3: [f64; 3] = [1.611e-3, 7.563e-3, 9.549e-3];
 
 /// The PathController settings of S14 (`dither_start`: see systems/path_control_mve.toml).
@@ -297,8 +298,8 @@ fn test_loop(seed: u64) -> Result<(f64, f64, f64), String> {
     Ok((eta_max, sq23.sqrt(), t_max))
 }
 
-/// S14: the runs through the master over the seeds, Table 16 and Figs. 28-31, the same loop at
-/// model level, figure and notes.
+/// S14: the runs through the master over the seeds, [Parsons1980, Table 16, Figs. 28-31], the
+/// same loop at model level, figure and notes.
 pub(super) fn s14(env: &Env, report: &mut Report) -> Result<(), String> {
     let runs = MveRuns::run(env)?;
     let c = &mut report.checks;
@@ -374,7 +375,8 @@ fn structure_checks(runs: &MveRuns, c: &mut Vec<Check>) {
     ));
 }
 
-/// The first cycle: the peak offset (Fig. 28) and when f̂23 comes near its truth (Fig. 29).
+/// The first cycle: the peak offset [Parsons1980, Fig. 28] and when f̂23 comes near its truth
+/// [Parsons1980, Fig. 29].
 struct FirstCycle {
     eta: Spread,
     t_eta: Spread,
@@ -386,7 +388,7 @@ struct FirstCycle {
 
 fn first_cycle_checks(runs: &MveRuns, c: &mut Vec<Check>) -> FirstCycle {
     let truth = parameters_of(&TABLE_2[2]);
-    // ---- Fig. 28: the offset after the first dither window
+    // ---- [Parsons1980, Fig. 28]: the offset after the first dither window
     let eta = runs.sp(0, |s| s.eta_max);
     let t_eta = runs.sp(0, |s| s.t_eta_max);
     c.push(within_seeds(
@@ -401,7 +403,7 @@ fn first_cycle_checks(runs: &MveRuns, c: &mut Vec<Check>) -> FirstCycle {
         &[t_eta],
         "",
     ));
-    // ---- Fig. 29 (the passing-ship run): f̂23 near its true value in about 3 L
+    // ---- [Parsons1980, Fig. 29] (the passing-ship run): f̂23 near its true value in about 3 L
     let near = runs.sp(1, |s| s.f23_near);
     let settle = runs.sp(1, |s| s.f23_settled);
     // the seed-mean trajectory of f̂23 (the noise averaged out), where it first comes within 10 %
@@ -431,7 +433,7 @@ fn first_cycle_checks(runs: &MveRuns, c: &mut Vec<Check>) -> FirstCycle {
     }
 }
 
-/// Table 16, three cases: min / mean / max / final and RMS(118) of every estimate.
+/// [Parsons1980, Table 16], three cases: min / mean / max / final and RMS(118) of every estimate.
 fn table_16_checks(runs: &MveRuns, c: &mut Vec<Check>) {
     for (ci, case) in MVE_CASES.iter().enumerate() {
         for (i, name) in NAMES.iter().enumerate() {
@@ -593,7 +595,7 @@ fn model_level(env: &Env, c: &mut Vec<Check>) -> Result<ModelLevel, String> {
     Ok(m)
 }
 
-/// Figs. 28-31 (seed 1): the cross-track and the estimates of f23, f25, f32.
+/// [Parsons1980, Figs. 28-31] (seed 1): the cross-track and the estimates of f23, f25, f32.
 fn figure(env: &Env, runs: &MveRuns, report: &mut Report) -> Result<(), String> {
     let truth = parameters_of(&TABLE_2[2]);
     let time = runs.seed1[0].time();

@@ -11,7 +11,7 @@ const P_NAMES: [&str; 8] = ["f22", "f23", "f25", "f32", "f33", "f35", "N′", "Y
 /// The fits and cycle offsets of one WLS run (S11, S13).
 #[derive(Clone, Debug, Default)]
 pub(super) struct WlsStats {
-    /// Per fit: p̂ (N′, Y′ ×10²), evaluations, Σ|e|² ×10², Table 10 code, row.
+    /// Per fit: p̂ (N′, Y′ ×10²), evaluations, Σ|e|² ×10², [Parsons1980, Table 10] code, row.
     pub fits: Vec<([f64; 8], f64, f64, f64, usize)>,
     /// Max |η′| and η′ at the end of each cycle of `lu`.
     pub max_offset: Vec<f64>,
