@@ -1,9 +1,9 @@
-"""Dynamic positioning with the passive observer (source 001, issue 8 system 4) in libcosim.
+"""Dynamic positioning with the passive observer [Fossen1999] (issue 8 system 4) in libcosim.
 
 systems/dp_observer.toml (SupplyVessel + Current bias + Waves + Sensors + PassiveObserver +
 DpController, multi-rate 0.1 s / 1 s), exported with `shipsim export-osp`, runs in libcosim
 (libcosimpy) with the same results as in shipsim: the DP closed loop as the file stands, and the
-paper's open-loop simulation study (Eq. 61 thrust, Markov bias with T = 1000 s) as
+paper's open-loop simulation study ([Fossen1999, eq. (61)] thrust, Markov bias with T = 1000 s) as
 tests/src/studies/dp_observer.rs runs it. The stop time is shortened to 1200 s and every base
 step recorded (decimation 1) so that each libcosim step is compared.
 
@@ -73,7 +73,7 @@ def test_dp_observer_equals_libcosim(tmp_path, changes, label):
     col = {h: i for i, h in enumerate(header)}
     assert len(rows) == 12001, label
     # Not trivial: waves of metres reach the measurement, the observer estimates a bias, and the
-    # thrust acts (the PID in the closed loop, Eq. 61 in the open loop).
+    # thrust acts (the PID in the closed loop, [Fossen1999, eq. (61)] in the open loop).
     meas = [r[col["sensors.north_measured"]] for r in rows]
     assert max(meas) - min(meas) > 5.0, label
     assert max(abs(r[col["observer.bias_north_estimate"]]) for r in rows) > 1e4, label

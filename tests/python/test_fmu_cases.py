@@ -118,7 +118,7 @@ def passive_observer_wave_filter_active(ref):
 
 
 def parameter_ekf_learns(ref):
-    # -Y_v moved from half the Table 2.3 value towards 0.0244
+    # -Y_v moved from half the [Taylor2000, Table 2.3] value towards 0.0244
     assert ref[-1]["neg_y_v_estimate"] > 0.018
     assert ref[-1]["update_count"] == 900
 

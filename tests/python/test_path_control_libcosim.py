@@ -1,11 +1,11 @@
-"""Adaptive path control of the Tokyo Maru (source 004, issue 8 system 2) in libcosim.
+"""Adaptive path control of the Tokyo Maru [Parsons1980] (issue 8 system 2) in libcosim.
 
 The system files systems/path_control_*.toml (TokyoMaru + SteeringGear + Current + Sensors +
 PathKalmanFilter + PathController), exported with `shipsim export-osp`, run in libcosim
 (libcosimpy) with the same results as in shipsim, to 1e-12: the passing-ship file with its
 defaults (scenario S3 with the report's measurement noise, seed 1; a LinearTransformation carries
-the B/2 track offset), and the design-current file as scenario S7 (deep water, the Table 8
-design reached through the controller's adaptation path) with noise seed 7.
+the B/2 track offset), and the design-current file as scenario S7 (deep water, the
+[Parsons1980, Table 8] design reached through the controller's adaptation path) with noise seed 7.
 
 Environment: SHIPSIM_BIN (the master), SHIPSIM_FMU_DIR (our built FMUs).
 """
@@ -71,6 +71,6 @@ def test_path_control_equals_libcosim(tmp_path, system, changes, label):
     assert max(eta) - min(eta) > 5.0, label
     assert any(r[col["kf.cross_track_estimate"]] != r[col["ship.cross_track"]] for r in rows[1:])
     if changes is S7:
-        # the adaptation path really produced the Table 8 design
+        # the adaptation path really produced the [Parsons1980, Table 8] design
         assert abs(rows[-1][col["ctl.gain_drift_angle"]] - 1.8986) < 2e-4
     assert_same_as_libcosim(osp, out)

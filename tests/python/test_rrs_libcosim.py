@@ -1,4 +1,4 @@
-"""Rudder roll stabilization (source 003, issue 8 system 1) in libcosim.
+"""Rudder roll stabilization [Klugt1987] (issue 8 system 1) in libcosim.
 
 systems/rrs.toml (RrsShip + SteeringGear + Waves + Wind + Sensors + RrsFilter + RrsAutopilot, multi-rate,
 wave moments mapped onto rudder-equivalent disturbances by LinearTransformation functions),

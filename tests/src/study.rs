@@ -1,6 +1,7 @@
 //! Coupled-system studies: each runs one or more system files from `systems/` through the
 //! shipsim master (in process, the same code as `shipsim run`), computes the quantities a source
-//! publishes, and compares them with the published (or [DERIVED]) values.
+//! publishes, and compares them with the published values, or with [DERIVED] ones: values
+//! computed from a source's equations where the source prints none.
 //!
 //! The same study functions serve the system tests (`tests/tests/studies.rs` asserts that every
 //! check passes) and the validation report (`cargo xtask report`, which writes every study's
@@ -106,12 +107,7 @@ pub fn series(table: &Table, column: &str, label: &str, scale: f64) -> Result<Se
     Ok(Series {
         label: label.to_string(),
         t: table.time().to_vec(),
-        y: table
-            .column(column)
-            .map_err(|e| e.to_string())?
-            .iter()
-            .map(|v| v * scale)
-            .collect(),
+        y: col(table, column)?.iter().map(|v| v * scale).collect(),
     })
 }
 
@@ -124,26 +120,39 @@ pub fn series_window(
     t0: f64,
     t1: f64,
 ) -> Result<Series, String> {
-    let full = series(table, column, label, scale)?;
-    let (t, y): (Vec<f64>, Vec<f64>) = full
-        .t
-        .iter()
-        .zip(&full.y)
-        .filter(|(t, _)| (t0..=t1).contains(*t))
-        .map(|(t, y)| (*t, *y))
-        .unzip();
-    Ok(Series {
-        label: full.label,
+    Ok(window(series(table, column, label, scale)?, t0, t1))
+}
+
+/// The part of a curve with t0 ≤ t ≤ t1.
+fn window(s: Series, t0: f64, t1: f64) -> Series {
+    let (t, y): (Vec<f64>, Vec<f64>) =
+        s.t.iter()
+            .zip(&s.y)
+            .filter(|(t, _)| (t0..=t1).contains(*t))
+            .map(|(t, y)| (*t, *y))
+            .unzip();
+    Series {
+        label: s.label,
         t,
         y,
-    })
+    }
+}
+
+/// A horizontal line at `y` over the times `t`.
+pub fn constant_series(t: &[f64], y: f64, label: &str) -> Series {
+    Series {
+        label: label.into(),
+        t: t.to_vec(),
+        y: vec![y; t.len()],
+    }
 }
 
 /// One compared quantity.
 #[derive(Clone, Debug)]
 pub struct Check {
     pub quantity: String,
-    /// The published value as the source prints it (with [DERIVED] where the spec derived it).
+    /// The published value as the source prints it ([DERIVED] where it was computed from the
+    /// source's equations).
     pub published: String,
     pub ours: String,
     /// The acceptance rule, in words.
@@ -301,20 +310,131 @@ impl Report {
     }
 }
 
-/// Variance of a slice (population, about its mean).
-pub fn variance(v: &[f64]) -> f64 {
-    if v.is_empty() {
-        return f64::NAN;
+/// The `--set` overrides of a run as the notes print them ("its defaults" when there are none).
+pub fn overrides_text(sets: &[&str]) -> String {
+    if sets.is_empty() {
+        "its defaults".to_string()
+    } else {
+        format!("--set {}", sets.join(" --set "))
     }
-    let mean = v.iter().sum::<f64>() / v.len() as f64;
-    v.iter().map(|x| (x - mean) * (x - mean)).sum::<f64>() / v.len() as f64
+}
+
+// ------------------------------------------------------------------------------------------
+// Columns and statistics
+// ------------------------------------------------------------------------------------------
+
+/// A column of a recorded table.
+pub fn col<'a>(table: &'a Table, column: &str) -> Result<&'a [f64], String> {
+    table.column(column).map_err(|e| e.to_string())
+}
+
+/// The last value of a column.
+pub fn last(table: &Table, column: &str) -> Result<f64, String> {
+    col(table, column)?
+        .last()
+        .copied()
+        .ok_or_else(|| format!("empty column {column}"))
 }
 
 /// The part of a column from time `t0` on.
 pub fn after<'a>(table: &'a Table, column: &str, t0: f64) -> Result<&'a [f64], String> {
     let t = table.time();
     let start = t.iter().position(|&x| x >= t0).unwrap_or(t.len());
-    Ok(&table.column(column).map_err(|e| e.to_string())?[start..])
+    Ok(&col(table, column)?[start..])
+}
+
+/// Mean of a slice.
+pub fn mean(v: &[f64]) -> f64 {
+    v.iter().sum::<f64>() / v.len() as f64
+}
+
+/// Variance of a slice (population, about its mean).
+pub fn variance(v: &[f64]) -> f64 {
+    if v.is_empty() {
+        return f64::NAN;
+    }
+    let mean = mean(v);
+    v.iter().map(|x| (x - mean) * (x - mean)).sum::<f64>() / v.len() as f64
+}
+
+/// Standard deviation of a slice (population).
+pub fn std_dev(v: &[f64]) -> f64 {
+    variance(v).sqrt()
+}
+
+/// Largest |v| (0 for an empty slice).
+pub fn max_abs(v: &[f64]) -> f64 {
+    v.iter().fold(0.0f64, |m, x| m.max(x.abs()))
+}
+
+/// RMS of a − b.
+pub fn rms_diff(a: &[f64], b: &[f64]) -> f64 {
+    (a.iter().zip(b).map(|(x, y)| (x - y).powi(2)).sum::<f64>() / a.len() as f64).sqrt()
+}
+
+// ------------------------------------------------------------------------------------------
+// Noise seeds: a published realisation against the spread of many
+// ------------------------------------------------------------------------------------------
+
+/// Min, max, mean and median of a statistic over the noise seeds.
+#[derive(Clone, Copy, Debug)]
+pub struct Spread {
+    pub n: usize,
+    pub min: f64,
+    pub max: f64,
+    pub mean: f64,
+    pub median: f64,
+}
+
+impl Spread {
+    /// The spread of the values `v` (one per seed).
+    pub fn of(v: &[f64]) -> Spread {
+        let mut s = v.to_vec();
+        s.sort_by(|a, b| a.total_cmp(b));
+        let n = s.len();
+        Spread {
+            n,
+            min: s[0],
+            max: s[n - 1],
+            mean: s.iter().sum::<f64>() / n as f64,
+            median: if n % 2 == 1 {
+                s[n / 2]
+            } else {
+                0.5 * (s[n / 2 - 1] + s[n / 2])
+            },
+        }
+    }
+
+    /// The spread of `f` over the runs.
+    pub fn over<T>(runs: &[T], f: impl Fn(&T) -> f64) -> Spread {
+        Spread::of(&runs.iter().map(f).collect::<Vec<_>>())
+    }
+
+    /// Whether a printed value lies within min..max, widened by half a unit of its last digit.
+    pub fn covers(&self, printed: &str) -> bool {
+        let v: f64 = printed.parse().unwrap_or(f64::NAN);
+        let h = half_digit(printed);
+        (self.min - h..=self.max + h).contains(&v)
+    }
+}
+
+/// "min .. max (mean m)".
+impl std::fmt::Display for Spread {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{} .. {} (mean {})",
+            fmt_num(self.min),
+            fmt_num(self.max),
+            fmt_num(self.mean)
+        )
+    }
+}
+
+/// Half a unit of the last digit of a printed number.
+pub fn half_digit(printed: &str) -> f64 {
+    let d = printed.split('.').nth(1).map_or(0, |f| f.len() as i32);
+    0.5 * 10f64.powi(-d)
 }
 
 #[cfg(test)]
@@ -329,5 +449,21 @@ mod tests {
         assert_eq!(fmt_num(34.8123), "34.81");
         assert_eq!(fmt_num(0.012345), "0.01235");
         assert!((variance(&[1.0, 3.0]) - 1.0).abs() < 1e-15);
+        assert!((std_dev(&[1.0, 3.0]) - 1.0).abs() < 1e-15);
+        assert_eq!(max_abs(&[1.0, -3.0]), 3.0);
+    }
+
+    #[test]
+    fn spreads_cover_printed_values() {
+        let s = Spread::of(&[3.0, 1.0, 2.0, 4.0]);
+        assert_eq!(
+            (s.n, s.min, s.max, s.mean, s.median),
+            (4, 1.0, 4.0, 2.5, 2.5)
+        );
+        assert_eq!(half_digit("0.00072"), 0.000005);
+        assert_eq!(half_digit("54"), 0.5);
+        // "4.00" ± 0.005 and "1" ± 0.5 touch the range; "4.1" ± 0.05 and "0.9" ± 0.05 do not
+        assert!(s.covers("4.00") && s.covers("1") && !s.covers("4.1") && !s.covers("0.9"));
+        assert_eq!(s.to_string(), "1.000 .. 4.000 (mean 2.500)");
     }
 }

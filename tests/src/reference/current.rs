@@ -23,7 +23,8 @@ pub fn params() -> CurrentParams {
     }
 }
 
-/// 1200 s at h = 0.5 s (t' up to 25.5: the 4x passing ship at t' = 20 on the Fig. 4 ramp).
+/// 1200 s at h = 0.5 s (t' up to 25.5: the 4x passing ship at t' = 20 on the ramp of
+/// [Parsons1980, Fig. 4]).
 pub fn disturbances_004(out: &mut dyn Write) -> std::io::Result<()> {
     let h = 0.5;
     let n = 2400;

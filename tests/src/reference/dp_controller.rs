@@ -3,11 +3,12 @@
 use models::controllers::dp::{body_error, DpController, DpInputs, DpParams};
 use std::io::Write;
 
-/// Default gains (Northern Clipper, ω_b = 0.05 rad/s, ζ = 0.9, r = 10) plus the Eq. 61 test input
-/// scaled to 1e5; estimates and set points are slow sinusoids and ramps, all zero at t = 0 (so
-/// row 0 is the same whether an importer samples before or after setting the first inputs);
-/// h = 1 s, 600 s. Columns as in `steering_gear::sine`: the outputs of row k (τ and the error,
-/// both with direct feedthrough) were computed with the inputs of row k − 1, held over the step.
+/// Default gains (Northern Clipper, ω_b = 0.05 rad/s, ζ = 0.9, r = 10) plus the
+/// [Fossen1999, eq. (61)] test input scaled to 1e5; estimates and set points are slow sinusoids and
+/// ramps, all zero at t = 0 (so row 0 is the same whether an importer samples before or after
+/// setting the first inputs); h = 1 s, 600 s. Columns as in `steering_gear::sine`: the outputs of
+/// row k (τ and the error, both with direct feedthrough) were computed with the inputs of row
+/// k − 1, held over the step.
 pub fn case(out: &mut dyn Write) -> std::io::Result<()> {
     let h = 1.0;
     let n = 600;

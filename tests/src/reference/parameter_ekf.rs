@@ -7,7 +7,8 @@ use models::manoeuvre::{ManoeuvreGenerator, ManoeuvreKind};
 use models::observers::parameter_ekf::{ParameterEkf, ParameterEkfParams};
 use std::io::Write;
 
-/// The FMU's default parameters (Esso Osaka preset, Table 4.1 noise, x̂₀ = 0.5 × Table 2.3,
+/// The FMU's default parameters (Esso Osaka preset, [Taylor2000, Table 4.1] noise,
+/// x̂₀ = 0.5 × [Taylor2000, Table 2.3],
 /// n₀ = 80 rpm, sample interval 1 s). Inputs: the Esso Osaka linear model (`NomotoShip`) in a
 /// 10/10 zig-zag executed at 0 with the rudder stepped (held over each step), its u = U, v and
 /// r at `time` and n = 80 rpm + 0.5 sin(0.1 t); h = 0.5 s (an update every second step),

@@ -3,9 +3,10 @@
 use models::observers::passive_observer::{PassiveObserver, PassiveObserverParams};
 use std::io::Write;
 
-/// Default parameters (Northern Clipper, eq. 59 gains, mass-normalised injection); measured
-/// position/heading = slow LF motion + 0.9 rad/s wave motion, thrust of eq. 61 scaled by 100;
-/// h = 1 s (the paper's 1 Hz), 600 s. Columns as in `steering_gear::sine`.
+/// Default parameters (Northern Clipper, [Fossen1999, eq. (59)] gains, mass-normalised injection);
+/// measured position/heading = slow LF motion + 0.9 rad/s wave motion, thrust of
+/// [Fossen1999, eq. (61)] scaled by 100; h = 1 s (the paper's 1 Hz), 600 s. Columns as in
+/// `steering_gear::sine`.
 pub fn case(out: &mut dyn Write) -> std::io::Result<()> {
     let h = 1.0;
     let n = 600;

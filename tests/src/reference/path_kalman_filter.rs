@@ -4,10 +4,10 @@ use models::hull::tokyo_maru::{L, U};
 use models::observers::path_kalman::{PathKalmanConfig, PathKalmanFilter};
 use std::io::Write;
 
-/// Default parameters (random-walk design at H/T = 1.89, Table 5 gains); measured heading, yaw
-/// rate and cross-track and a square-wave rudder command as functions of time; h = 0.25 s (two
-/// Euler sub-steps, as ceil(0.25 / 0.2349) = 2), 300 s.
-/// Columns as in `steering_gear::sine` (inputs at `time`, outputs sampled before the step).
+/// Default parameters (random-walk design at H/T = 1.89, [Parsons1980, Table 5] gains); measured
+/// heading, yaw rate and cross-track and a square-wave rudder command as functions of time;
+/// h = 0.25 s (two Euler sub-steps, as ceil(0.25 / 0.2349) = 2), 300 s. Columns as in
+/// `steering_gear::sine` (inputs at `time`, outputs sampled before the step).
 pub fn case(out: &mut dyn Write) -> std::io::Result<()> {
     let h = 0.25;
     let n = 1200;

@@ -14,10 +14,11 @@ pub const UPDATE_CYCLE: f64 = 1.5;
 /// (Euler at Δt′ = hU/L, internal steering gear) from the line-1145 equilibrium, under a ±0.5 rad
 /// dither of period 0.5 L throughout, sampled every h = 0.25 s (exact in libcosim's integer-ns
 /// clock) as the PathWlsEstimator's inputs; the measurements carry a deterministic perturbation
-/// (1e-4 sin) so that the fits do not end at zero cost, the estimate inputs a smaller one. The
-/// FMU runs with window_start = 0.5, window_length = 1.0, update_cycle = 1.5 (three fits in 870
-/// steps, 4.6 L) and its other defaults (first search from the Table 2 values at 1.89). Columns:
-/// `time`, the inputs (set at `time`), then the outputs as sampled before that row's inputs.
+/// (1e-4 sin) so that the fits do not end at zero cost, the estimate inputs a smaller one. The FMU
+/// runs with window_start = 0.5, window_length = 1.0, update_cycle = 1.5 (three fits in 870 steps,
+/// 4.6 L) and its other defaults (first search from the [Parsons1980, Table 2] values at 1.89).
+/// Columns: `time`, the inputs (set at `time`), then the outputs as sampled before that row's
+/// inputs.
 pub fn windows(out: &mut dyn Write) -> std::io::Result<()> {
     let h = 0.25;
     let n = 870;

@@ -5,9 +5,9 @@ use models::observers::rrs_filter::{
 };
 use std::io::Write;
 
-/// Default parameters (T = 0.1 s, Table 2.4 at 11 m/s, roll (q1, q2) = (10, 0.001), realised yaw
-/// filter with adaptive E[w3^2], L speed filter); analytic inputs; h = 0.25 s (3 samples per
-/// step), 300 s. Columns as in `steering_gear::sine`.
+/// Default parameters (T = 0.1 s, [Klugt1987, Table 2.4] at 11 m/s, roll (q1, q2) = (10, 0.001),
+/// realised yaw filter with adaptive E[w3^2], L speed filter); analytic inputs; h = 0.25 s (3
+/// samples per step), 300 s. Columns as in `steering_gear::sine`.
 pub fn case(out: &mut dyn Write) -> std::io::Result<()> {
     let h = 0.25;
     let n = 1200;

@@ -69,7 +69,8 @@ pub fn simulation(out: &mut dyn Write) -> std::io::Result<()> {
     case(out, RrsShip::simulation_22kn(), |_| U_22KN, true)
 }
 
-/// `model = 2` (control model, Table 2.4) with a slowly increasing speed; h = 0.05 s, 200 s.
+/// `model = 2` (control model, [Klugt1987, Table 2.4]) with a slowly increasing speed; h = 0.05 s,
+/// 200 s.
 pub fn control(out: &mut dyn Write) -> std::io::Result<()> {
     case(out, RrsShip::control_model(), |t| 8.0 + 0.02 * t, false)
 }

@@ -58,7 +58,7 @@ pub fn sum_of_sinusoids(out: &mut dyn Write) -> std::io::Result<()> {
     run(out, base())
 }
 
-/// Shaping filter, low-pass form (003 Fig. 2.10), 300 s at h = 0.1 s.
+/// Shaping filter, low-pass form [Klugt1987, Fig. 2.10], 300 s at h = 0.1 s.
 pub fn shaping_filter(out: &mut dyn Write) -> std::io::Result<()> {
     run(
         out,

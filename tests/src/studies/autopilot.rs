@@ -1,51 +1,39 @@
-//! Autopilot and track keeping of the DDG-51 EKF thesis (source 000, spec
-//! `ddg51_ekf_autopilot.md` §4.7-4.11 and §4.5, AT-6 to AT-9 and AT-11), through the master:
+//! Autopilot and track keeping of the DDG-51 EKF thesis [Taylor2000, secs. 4.3.4, 5.2.3, 5.3.3]
+//! (the checks named AT-6 to AT-9 and AT-11 in the report), through the master:
 //!
 //! * `autopilot_current.toml`: NomotoShip (DDG-51 first-order Nomoto) + SteeringGear (6/(s+6) in
 //!   t') + Current (5 kn on the beam, decaying) + Sensors (noisy heading) + HeadingAutopilot:
-//!   AT-6 (gear filters the noise) and AT-7 (current offset);
+//!   AT-6 (gear filters the noise) and AT-7 (current offset) [Taylor2000, sec. 5.2.3.1];
 //! * `autopilot_track_change.toml`: the same loop with the autopilot's 90° track-change
-//!   generator: AT-8;
+//!   generator: AT-8 [Taylor2000, sec. 5.2.3.2];
 //! * `autopilot_current_nonlinear.toml`, `autopilot_track_change_nonlinear.toml`: AT-7 and AT-8
 //!   again on a nonlinear plant with sway and speed loss (ContainerShip standing in for the
-//!   thesis's plant [43], which is not given), the current as an initial sway velocity as the
-//!   thesis applied it;
+//!   thesis's nonlinear plant, its reference [43], which is not given), the current as an initial
+//!   sway velocity as the thesis applied it;
 //! * `autopilot_track_offset.toml`: TrackController, sea state 4 (Waves, rudder-equivalent yaw
-//!   disturbance), 5-kn beam current gust and a 2 L lateral offset to port: AT-9;
+//!   disturbance), 5-kn beam current gust and a 2 L lateral offset to port: AT-9
+//!   [Taylor2000, sec. 5.3.3];
 //! * `identification_zigzag.toml`: ContainerShip + Manoeuvre (10/10 zig-zag) + Sensors +
 //!   ParameterEkf; the identified linear model's 10° turning circle against the plant's
-//!   (computed here with the models crate from the FMU's identified coefficients): AT-11.
+//!   (computed here with the models crate from the FMU's identified coefficients): AT-11
+//!   [Taylor2000, sec. 4.3.4].
 
-use crate::study::{after, series, Check, Env, Report};
+use crate::study::{after, col, last, max_abs, mean, series, std_dev, Check, Env, Report};
 use models::hull::container_ship::{ContainerShip, L as CS_L, LIN_B, LIN_M};
 use models::hull::nomoto::{NomotoInputs, NomotoModel, NomotoShip};
+use models::hull::{DEG, KNOT};
 use models::manoeuvre::{
     run as run_manoeuvre, turning_circle, ContainerShipRun, ManoeuvreGenerator, ManoeuvreKind,
     ManoeuvreShip, Sample,
 };
 use shipsim::plot::{Panel, Series, Table};
 
-const DEG: f64 = std::f64::consts::PI / 180.0;
 /// DDG-51 length 466 ft [m] and speed 22 kn [m/s] of the time base t' = tU/L.
 const L: f64 = 142.0368;
 const U: f64 = 11.317777777777778;
-const KNOT: f64 = 1852.0 / 3600.0;
 const T_NOMOTO: f64 = 1.9287;
 /// Rudder-equivalent wave yaw gain of systems/autopilot_track_offset.toml [rad per m].
 const WAVE_YAW_GAIN: f64 = 0.0745;
-
-fn col<'a>(t: &'a Table, c: &str) -> Result<&'a [f64], String> {
-    t.column(c).map_err(|e| e.to_string())
-}
-
-fn max_abs(v: &[f64]) -> f64 {
-    v.iter().fold(0.0_f64, |a, x| a.max(x.abs()))
-}
-
-fn std(v: &[f64]) -> f64 {
-    let m = v.iter().sum::<f64>() / v.len() as f64;
-    (v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / v.len() as f64).sqrt()
-}
 
 /// Largest peak-to-peak of `v` over consecutive windows of `n` samples.
 fn max_window_p2p(v: &[f64], n: usize) -> f64 {
@@ -126,7 +114,7 @@ fn current_rejection(env: &Env, report: &mut Report) -> Result<(), String> {
         .iter()
         .map(|v| v / DEG)
         .collect();
-    let jitter = std(&rud);
+    let jitter = std_dev(&rud);
     let p2p5 = max_window_p2p(&rud, 100); // 5 s windows at 0.05 s
     report.checks.push(Check::range(
         "AT-6 actual-rudder steady jitter (std, t > 200 s), heading noise 0.05 deg",
@@ -141,12 +129,12 @@ fn current_rejection(env: &Env, report: &mut Report) -> Result<(), String> {
         "commanded rudder very noisy, actual smooth (Fig 5-9)",
         format!(
             "command std {:.3} deg, actual {:.3} deg (ratio {:.2}); largest 5 s peak-to-peak of the actual {:.3} deg",
-            std(&cmd),
+            std_dev(&cmd),
             jitter,
-            jitter / std(&cmd),
+            jitter / std_dev(&cmd),
             p2p5
         ),
-        jitter < 0.5 * std(&cmd),
+        jitter < 0.5 * std_dev(&cmd),
     ));
     let y = col(&t, "ship.y")?;
     let peak = max_abs(y) / L;
@@ -186,7 +174,7 @@ fn current_rejection(env: &Env, report: &mut Report) -> Result<(), String> {
          with sigma = 0.05 deg (our choice, sampled every 1 s) the actual rudder's steady std is {jitter:.3} deg; \
          with the Sensors preset 0.092 deg (0.001611 rad, Parsons & Cuong Table 3) it is {:.3} deg, so \
          AT-6's 0.1 deg holds for heading noise below about {:.3} deg.",
-        std(&rud2),
+        std_dev(&rud2),
         0.1 / jitter * 0.05
     ));
     report.notes.push(format!(
@@ -198,22 +186,27 @@ fn current_rejection(env: &Env, report: &mut Report) -> Result<(), String> {
          heading is unaffected by a kinematic current, so the thesis's heading excursion (Fig 5-8, +2..-4 deg) \
          is not reproduced either. A sway time constant of 16.6 s would give 0.3 L."
     ));
+    current_rejection_figure(env, &t, report)
+}
+
+/// The current-rejection figure: offset, heading (measured and actual), rudder.
+fn current_rejection_figure(env: &Env, t: &Table, report: &mut Report) -> Result<(), String> {
     let fig = env.figure(
         "autopilot_current.png",
         "Heading autopilot, 5-kn decaying beam current (AT-6, AT-7)",
         &[
             Panel {
                 y_label: "lateral offset [L]".into(),
-                series: vec![series(&t, "ship.y", "y / L", 1.0 / L)?],
+                series: vec![series(t, "ship.y", "y / L", 1.0 / L)?],
             },
             Panel {
                 y_label: "heading [deg]".into(),
                 series: vec![
-                    series(&t, "sensors.heading_measured", "measured", 1.0 / DEG)?,
-                    series(&t, "ship.heading", "actual", 1.0 / DEG)?,
+                    series(t, "sensors.heading_measured", "measured", 1.0 / DEG)?,
+                    series(t, "ship.heading", "actual", 1.0 / DEG)?,
                 ],
             },
-            rudder_panel(&t, "ap.rudder_command")?,
+            rudder_panel(t, "ap.rudder_command")?,
         ],
     )?;
     report
@@ -339,7 +332,7 @@ fn current_rejection_nonlinear(env: &Env, report: &mut Report) -> Result<(), Str
         .iter()
         .map(|v| v / DEG)
         .collect();
-    let jitter = std(&rud);
+    let jitter = std_dev(&rud);
     report.checks.push(Check::range(
         "AT-6 (nonlinear plant) actual-rudder steady jitter (std, t > 200 s)",
         "< 0.1 deg (L2433-2437)",
@@ -463,11 +456,22 @@ fn track_change_nonlinear(env: &Env, report: &mut Report) -> Result<(), String> 
         ((y[k1] - yd[k1]) / CS_L).abs(),
         xte2.abs()
     ));
+    track_change_nonlinear_figure(env, &t, &xd, report)
+}
+
+/// The track change on the nonlinear plant: heading, offset from dead reckoning, speed, rudder.
+fn track_change_nonlinear_figure(
+    env: &Env,
+    t: &Table,
+    xd: &[f64],
+    report: &mut Report,
+) -> Result<(), String> {
+    let (time, x) = (t.time(), col(t, "ship.x")?);
     let fig = env.figure(
         "autopilot_track_change_nonlinear.png",
         "Heading autopilot on the nonlinear plant, 90 deg track change (AT-8)",
         &[
-            heading_panel(&t)?,
+            heading_panel(t)?,
             Panel {
                 y_label: "north offset from dead reckoning [L]".into(),
                 series: vec![Series {
@@ -478,9 +482,9 @@ fn track_change_nonlinear(env: &Env, report: &mut Report) -> Result<(), String> 
             },
             Panel {
                 y_label: "speed [m/s]".into(),
-                series: vec![series(&t, "ship.speed", "speed", 1.0)?],
+                series: vec![series(t, "ship.speed", "speed", 1.0)?],
             },
-            rudder_panel(&t, "ap.rudder_command")?,
+            rudder_panel(t, "ap.rudder_command")?,
         ],
     )?;
     report.figures.push((
@@ -502,11 +506,7 @@ fn track_offset(env: &Env, report: &mut Report) -> Result<(), String> {
         col(&t, "ship.y")?,
         col(&t, "ctl.cross_track_reference_used")?,
     );
-    let dev: Vec<f64> = (0..time.len())
-        .filter(|&k| time[k] > 900.0)
-        .map(|k| y[k] - yr[k])
-        .collect();
-    let osc = max_abs(&dev) / 0.9144;
+    let (osc, dist) = steady_leg(&t)?;
     report.checks.push(Check::range(
         "AT-9 oscillation about the track on the steady leg (t > 900 s, SS4 + 5-kn current, noisy y)",
         "< 20 yd (L2792; with SS4)",
@@ -516,7 +516,7 @@ fn track_offset(env: &Env, report: &mut Report) -> Result<(), String> {
         "yd",
     ));
     let psi = after(&t, "ship.heading", 1200.0)?;
-    let psi_mean = psi.iter().sum::<f64>() / psi.len() as f64 / DEG;
+    let psi_mean = mean(psi) / DEG;
     let crab = -(5.0 / 22.0_f64).asin() / DEG;
     report.checks.push(Check::abs(
         "AT-9 steady heading offset into the current (current to starboard: negative)",
@@ -534,29 +534,15 @@ fn track_offset(env: &Env, report: &mut Report) -> Result<(), String> {
         .map(|k| y[k] - yr[k])
         .collect();
     // Sweep of the (assumed) wave level: calm water and ten times the system's yaw gain.
-    let osc_at = |gain: f64, tag: &str| -> Result<(f64, f64), String> {
-        let tw = env.run(
+    let at_wave_level = |gain: f64, tag: &str| -> Result<(f64, f64), String> {
+        steady_leg(&env.run(
             "autopilot_track_offset.toml",
             &[format!("waves.yaw_gain={gain}")],
             &format!("autopilot_track_offset_{tag}.csv"),
-        )?;
-        let tt = tw.time();
-        let (yw, yrw) = (
-            col(&tw, "ship.y")?,
-            col(&tw, "ctl.cross_track_reference_used")?,
-        );
-        let d: Vec<f64> = (0..tt.len())
-            .filter(|&k| tt[k] > 900.0)
-            .map(|k| yw[k] - yrw[k])
-            .collect();
-        Ok((
-            max_abs(&d) / 0.9144,
-            std(after(&tw, "waves.yaw_moment", 900.0)?) / DEG,
-        ))
+        )?)
     };
-    let (osc_calm, _) = osc_at(0.0, "calm")?;
-    let (osc_10, dist_10) = osc_at(10.0 * WAVE_YAW_GAIN, "waves_x10")?;
-    let dist = std(after(&t, "waves.yaw_moment", 900.0)?) / DEG;
+    let (osc_calm, _) = at_wave_level(0.0, "calm")?;
+    let (osc_10, dist_10) = at_wave_level(10.0 * WAVE_YAW_GAIN, "waves_x10")?;
     report.checks.push(Check::holds(
         "AT-9 the wave disturbance acts on the loop (SS4 vs calm water, same noise)",
         "waves move the ship about the track (Figs 5-22 to 5-24)",
@@ -586,6 +572,26 @@ fn track_offset(env: &Env, report: &mut Report) -> Result<(), String> {
         max_abs(&pre) / L,
         max_abs(&during)
     ));
+    track_offset_figure(env, &t, report)
+}
+
+/// The steady leg of a track-offset run (t > 900 s): the largest deviation from the track [yd]
+/// and the std of the rudder-equivalent wave yaw disturbance [deg].
+fn steady_leg(t: &Table) -> Result<(f64, f64), String> {
+    let time = t.time();
+    let (y, yr) = (col(t, "ship.y")?, col(t, "ctl.cross_track_reference_used")?);
+    let dev: Vec<f64> = (0..time.len())
+        .filter(|&k| time[k] > 900.0)
+        .map(|k| y[k] - yr[k])
+        .collect();
+    Ok((
+        max_abs(&dev) / 0.9144,
+        std_dev(after(t, "waves.yaw_moment", 900.0)?) / DEG,
+    ))
+}
+
+/// The lateral offset: track, heading, rudder.
+fn track_offset_figure(env: &Env, t: &Table, report: &mut Report) -> Result<(), String> {
     let fig = env.figure(
         "autopilot_track_offset.png",
         "Track controller: SS4, 5-kn gust and 2 L offset to port (AT-9)",
@@ -593,15 +599,15 @@ fn track_offset(env: &Env, report: &mut Report) -> Result<(), String> {
             Panel {
                 y_label: "cross-track [L]".into(),
                 series: vec![
-                    series(&t, "ctl.cross_track_reference_used", "desired", 1.0 / L)?,
-                    series(&t, "ship.y", "actual", 1.0 / L)?,
+                    series(t, "ctl.cross_track_reference_used", "desired", 1.0 / L)?,
+                    series(t, "ship.y", "actual", 1.0 / L)?,
                 ],
             },
             Panel {
                 y_label: "heading [deg]".into(),
-                series: vec![series(&t, "ship.heading", "heading", 1.0 / DEG)?],
+                series: vec![series(t, "ship.heading", "heading", 1.0 / DEG)?],
             },
-            rudder_panel(&t, "ctl.rudder_command")?,
+            rudder_panel(t, "ctl.rudder_command")?,
         ],
     )?;
     report
@@ -654,12 +660,11 @@ fn identification(env: &Env, report: &mut Report) -> Result<(), String> {
         &[],
         "identification_zigzag.csv",
     )?;
-    let last = |c: &str| -> Result<f64, String> { Ok(*col(&t, c)?.last().unwrap()) };
     let n = [
-        last("kf.neg_y_v_mean")?,
-        last("kf.m_minus_y_r_mean")?,
-        last("kf.neg_n_v_mean")?,
-        last("kf.mxg_minus_n_r_mean")?,
+        last(&t, "kf.neg_y_v_mean")?,
+        last(&t, "kf.m_minus_y_r_mean")?,
+        last(&t, "kf.neg_n_v_mean")?,
+        last(&t, "kf.mxg_minus_n_r_mean")?,
     ];
     let plant = ContainerShip::at_equilibrium(80.0).map_err(|e| format!("{e:?}"))?;
     let u0 = plant.outputs().u;
@@ -716,13 +721,18 @@ fn identification(env: &Env, report: &mut Report) -> Result<(), String> {
         n[1],
         n[2],
         n[3],
-        last("kf.nomoto_time_constant_prime")?,
-        last("kf.nomoto_gain_prime")?,
+        last(&t, "kf.nomoto_time_constant_prime")?,
+        last(&t, "kf.nomoto_gain_prime")?,
         tp.tactical_diameter,
         tp.steady_diameter,
         100.0 * tact,
         100.0 * steady
     ));
+    identification_figure(env, &t, report)
+}
+
+/// The identification run: zig-zag and the estimates.
+fn identification_figure(env: &Env, t: &Table, report: &mut Report) -> Result<(), String> {
     let fig = env.figure(
         "identification_zigzag.png",
         "10/10 zig-zag on ContainerShip feeding ParameterEkf (AT-11)",
@@ -730,17 +740,17 @@ fn identification(env: &Env, report: &mut Report) -> Result<(), String> {
             Panel {
                 y_label: "heading, rudder [deg]".into(),
                 series: vec![
-                    series(&t, "ship.heading", "heading", 1.0 / DEG)?,
-                    series(&t, "ship.rudder_angle", "rudder", 1.0 / DEG)?,
+                    series(t, "ship.heading", "heading", 1.0 / DEG)?,
+                    series(t, "ship.rudder_angle", "rudder", 1.0 / DEG)?,
                 ],
             },
             Panel {
                 y_label: "estimate / mean".into(),
                 series: vec![
-                    series(&t, "kf.neg_y_v_estimate", "-Y_v' x100", 100.0)?,
-                    series(&t, "kf.m_minus_y_r_estimate", "m'-Y_r' x100", 100.0)?,
-                    series(&t, "kf.neg_n_v_estimate", "-N_v' x100", 100.0)?,
-                    series(&t, "kf.mxg_minus_n_r_estimate", "m'x_G'-N_r' x100", 100.0)?,
+                    series(t, "kf.neg_y_v_estimate", "-Y_v' x100", 100.0)?,
+                    series(t, "kf.m_minus_y_r_estimate", "m'-Y_r' x100", 100.0)?,
+                    series(t, "kf.neg_n_v_estimate", "-N_v' x100", 100.0)?,
+                    series(t, "kf.mxg_minus_n_r_estimate", "m'x_G'-N_r' x100", 100.0)?,
                 ],
             },
         ],

@@ -1,26 +1,22 @@
-//! DGPS manoeuvring trial (seed 002, Artyszuk; spec `dgps_kalman.md` §2.5, §3.4, §4 T4-T7): the
-//! velocity and drift-angle bias of the receiver's steady-state PV Kalman filter during turns,
-//! a zig-zag and a coasting stop of the ContainerShip, for S_p = 0.001, 0.01, 0.1, through the
-//! master (`systems/dgps_trial.toml`, `systems/dgps_stopping.toml`).
+//! DGPS manoeuvring trial [Artyszuk2003, secs. 2-3]: the velocity and drift-angle bias of the
+//! receiver's steady-state PV Kalman filter during turns, a zig-zag and a coasting stop of the
+//! ContainerShip, for S_p = 0.001, 0.01, 0.1, through the master (`systems/dgps_trial.toml`,
+//! `systems/dgps_stopping.toml`; the checks named T4-T7 in the report).
 
-use crate::study::{series, Check, Env, Report};
+use crate::study::{col, series, Check, Env, Report};
+use models::hull::DEG;
 use shipsim::plot::{Panel, Series, Table};
 use std::f64::consts::PI;
 
-const DEG: f64 = PI / 180.0;
-/// [DERIVED] steady-state velocity lag of the filter per unit acceleration / turn rate [s]
-/// (spec §3.4) for S_p = 0.001, 0.01, 0.1.
+/// [DERIVED] steady-state velocity lag of the filter per unit acceleration / turn rate [s] for
+/// S_p = 0.001, 0.01, 0.1: computed from the filter of [Artyszuk2003, sec. 2] (not in the paper).
 const LAG: [f64; 3] = [10.76, 5.85, 3.10];
-/// [DERIVED] noise-only output std of v̂ per axis at σ_z = 2 m (spec §3.4).
+/// [DERIVED] noise-only output std of v̂ per axis at σ_z = 2 m, computed from the same filter.
 const NOISE_V: [f64; 3] = [0.053, 0.126, 0.296];
 const KF: [&str; 3] = ["kf_low", "kf", "kf_high"];
 const SP: [&str; 3] = ["0.001", "0.01", "0.1"];
 /// Length ratio of the ContainerShip (175 m) to the paper's tanker (~100 m).
 const SCALE: f64 = 1.75;
-
-fn col<'a>(t: &'a Table, name: &str) -> Result<&'a [f64], String> {
-    t.column(name).map_err(|e| e.to_string())
-}
 
 fn wrap(a: f64) -> f64 {
     (a + PI).rem_euclid(2.0 * PI) - PI
@@ -118,6 +114,7 @@ fn at(tab: &Table, a: &Aligned, name: &str) -> Result<Vec<f64>, String> {
     Ok(a.t.iter().map(|&x| interp(t, c, x)).collect())
 }
 
+#[derive(Clone, Copy)]
 struct Bias {
     /// max of β̂ − β and of v̂_xy − v_xy after the manoeuvre starts [rad], [m/s]
     beta_max: f64,
@@ -162,44 +159,90 @@ fn aligned_series(label: &str, t: &[f64], y: &[f64], scale: f64) -> Series {
     }
 }
 
+const TURN: &str = "dgps_trial.toml";
+const STOP: &str = "dgps_stopping.toml";
+
 pub fn run(env: &Env) -> Result<Report, String> {
-    let (turn_file, stop_file) = ("dgps_trial.toml", "dgps_stopping.toml");
     let mut report = Report {
         id: "dgps_trial".into(),
         title: "DGPS manoeuvring trial: Kalman-filter velocity and drift-angle bias".into(),
         source: "Artyszuk (2003) §2-3, Figs. 2-7 (seed 002; spec dgps_kalman.md §2.5, §3.4, §4)"
             .into(),
-        systems: vec![turn_file.into(), stop_file.into()],
+        systems: vec![TURN.into(), STOP.into()],
         ..Default::default()
     };
-    let quiet = vec!["gps.noise_scale=0".to_string()];
-    let turn = env.run(turn_file, &quiet, "turning_noise_free.csv")?;
-    let zz_sets = vec![
-        "gps.noise_scale=0".to_string(),
-        "manoeuvre.kind=2".to_string(),
-        format!("manoeuvre.rudder_angle={}", 20.0 * DEG),
-        format!("manoeuvre.check_angle={}", 20.0 * DEG),
-    ];
-    let zigzag = env.run(turn_file, &zz_sets, "zigzag_noise_free.csv")?;
-    let stop = env.run(stop_file, &quiet, "coasting_stop_noise_free.csv")?;
-    let noisy = env.run(turn_file, &[], "turning_noisy.csv")?;
-    let straight = env.run(
-        turn_file,
-        &["manoeuvre.rudder_angle=0".to_string()],
-        "straight_noisy.csv",
-    )?;
+    let r = Runs::run(env)?;
+    let c = &mut report.checks;
+    let peaks = magnitude_checks(&r, c)?;
+    steady_turn_checks(&r, c)?;
+    let peak_deceleration = coasting_stop_checks(&r, c)?;
+    let per_sp = trade_off_checks(&r, c)?;
+    turning_figures(env, &r, &mut report)?;
+    coasting_stop_figure(env, &r, &mut report)?;
+    notes(&r, &peaks, peak_deceleration, &per_sp, &mut report.notes);
+    Ok(report)
+}
 
-    let at_turn = align(&turn)?;
-    let at_zz = align(&zigzag)?;
-    let at_stop = align(&stop)?;
+/// The runs: noise free (turn, 20/20 zig-zag, coasting stop), with the DGPS noise (turn,
+/// straight); the noise-free ones with the truth aligned to the filter's update instants.
+struct Runs {
+    turn: Table,
+    stop: Table,
+    noisy: Table,
+    straight: Table,
+    at_turn: Aligned,
+    at_stop: Aligned,
+    /// The zig-zag's bias at S_p = 0.01.
+    zigzag_bias: Bias,
+}
 
-    // --- the paper's magnitudes at the optimal S_p = 0.01 ---
-    let bt = bias(&turn, &at_turn, "kf", 60.0)?;
-    let bz = bias(&zigzag, &at_zz, "kf", 60.0)?;
-    let bs = bias(&stop, &at_stop, "kf", 60.0)?;
+impl Runs {
+    fn run(env: &Env) -> Result<Runs, String> {
+        let quiet = vec!["gps.noise_scale=0".to_string()];
+        let turn = env.run(TURN, &quiet, "turning_noise_free.csv")?;
+        let zz_sets = vec![
+            "gps.noise_scale=0".to_string(),
+            "manoeuvre.kind=2".to_string(),
+            format!("manoeuvre.rudder_angle={}", 20.0 * DEG),
+            format!("manoeuvre.check_angle={}", 20.0 * DEG),
+        ];
+        let zigzag = env.run(TURN, &zz_sets, "zigzag_noise_free.csv")?;
+        let stop = env.run(STOP, &quiet, "coasting_stop_noise_free.csv")?;
+        let noisy = env.run(TURN, &[], "turning_noisy.csv")?;
+        let straight = env.run(
+            TURN,
+            &["manoeuvre.rudder_angle=0".to_string()],
+            "straight_noisy.csv",
+        )?;
+        let at_zz = align(&zigzag)?;
+        Ok(Runs {
+            at_turn: align(&turn)?,
+            at_stop: align(&stop)?,
+            zigzag_bias: bias(&zigzag, &at_zz, "kf", 60.0)?,
+            turn,
+            stop,
+            noisy,
+            straight,
+        })
+    }
+}
+
+/// The biases at S_p = 0.01 in the turn and the zig-zag, and the peaks over the manoeuvres.
+struct Peaks {
+    bt: Bias,
+    bz: Bias,
+    beta_peak: f64,
+    speed_peak: f64,
+}
+
+/// The paper's magnitudes at the optimal S_p = 0.01.
+fn magnitude_checks(r: &Runs, c: &mut Vec<Check>) -> Result<Peaks, String> {
+    let bt = bias(&r.turn, &r.at_turn, "kf", 60.0)?;
+    let bz = &r.zigzag_bias;
+    let bs = bias(&r.stop, &r.at_stop, "kf", 60.0)?;
     let beta_peak = bt.beta_max.max(bz.beta_max.max(-bz.beta_min));
     let speed_peak = bt.speed_max.max(bz.speed_max).max(bs.speed_max);
-    report.checks.push(Check::holds(
+    c.push(Check::holds(
         "S_p = 0.01: drift angle overestimated in the turn (β̂ − β ≥ 0 after execute, starboard)",
         "\"always higher\" (line 157)",
         format!(
@@ -209,7 +252,7 @@ pub fn run(env: &Env) -> Result<Report, String> {
         ),
         bt.beta_min > -0.6 * DEG && bt.beta_max > 0.0,
     ));
-    report.checks.push(Check::holds(
+    c.push(Check::holds(
         "S_p = 0.01: speed over ground overestimated during speed loss (turn, zig-zag, stop)",
         "v_xy overestimated when the manoeuvre involves speed loss (line 156)",
         format!(
@@ -218,7 +261,7 @@ pub fn run(env: &Env) -> Result<Report, String> {
         ),
         bt.speed_max > 0.0 && bz.speed_max > 0.0 && bs.speed_max > 0.0,
     ));
-    report.checks.push(Check::range(
+    c.push(Check::range(
         "S_p = 0.01: peak drift-angle bias, 175 m hull scaled to ~100 m (×1.75, r ∝ U/L) [order of magnitude]",
         "up to ~10° (lines 141, 157)",
         SCALE * beta_peak / DEG,
@@ -226,7 +269,7 @@ pub fn run(env: &Env) -> Result<Report, String> {
         15.0,
         "deg",
     ));
-    report.checks.push(Check::range(
+    c.push(Check::range(
         "S_p = 0.01: peak speed bias, scaled to ~100 m (×1.75, a ∝ U²/L) [order of magnitude]",
         "up to ~0.5 m/s, \"sometimes of order one knot\" (lines 141, 156)",
         SCALE * speed_peak,
@@ -234,27 +277,35 @@ pub fn run(env: &Env) -> Result<Report, String> {
         1.0,
         "m/s",
     ));
+    Ok(Peaks {
+        bt,
+        bz: *bz,
+        beta_peak,
+        speed_peak,
+    })
+}
 
-    // --- the mechanism against the [DERIVED] steady-state lags ---
+/// The mechanism against the [DERIVED] steady-state lags: the steady turn.
+fn steady_turn_checks(r: &Runs, c: &mut Vec<Check>) -> Result<(), String> {
     // steady turn (last 50 s; the speed is still falling slowly before): β̂ − β = 5.85 s × r,
     // |v̂|/|v| = 1
-    let b_kf = at(&turn, &at_turn, "kf.drift_angle")?;
-    let s_kf = at(&turn, &at_turn, "kf.speed_over_ground")?;
-    let steady: Vec<usize> = (0..at_turn.t.len())
-        .filter(|&k| at_turn.t[k] >= 550.0)
+    let b_kf = at(&r.turn, &r.at_turn, "kf.drift_angle")?;
+    let s_kf = at(&r.turn, &r.at_turn, "kf.speed_over_ground")?;
+    let steady: Vec<usize> = (0..r.at_turn.t.len())
+        .filter(|&k| r.at_turn.t[k] >= 550.0)
         .collect();
     let m = steady.len() as f64;
     let db_ss = steady
         .iter()
-        .map(|&k| wrap(b_kf[k] - at_turn.beta[k]))
+        .map(|&k| wrap(b_kf[k] - r.at_turn.beta[k]))
         .sum::<f64>()
         / m;
-    let r_ss = steady.iter().map(|&k| at_turn.yaw_rate[k]).sum::<f64>() / m;
+    let r_ss = steady.iter().map(|&k| r.at_turn.yaw_rate[k]).sum::<f64>() / m;
     let sp_ss = steady
         .iter()
-        .map(|&k| (s_kf[k] / at_turn.speed[k] - 1.0).abs())
+        .map(|&k| (s_kf[k] / r.at_turn.speed[k] - 1.0).abs())
         .fold(0.0f64, f64::max);
-    report.checks.push(Check::rel(
+    c.push(Check::rel(
         &format!(
             "T5: steady-turn drift-angle bias at r = {:.5} rad/s, S_p = 0.01 [derived 5.85 s × r]",
             r_ss
@@ -264,7 +315,7 @@ pub fn run(env: &Env) -> Result<Report, String> {
         0.05,
         "deg",
     ));
-    report.checks.push(Check::range(
+    c.push(Check::range(
         "T5: steady-turn speed magnitude error |v̂_xy/v_xy − 1|",
         "< 0.1 % (\"not conspicuous\", line 156)",
         100.0 * sp_ss,
@@ -273,33 +324,43 @@ pub fn run(env: &Env) -> Result<Report, String> {
         "%",
     ));
     // coasting stop: speed bias = 5.85 s × a (quasi-steady, T4) once the filter transient of the
+    Ok(())
+}
+
+/// The coasting stop (T4); returns the peak deceleration [m/s²].
+fn coasting_stop_checks(r: &Runs, c: &mut Vec<Check>) -> Result<f64, String> {
     // sudden deceleration at the stop order (60 s) has decayed (poles 0.84 ± 0.13j: ~6 s): at 100 s
-    let s_stop = at(&stop, &at_stop, "kf.speed_over_ground")?;
-    let kmax = (0..at_stop.t.len())
-        .filter(|&k| at_stop.t[k] > 60.0)
-        .min_by(|&i, &j| at_stop.accel[i].total_cmp(&at_stop.accel[j]))
+    let s_stop = at(&r.stop, &r.at_stop, "kf.speed_over_ground")?;
+    let kmax = (0..r.at_stop.t.len())
+        .filter(|&k| r.at_stop.t[k] > 60.0)
+        .min_by(|&i, &j| r.at_stop.accel[i].total_cmp(&r.at_stop.accel[j]))
         .ok_or("no stopping phase")?;
-    let k100 = at_stop
+    let k100 = r
+        .at_stop
         .t
         .iter()
         .position(|&x| x >= 100.0)
         .ok_or("stop run too short")?;
-    report.checks.push(Check::rel(
+    c.push(Check::rel(
         &format!(
             "T4: coasting-stop speed bias 40 s after the order, a = {:.4} m/s² [derived 5.85 s × a]",
-            -at_stop.accel[k100]
+            -r.at_stop.accel[k100]
         ),
-        -LAG[1] * at_stop.accel[k100],
-        s_stop[k100] - at_stop.speed[k100],
+        -LAG[1] * r.at_stop.accel[k100],
+        s_stop[k100] - r.at_stop.speed[k100],
         0.05,
         "m/s",
     ));
-    // --- S_p trade-off (T6) ---
+    Ok(-r.at_stop.accel[kmax])
+}
+
+/// The S_p trade-off (T6): bias against noise; returns the biases per S_p in the turn.
+fn trade_off_checks(r: &Runs, c: &mut Vec<Check>) -> Result<Vec<Bias>, String> {
     let per_sp: Vec<Bias> = KF
         .iter()
-        .map(|k| bias(&turn, &at_turn, k, 60.0))
+        .map(|k| bias(&r.turn, &r.at_turn, k, 60.0))
         .collect::<Result<_, _>>()?;
-    report.checks.push(Check::holds(
+    c.push(Check::holds(
         "T6: drift-angle bias falls as S_p rises (turn, noise free)",
         "S_p too low: systematic error; too high: small bias (lines 112-114)",
         format!(
@@ -310,15 +371,21 @@ pub fn run(env: &Env) -> Result<Report, String> {
         ),
         per_sp[0].beta_max > per_sp[1].beta_max && per_sp[1].beta_max > per_sp[2].beta_max,
     ));
-    let at_st = align(&straight)?;
+    velocity_noise_checks(&r.straight, c)?;
+    Ok(per_sp)
+}
+
+/// The velocity noise per S_p on the straight run with the DGPS noise.
+fn velocity_noise_checks(straight: &Table, c: &mut Vec<Check>) -> Result<(), String> {
+    let at_st = align(straight)?;
     for i in 0..3 {
         let vn = at(
-            &straight,
+            straight,
             &at_st,
             &format!("{}.velocity_north_estimate", KF[i]),
         )?;
         let ve = at(
-            &straight,
+            straight,
             &at_st,
             &format!("{}.velocity_east_estimate", KF[i]),
         )?;
@@ -331,7 +398,7 @@ pub fn run(env: &Env) -> Result<Report, String> {
             ss += (vn[k] - at_st.vn[k]).powi(2) + (ve[k] - at_st.ve[k]).powi(2);
             n += 2.0;
         }
-        report.checks.push(Check::rel(
+        c.push(Check::rel(
             &format!(
                 "T6: velocity noise std per axis, S_p = {}, 2 m DGPS noise, straight run",
                 SP[i]
@@ -342,23 +409,25 @@ pub fn run(env: &Env) -> Result<Report, String> {
             "m/s",
         ));
     }
-    let pos_low = per_sp[0].pos_max;
+    Ok(())
+}
 
-    // --- figures ---
-    let t = &at_turn.t;
-    let mut beta_series = vec![aligned_series("true β", t, &at_turn.beta, 1.0 / DEG)];
-    let mut speed_series = vec![aligned_series("true v_xy", t, &at_turn.speed, 1.0)];
+/// The turning test, noise free and with the DGPS noise (as [Artyszuk2003, Figs. 2-3]).
+fn turning_figures(env: &Env, r: &Runs, report: &mut Report) -> Result<(), String> {
+    let t = &r.at_turn.t;
+    let mut beta_series = vec![aligned_series("true β", t, &r.at_turn.beta, 1.0 / DEG)];
+    let mut speed_series = vec![aligned_series("true v_xy", t, &r.at_turn.speed, 1.0)];
     for i in 0..3 {
         beta_series.push(aligned_series(
             &format!("KF S_p = {}", SP[i]),
             t,
-            &at(&turn, &at_turn, &format!("{}.drift_angle", KF[i]))?,
+            &at(&r.turn, &r.at_turn, &format!("{}.drift_angle", KF[i]))?,
             1.0 / DEG,
         ));
         speed_series.push(aligned_series(
             &format!("KF S_p = {}", SP[i]),
             t,
-            &at(&turn, &at_turn, &format!("{}.speed_over_ground", KF[i]))?,
+            &at(&r.turn, &r.at_turn, &format!("{}.speed_over_ground", KF[i]))?,
             1.0,
         ));
     }
@@ -389,18 +458,18 @@ pub fn run(env: &Env) -> Result<Report, String> {
             Panel {
                 y_label: "speed over ground [m/s]".into(),
                 series: vec![
-                    series(&noisy, "ship.speed", "true", 1.0)?,
-                    series(&noisy, "kf_low.speed_over_ground", "S_p = 0.001", 1.0)?,
-                    series(&noisy, "kf.speed_over_ground", "S_p = 0.01", 1.0)?,
-                    series(&noisy, "kf_high.speed_over_ground", "S_p = 0.1", 1.0)?,
+                    series(&r.noisy, "ship.speed", "true", 1.0)?,
+                    series(&r.noisy, "kf_low.speed_over_ground", "S_p = 0.001", 1.0)?,
+                    series(&r.noisy, "kf.speed_over_ground", "S_p = 0.01", 1.0)?,
+                    series(&r.noisy, "kf_high.speed_over_ground", "S_p = 0.1", 1.0)?,
                 ],
             },
             Panel {
                 y_label: "drift angle [deg]".into(),
                 series: vec![
-                    series(&noisy, "kf_low.drift_angle", "S_p = 0.001", 1.0 / DEG)?,
-                    series(&noisy, "kf.drift_angle", "S_p = 0.01", 1.0 / DEG)?,
-                    series(&noisy, "kf_high.drift_angle", "S_p = 0.1", 1.0 / DEG)?,
+                    series(&r.noisy, "kf_low.drift_angle", "S_p = 0.001", 1.0 / DEG)?,
+                    series(&r.noisy, "kf.drift_angle", "S_p = 0.01", 1.0 / DEG)?,
+                    series(&r.noisy, "kf_high.drift_angle", "S_p = 0.1", 1.0 / DEG)?,
                 ],
             },
         ],
@@ -409,25 +478,31 @@ pub fn run(env: &Env) -> Result<Report, String> {
         "Turning test with DGPS noise (as the paper's Figs. 2-3)".into(),
         fig,
     ));
-    let ts = &at_stop.t;
+    Ok(())
+}
+
+/// The coasting stop (as [Artyszuk2003, Fig. 7]).
+fn coasting_stop_figure(env: &Env, r: &Runs, report: &mut Report) -> Result<(), String> {
+    let s_stop = at(&r.stop, &r.at_stop, "kf.speed_over_ground")?;
+    let ts = &r.at_stop.t;
     let fig = env.figure(
         "coasting_stop.png",
         "Coasting stop from 7 m/s, noise free",
         &[Panel {
             y_label: "speed over ground [m/s]".into(),
             series: vec![
-                aligned_series("true v_xy", ts, &at_stop.speed, 1.0),
+                aligned_series("true v_xy", ts, &r.at_stop.speed, 1.0),
                 aligned_series(
                     "KF S_p = 0.001",
                     ts,
-                    &at(&stop, &at_stop, "kf_low.speed_over_ground")?,
+                    &at(&r.stop, &r.at_stop, "kf_low.speed_over_ground")?,
                     1.0,
                 ),
                 aligned_series("KF S_p = 0.01", ts, &s_stop, 1.0),
                 aligned_series(
                     "KF S_p = 0.1",
                     ts,
-                    &at(&stop, &at_stop, "kf_high.speed_over_ground")?,
+                    &at(&r.stop, &r.at_stop, "kf_high.speed_over_ground")?,
                     1.0,
                 ),
             ],
@@ -437,7 +512,20 @@ pub fn run(env: &Env) -> Result<Report, String> {
         .figures
         .push(("Coasting stop (as the paper's Fig. 7)".into(), fig));
 
-    report.notes.extend([
+    Ok(())
+}
+
+/// The notes: the stand-in hull and the scaling, the latency, position errors, noise.
+fn notes(r: &Runs, p: &Peaks, peak_deceleration: f64, per_sp: &[Bias], n: &mut Vec<String>) {
+    let Peaks {
+        bt,
+        bz,
+        beta_peak,
+        speed_peak,
+    } = p;
+    let (beta_peak, speed_peak) = (*beta_peak, *speed_peak);
+    let pos_low = per_sp[0].pos_max;
+    n.extend([
         format!(
             "Hull: the paper's ~100 m tanker model and trial tracks are not given; the 175 m \
              Son & Nomoto ContainerShip at its 7.00 m/s equilibrium (66.853 rpm) with the rudder \
@@ -449,8 +537,11 @@ pub fn run(env: &Env) -> Result<Report, String> {
              and a ∝ U²/L, so a 100 m hull at 7 m/s sees ×1.75: {:.1}° and {:.2} m/s, the \
              paper's order. The HAH 65° Schilling-rudder test and the crash stop (reversed \
              pitch) cannot be run: the model has a fixed-pitch propeller valid only for n > 0.",
-            at_turn.yaw_rate.iter().fold(0.0f64, |a, b| a.max(b.abs())),
-            -at_stop.accel[kmax],
+            r.at_turn
+                .yaw_rate
+                .iter()
+                .fold(0.0f64, |a, b| a.max(b.abs())),
+            peak_deceleration,
             beta_peak / DEG,
             bt.beta_max / DEG,
             bz.beta_max.max(-bz.beta_min) / DEG,
@@ -465,7 +556,7 @@ pub fn run(env: &Env) -> Result<Report, String> {
              alignment the pure delay would add a × latency to the speed bias. The brief \
              negative β̂ − β (down to {:.2}°) is the ship's inverse drift response right after \
              the rudder order, which the lagging filter misses.",
-            at_turn.latency,
+            r.at_turn.latency,
             bt.beta_min / DEG
         ),
         format!(
@@ -480,5 +571,4 @@ pub fn run(env: &Env) -> Result<Report, String> {
          the noise std on a straight run."
             .to_string(),
     ]);
-    Ok(report)
 }

@@ -1,22 +1,24 @@
-//! Dynamic positioning with Fossen & Strand's passive observer (seed 001, spec
-//! `passive_observer_dp.md` §4.1 and T1, T6, T9, T10): wave filtering, bias estimation and
-//! position keeping through the master, in `systems/dp_observer.toml`.
+//! Dynamic positioning with the passive nonlinear observer of [Fossen1999, sec. 4.1]: wave
+//! filtering, bias estimation and position keeping through the master, in
+//! `systems/dp_observer.toml` (the checks named T1, T6, T9 and T10 in the report).
 //!
-//! Runs: (1) DP closed loop with a constant bias (8000 s); (2) the paper's simulation study: open
-//! loop under the Eq. 61 thrust with a Markov bias (T = 1000 s, Eq. 58); (3) noise-free, no waves,
-//! matched bias model, initial estimation errors (T9).
+//! Runs: (1) DP closed loop with a constant bias (8000 s); (2) the paper's simulation study
+//! [Fossen1999, sec. 6.1]: open loop under the thrust of [Fossen1999, eq. (61)] with a Markov bias
+//! (T = 1000 s, [Fossen1999, eq. (58)]); (3) noise-free, no waves, matched bias model, initial
+//! estimation errors (T9).
 
-use crate::study::{series, Check, Env, Report};
-use shipsim::plot::{Panel, Series, Table};
+use crate::study::{col, last, mean, rms_diff, series, series_window, Check, Env, Report};
+use models::hull::DEG;
+use nalgebra::{Complex, Matrix3, Vector3};
+use shipsim::plot::{Panel, Table};
 use std::f64::consts::PI;
 
-const DEG: f64 = PI / 180.0;
 /// Samples (1 Hz) of the analysis window at the end of a run.
 const N: usize = 4096;
 /// Wave band of the band-power ratios [rad/s] (as in the observer model's own test).
 const BAND: (f64, f64) = (0.45, 1.8);
 
-// Paper data (001 §3.1-3.3) and the system file's settings.
+// Paper data [Fossen1999, sec. 6, eqs. (56)-(60)] and the system file's settings.
 const M: [f64; 3] = [5.3122e6, 8.2831e6, 3.7454e9];
 const D: [[f64; 3]; 3] = [
     [5.0242e4, 0.0, 0.0],
@@ -59,29 +61,12 @@ const BIAS_EST: [&str; 3] = [
     "observer.bias_yaw_estimate",
 ];
 
-/// Minimal complex arithmetic for the frequency responses.
-#[derive(Clone, Copy, Debug)]
-struct C(f64, f64);
-impl C {
-    fn add(self, o: C) -> C {
-        C(self.0 + o.0, self.1 + o.1)
-    }
-    fn mul(self, o: C) -> C {
-        C(self.0 * o.0 - self.1 * o.1, self.0 * o.1 + self.1 * o.0)
-    }
-    fn div(self, o: C) -> C {
-        let d = o.0 * o.0 + o.1 * o.1;
-        C(
-            (self.0 * o.0 + self.1 * o.1) / d,
-            (self.1 * o.0 - self.0 * o.1) / d,
-        )
-    }
-    fn scale(self, k: f64) -> C {
-        C(self.0 * k, self.1 * k)
-    }
-    fn norm2(self) -> f64 {
-        self.0 * self.0 + self.1 * self.1
-    }
+/// A complex number of the frequency responses (nalgebra's re-export of num-complex).
+type C = Complex<f64>;
+
+/// The complex number re + j im.
+fn c(re: f64, im: f64) -> C {
+    C::new(re, im)
 }
 
 /// Continuous y → η̂ of one DOF of the linear observer (J = I, τ = 0, mass-normalised injection,
@@ -91,29 +76,28 @@ fn observer_response(w: f64, dof: usize) -> C {
     let k1 = -2.0 * (ZETA_N - ZETA) * OMEGA_C / OMEGA0;
     let k2 = 2.0 * OMEGA0 * (ZETA_N - ZETA);
     let k3 = OMEGA_C;
-    let s = C(0.0, w);
-    let one = C(1.0, 0.0);
+    // real operands stay complex (re + j0): num-complex's mixed real-complex operators round
+    // differently, and the report's numbers were computed this way
+    let s = c(0.0, w);
+    let one = c(1.0, 0.0);
     let a = D[dof][dof] / M[dof];
-    let hb = C(KAPPA[dof], 0.0).add(C(LAMBDA[dof], 0.0).div(s.add(C(1.0 / T_BIAS, 0.0))));
-    let ge = hb.div(s.add(C(a, 0.0))).add(C(k3, 0.0)).div(s);
-    let den = s
-        .mul(s)
-        .add(s.scale(2.0 * ZETA * OMEGA0))
-        .add(C(OMEGA0 * OMEGA0, 0.0));
-    let gw = s.scale(k2).add(C(-OMEGA0 * OMEGA0 * k1, 0.0)).div(den);
-    ge.div(one.add(ge).add(gw))
+    let hb = c(KAPPA[dof], 0.0) + c(LAMBDA[dof], 0.0) / (s + c(1.0 / T_BIAS, 0.0));
+    let ge = (hb / (s + c(a, 0.0)) + c(k3, 0.0)) / s;
+    let den = s * s + s.scale(2.0 * ZETA * OMEGA0) + c(OMEGA0 * OMEGA0, 0.0);
+    let gw = (s.scale(k2) + c(-OMEGA0 * OMEGA0 * k1, 0.0)) / den;
+    ge / (one + ge + gw)
 }
 
-/// Shape of the WF spectrum of 001 Eq. 10 (|h_w|² without σ²); ∫₀^∞ = π/(4ζω₀).
+/// Shape of the WF spectrum of [Fossen1999, eq. (10)] (|h_w|² without σ²); ∫₀^∞ = π/(4ζω₀).
 fn wf_shape(w: f64) -> f64 {
     let w2 = w * w;
     w2 / ((OMEGA0 * OMEGA0 - w2).powi(2) + (2.0 * ZETA * OMEGA0 * w).powi(2))
 }
 
-/// [DERIVED] expected band-power ratio η̂/y of one DOF at 1 Hz: the observer driven by the
-/// held 1-Hz samples (zero-order hold) and read at 1 Hz, H_d(ω) = Σ_k H(jω_k)(1 − e^{−jω_k})/(jω_k),
-/// ω_k = ω + 2πk; the sampled measurement is the aliased WF spectrum plus white sensor noise.
-/// Evaluated on the DFT bins of the analysis window.
+/// [DERIVED] expected band-power ratio η̂/y of one DOF at 1 Hz: the observer driven by the held
+/// 1-Hz samples (zero-order hold) and read at 1 Hz, H_d(ω) = Σ_k H(jω_k)(1 − e^{−jω_k})/(jω_k), ω_k
+/// = ω + 2πk; the sampled measurement is the aliased WF spectrum plus white sensor noise. Evaluated
+/// on the DFT bins of the analysis window.
 fn predicted_band_ratio(dof: usize) -> f64 {
     let kmax = 1000i32;
     let c_norm = PI / (4.0 * ZETA * OMEGA0);
@@ -123,17 +107,17 @@ fn predicted_band_ratio(dof: usize) -> f64 {
         if !(BAND.0..=BAND.1).contains(&w) {
             continue;
         }
-        let mut hd = C(0.0, 0.0);
+        let mut hd = c(0.0, 0.0);
         let mut sa = 0.0;
         for k in -kmax..=kmax {
             let wk = w + 2.0 * PI * k as f64;
             // (1 − e^{−jω})/(jω)
-            let zoh = C(1.0 - wk.cos(), wk.sin()).div(C(0.0, wk));
-            hd = hd.add(observer_response(wk, dof).mul(zoh));
+            let zoh = c(1.0 - wk.cos(), wk.sin()) / c(0.0, wk);
+            hd += observer_response(wk, dof) * zoh;
             sa += wf_shape(wk.abs());
         }
         let sy = WF_STD[dof].powi(2) * sa / c_norm + NOISE_STD[dof].powi(2) / PI;
-        num += hd.norm2() * sy;
+        num += hd.norm_sqr() * sy;
         den += sy;
     }
     num / den
@@ -160,10 +144,6 @@ fn band_power(x: &[f64]) -> f64 {
     p
 }
 
-fn col<'a>(t: &'a Table, name: &str) -> Result<&'a [f64], String> {
-    t.column(name).map_err(|e| e.to_string())
-}
-
 /// Wave-band power of η̂ − η over that of y − η (the true LF motion removed from both, so that
 /// a drifting ship leaks no power into the band through the window edges).
 fn wf_ratio(t: &Table, i: usize) -> Result<f64, String> {
@@ -174,38 +154,23 @@ fn wf_ratio(t: &Table, i: usize) -> Result<f64, String> {
     Ok(band_power(&diff(EST[i])?) / band_power(&diff(MEAS[i])?))
 }
 
-fn mean(x: &[f64]) -> f64 {
-    x.iter().sum::<f64>() / x.len() as f64
-}
-
-fn rms_diff(a: &[f64], b: &[f64]) -> f64 {
-    (a.iter().zip(b).map(|(x, y)| (x - y).powi(2)).sum::<f64>() / a.len() as f64).sqrt()
-}
-
-/// [DERIVED] equilibrium of the observer under a constant bias b (J = I, held position): Eq. 24's
-/// leak −b̂/T leaves b̂ = TΛỹ with (TΛ + 𝒦 + M⁻¹D K₂) ỹ = M⁻¹ b; returned as the force M b̂.
+/// [DERIVED] equilibrium of the observer under a constant bias b (J = I, held position): the
+/// leak −b̂/T of [Fossen1999, eq. (24)] leaves b̂ = TΛỹ with (TΛ + 𝒦 + M⁻¹D K₂) ỹ = M⁻¹ b;
+/// returned as the force M b̂.
 fn bias_equilibrium(b: [f64; 3]) -> [f64; 3] {
-    let mut a = [[0.0; 3]; 3];
-    for i in 0..3 {
-        for j in 0..3 {
-            a[i][j] = D[i][j] / M[i] * OMEGA_C;
-        }
-        a[i][i] += T_BIAS * LAMBDA[i] + KAPPA[i];
-    }
-    let rhs: [f64; 3] = std::array::from_fn(|i| b[i] / M[i]);
-    let det3 = |m: &[[f64; 3]; 3]| {
-        m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
-            - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
-            + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
-    };
-    let d = det3(&a);
-    std::array::from_fn(|i| {
-        let mut ai = a;
-        for r in 0..3 {
-            ai[r][i] = rhs[r];
-        }
-        M[i] * T_BIAS * LAMBDA[i] * det3(&ai) / d
-    })
+    let a = Matrix3::from_fn(|i, j| {
+        let leak = if i == j {
+            T_BIAS * LAMBDA[i] + KAPPA[i]
+        } else {
+            0.0
+        };
+        D[i][j] / M[i] * OMEGA_C + leak
+    });
+    let y = a
+        .lu()
+        .solve(&Vector3::from_fn(|i, _| b[i] / M[i]))
+        .unwrap_or_else(|| Vector3::repeat(f64::NAN));
+    std::array::from_fn(|i| M[i] * T_BIAS * LAMBDA[i] * y[i])
 }
 
 /// Centered moving average over `w` samples (shorter at the ends).
@@ -235,26 +200,12 @@ fn correlation(a: &[f64], b: &[f64]) -> f64 {
     sab / (saa * sbb).sqrt()
 }
 
-/// A series restricted to t in [t0, t1].
-fn window(s: Series, t0: f64, t1: f64) -> Series {
-    let (t, y): (Vec<f64>, Vec<f64>) =
-        s.t.iter()
-            .zip(&s.y)
-            .filter(|(t, _)| (t0..=t1).contains(*t))
-            .map(|(t, y)| (*t, *y))
-            .unzip();
-    Series {
-        label: s.label,
-        t,
-        y,
-    }
-}
-
 fn sets(list: &[(&str, f64)]) -> Vec<String> {
     list.iter().map(|(k, v)| format!("{k}={v}")).collect()
 }
 
-/// The paper's simulation study: no feedback, Eq. 61 thrust, Markov bias with T = 1000 s.
+/// The paper's simulation study: no feedback, the thrust of [Fossen1999, eq. (61)], Markov bias
+/// with T = 1000 s.
 fn open_loop_sets() -> Vec<(&'static str, f64)> {
     vec![
         ("dp.bandwidth_surge", 0.0),
@@ -268,37 +219,63 @@ fn open_loop_sets() -> Vec<(&'static str, f64)> {
     ]
 }
 
+const FILE: &str = "dp_observer.toml";
+/// Units of the bias (force) per DOF.
+const UNITS: [&str; 3] = ["N", "N", "N·m"];
+
+/// Runs: (1) DP closed loop with a constant bias; (2) the paper's open-loop simulation study;
+/// (3) noise free, no waves, initial errors (T9).
 pub fn run(env: &Env) -> Result<Report, String> {
-    let file = "dp_observer.toml";
     let mut report = Report {
         id: "dp_observer".into(),
         title: "Dynamic positioning: passive observer wave filtering and bias estimation".into(),
         source: "Fossen & Strand (1999) §3, §6.1 (seed 001; spec passive_observer_dp.md §4)".into(),
-        systems: vec![file.into()],
+        systems: vec![FILE.into()],
         ..Default::default()
     };
+    let cl = env.run(FILE, &[], "closed_loop.csv")?;
+    let c = &mut report.checks;
+    gain_checks(&cl, c)?;
+    wave_filtering_checks(&cl, c)?;
+    let bias = bias_checks(&cl, c)?;
+    station_keeping_checks(&cl, c)?;
+    let ol = env.run(FILE, &sets(&open_loop_study_sets()), "open_loop.csv")?;
+    tracking_checks(&ol, c)?;
+    let bias_notes = bias_estimation_checks(&ol, c)?;
+    let velocity = velocity_errors(&ol)?;
+    t9_checks(env, c)?;
+    closed_loop_figures(env, &cl, &mut report)?;
+    open_loop_figure(env, &ol, &mut report)?;
+    notes(bias, &bias_notes, &velocity, &mut report.notes);
+    Ok(report)
+}
 
-    // ---- (1) DP closed loop, constant bias ----
-    let cl = env.run(file, &[], "closed_loop.csv")?;
-    let k1 = *col(&cl, "observer.k1_surge")?.last().ok_or("empty run")?;
-    let k2 = *col(&cl, "observer.k2_surge")?.last().ok_or("empty run")?;
-    report.checks.push(Check::abs(
+/// T1: the notch gains the FMU computes.
+fn gain_checks(cl: &Table, c: &mut Vec<Check>) -> Result<(), String> {
+    let k1 = last(cl, "observer.k1_surge")?;
+    let k2 = last(cl, "observer.k2_surge")?;
+    c.push(Check::abs(
         "T1: notch gain k₁ (Eq. 45), through the FMU",
         -2.2059,
         k1,
         0.5e-4,
         "",
     ));
-    report.checks.push(Check::abs(
+    c.push(Check::abs(
         "T1: notch gain k₂ (Eq. 46), through the FMU",
         1.6157,
         k2,
         0.5e-4,
         "rad/s",
     ));
+    Ok(())
+}
+
+/// The DP loop filters the wave-frequency motion out of η̂ (T6).
+fn wave_filtering_checks(cl: &Table, c: &mut Vec<Check>) -> Result<(), String> {
     for i in 0..3 {
-        let ratio = wf_ratio(&cl, i)?;
-        report.checks.push(Check::range(
+        let ratio = wf_ratio(cl, i)?;
+        c.push(Check::range(
             &format!("DP loop, {}: WF band power in η̂ / in y", DOF[i]),
             "\"most of the first-order wave disturbances are filtered out\" (< 5 %)",
             100.0 * ratio,
@@ -306,7 +283,7 @@ pub fn run(env: &Env) -> Result<Report, String> {
             5.0,
             "%",
         ));
-        report.checks.push(Check::rel(
+        c.push(Check::rel(
             "same, against the linear observer at 1 Hz with hold [derived from T6]",
             100.0 * predicted_band_ratio(i),
             100.0 * ratio,
@@ -314,20 +291,28 @@ pub fn run(env: &Env) -> Result<Report, String> {
             "%",
         ));
     }
+    Ok(())
+}
+
+/// The mean bias estimate against the observer's equilibrium under the applied constant bias;
+/// returns (applied, expected).
+fn bias_checks(cl: &Table, c: &mut Vec<Check>) -> Result<([f64; 3], [f64; 3]), String> {
+    // the means over the analysis window at the end of the run
+    let tail_mean = |name: &str| -> Result<f64, String> {
+        let v = col(cl, name)?;
+        Ok(mean(&v[v.len() - N..]))
+    };
     let applied: [f64; 3] = {
         let mut b = [0.0; 3];
         for i in 0..3 {
-            let c = col(&cl, BIAS[i])?;
-            b[i] = mean(&c[c.len() - N..]);
+            b[i] = tail_mean(BIAS[i])?;
         }
         b
     };
     let expected = bias_equilibrium(applied);
-    let units = ["N", "N", "N·m"];
     for i in 0..3 {
-        let c = col(&cl, BIAS_EST[i])?;
-        let m = mean(&c[c.len() - N..]);
-        report.checks.push(Check::abs(
+        let m = tail_mean(BIAS_EST[i])?;
+        c.push(Check::abs(
             &format!(
                 "DP loop, {}: mean b̂ over the last {N} s (applied {:.4e})",
                 DOF[i], applied[i]
@@ -335,11 +320,16 @@ pub fn run(env: &Env) -> Result<Report, String> {
             expected[i],
             m,
             0.02 * applied[i].abs(),
-            units[i],
+            UNITS[i],
         ));
     }
+    Ok((applied, expected))
+}
+
+/// The DP loop keeps position and heading.
+fn station_keeping_checks(cl: &Table, c: &mut Vec<Check>) -> Result<(), String> {
     let pos_err: Vec<f64> = {
-        let (x, y) = (col(&cl, "ship.x")?, col(&cl, "ship.y")?);
+        let (x, y) = (col(cl, "ship.x")?, col(cl, "ship.y")?);
         x.iter()
             .zip(y)
             .skip(x.len() - N)
@@ -348,30 +338,34 @@ pub fn run(env: &Env) -> Result<Report, String> {
     };
     let rms_pos = (pos_err.iter().map(|e| e * e).sum::<f64>() / N as f64).sqrt();
     let meas_err = rms_diff(
-        &col(&cl, MEAS[0])?[cl.time().len() - N..],
-        &col(&cl, "ship.x")?[cl.time().len() - N..],
+        &col(cl, MEAS[0])?[cl.time().len() - N..],
+        &col(cl, "ship.x")?[cl.time().len() - N..],
     );
-    report.checks.push(Check::holds(
+    c.push(Check::holds(
         "DP loop: LF position kept (RMS horizontal distance of η from the set point)",
         "WF motion kept out of the loop (Definition 1); < 1 m, the DGPS class",
         format!("{rms_pos:.3} m (north measurement − η: {meas_err:.2} m RMS)"),
         rms_pos < 1.0,
     ));
-    let heading = col(&cl, "ship.heading")?;
+    let heading = col(cl, "ship.heading")?;
     let rms_psi = (heading[heading.len() - N..]
         .iter()
         .map(|e| e * e)
         .sum::<f64>()
         / N as f64)
         .sqrt();
-    report.checks.push(Check::holds(
+    c.push(Check::holds(
         "DP loop: heading kept (RMS LF heading error)",
         "< 1° (normal-operation ψ_w class, line 171)",
         format!("{:.3}°", rms_psi / DEG),
         rms_psi < DEG,
     ));
 
-    // ---- (2) the paper's simulation study: open loop, Eq. 61, Markov bias ----
+    Ok(())
+}
+
+/// The paper's simulation study [Fossen1999, sec. 6.1]: open loop, eq. (61) thrust, Markov bias.
+fn open_loop_study_sets() -> Vec<(&'static str, f64)> {
     let mut ol_sets = open_loop_sets();
     ol_sets.extend([
         ("bias.bias_psi_x", 1000.0),
@@ -381,15 +375,21 @@ pub fn run(env: &Env) -> Result<Report, String> {
         ("bias.bias_initial_y", -2e4),
         ("bias.bias_initial_n", 1e5),
     ]);
-    let ol = env.run(file, &sets(&ol_sets), "open_loop.csv")?;
-    let start = 1000; // samples (s): after the initial transient
+    ol_sets
+}
+
+/// Samples (s) of the open-loop run skipped: the initial transient.
+const START: usize = 1000;
+
+/// The open-loop run: wave filtering and position tracking.
+fn tracking_checks(ol: &Table, c: &mut Vec<Check>) -> Result<(), String> {
     for i in 0..3 {
-        let ratio = wf_ratio(&ol, i)?;
-        let est = &col(&ol, EST[i])?[start..];
-        let tru = &col(&ol, TRUE_ETA[i])?[start..];
-        let meas = &col(&ol, MEAS[i])?[start..];
+        let ratio = wf_ratio(ol, i)?;
+        let est = &col(ol, EST[i])?[START..];
+        let tru = &col(ol, TRUE_ETA[i])?[START..];
+        let meas = &col(ol, MEAS[i])?[START..];
         let (e_est, e_meas) = (rms_diff(est, tru), rms_diff(meas, tru));
-        report.checks.push(Check::range(
+        c.push(Check::range(
             &format!("Eq. 61 run, {}: WF band power in η̂ / in y", DOF[i]),
             "most WF motion filtered out (< 5 %)",
             100.0 * ratio,
@@ -397,7 +397,7 @@ pub fn run(env: &Env) -> Result<Report, String> {
             5.0,
             "%",
         ));
-        report.checks.push(Check::range(
+        c.push(Check::range(
             &format!(
                 "Eq. 61 run, {}: RMS(η̂ − η) / RMS(y − η) (y − η: {:.3} {})",
                 DOF[i],
@@ -411,13 +411,18 @@ pub fn run(env: &Env) -> Result<Report, String> {
             "",
         ));
     }
+    Ok(())
+}
+
+/// The open-loop run: the bias estimate follows the Markov bias; returns the raw errors (notes).
+fn bias_estimation_checks(ol: &Table, c: &mut Vec<Check>) -> Result<Vec<String>, String> {
     let mut bias_notes = Vec::new();
     for i in 0..3 {
-        let lp = moving_average(col(&ol, BIAS_EST[i])?, 200);
-        let tru = col(&ol, BIAS[i])?;
+        let lp = moving_average(col(ol, BIAS_EST[i])?, 200);
+        let tru = col(ol, BIAS[i])?;
         let n = tru.len();
-        let r = correlation(&lp[start..n - 200], &tru[start..n - 200]);
-        report.checks.push(Check::range(
+        let r = correlation(&lp[START..n - 200], &tru[START..n - 200]);
+        c.push(Check::range(
             &format!(
                 "Eq. 61 run, {}: correlation of b̂ (200-s mean) with the Markov bias b",
                 DOF[i]
@@ -428,18 +433,23 @@ pub fn run(env: &Env) -> Result<Report, String> {
             1.0,
             "",
         ));
-        let raw = rms_diff(&col(&ol, BIAS_EST[i])?[start..], &tru[start..]);
-        let std_b = rms_diff(&tru[start..], &vec![mean(&tru[start..]); n - start]);
+        let raw = rms_diff(&col(ol, BIAS_EST[i])?[START..], &tru[START..]);
+        let std_b = rms_diff(&tru[START..], &vec![mean(&tru[START..]); n - START]);
         bias_notes.push(format!(
             "{}: raw RMS(b̂ − b) {raw:.3e} vs std(b) {std_b:.3e}",
             DOF[i]
         ));
     }
-    let vel: Vec<String> = (0..3)
+    Ok(bias_notes)
+}
+
+/// The open-loop run: RMS(ν̂ − ν) per DOF, as the notes print it.
+fn velocity_errors(ol: &Table) -> Result<Vec<String>, String> {
+    (0..3)
         .map(|i| -> Result<String, String> {
             let e = rms_diff(
-                &col(&ol, EST_NU[i])?[start..],
-                &col(&ol, TRUE_NU[i])?[start..],
+                &col(ol, EST_NU[i])?[START..],
+                &col(ol, TRUE_NU[i])?[START..],
             );
             Ok(if i == 2 {
                 format!("{:.2e} rad/s", e)
@@ -447,9 +457,11 @@ pub fn run(env: &Env) -> Result<Report, String> {
                 format!("{e:.3} m/s")
             })
         })
-        .collect::<Result<_, _>>()?;
+        .collect()
+}
 
-    // ---- (3) T9: noise free, no waves, matched bias model, initial errors ----
+/// T9: noise free, no waves, matched bias model, initial errors.
+fn t9_checks(env: &Env, c: &mut Vec<Check>) -> Result<(), String> {
     let mut nf = open_loop_sets();
     nf.extend([
         ("sensors.noise_scale", 0.0),
@@ -463,7 +475,7 @@ pub fn run(env: &Env) -> Result<Report, String> {
         ("observer.initial_east", -3.0),
         ("observer.initial_heading", 0.05),
     ]);
-    let t9 = env.run(file, &sets(&nf), "noise_free.csv")?;
+    let t9 = env.run(FILE, &sets(&nf), "noise_free.csv")?;
     let err_at = |tab: &Table, est: &str, tru: &str, k: usize| -> Result<f64, String> {
         Ok((col(tab, est)?[k] - col(tab, tru)?[k]).abs())
     };
@@ -472,7 +484,7 @@ pub fn run(env: &Env) -> Result<Report, String> {
     for (i, tol) in [(0usize, 1e-3), (1, 1e-3), (2, 1e-3)] {
         let e0 = err_at(&t9, EST[i], TRUE_ETA[i], 0)?;
         let e1 = err_at(&t9, EST[i], TRUE_ETA[i], last)?;
-        report.checks.push(Check::range(
+        c.push(Check::range(
             &format!(
                 "T9 noise free, {}: |η̂ − η| at {} s / at 0 s",
                 DOF[i],
@@ -487,7 +499,7 @@ pub fn run(env: &Env) -> Result<Report, String> {
     }
     let eb200 = err_at(&t9, BIAS_EST[0], BIAS[0], k200)?;
     let eb = err_at(&t9, BIAS_EST[0], BIAS[0], last)?;
-    report.checks.push(Check::range(
+    c.push(Check::range(
         "T9 noise free, surge bias: |b̂ − b| at the end / at 200 s",
         "bias error converges to zero (conclusions, line 466)",
         eb / eb200,
@@ -496,7 +508,11 @@ pub fn run(env: &Env) -> Result<Report, String> {
         "",
     ));
 
-    // ---- figures ----
+    Ok(())
+}
+
+/// The DP loop: measurement against the LF estimate, and the bias estimates.
+fn closed_loop_figures(env: &Env, cl: &Table, report: &mut Report) -> Result<(), String> {
     let (t0, t1) = (6000.0, 6300.0);
     let mut panels = Vec::new();
     for i in 0..3 {
@@ -508,9 +524,9 @@ pub fn run(env: &Env) -> Result<Report, String> {
         panels.push(Panel {
             y_label: format!("{} [{unit}]", ["north", "east", "heading"][i]),
             series: vec![
-                window(series(&cl, MEAS[i], "measured y", s)?, t0, t1),
-                window(series(&cl, TRUE_ETA[i], "true LF η", s)?, t0, t1),
-                window(series(&cl, EST[i], "estimate η̂", s)?, t0, t1),
+                series_window(cl, MEAS[i], "measured y", s, t0, t1)?,
+                series_window(cl, TRUE_ETA[i], "true LF η", s, t0, t1)?,
+                series_window(cl, EST[i], "estimate η̂", s, t0, t1)?,
             ],
         });
     }
@@ -527,10 +543,10 @@ pub fn run(env: &Env) -> Result<Report, String> {
     let mut panels = Vec::new();
     for i in 0..3 {
         panels.push(Panel {
-            y_label: format!("bias {} [{}]", ["north", "east", "yaw"][i], units[i]),
+            y_label: format!("bias {} [{}]", ["north", "east", "yaw"][i], UNITS[i]),
             series: vec![
-                series(&cl, BIAS[i], "applied b", 1.0)?,
-                series(&cl, BIAS_EST[i], "estimate b̂", 1.0)?,
+                series(cl, BIAS[i], "applied b", 1.0)?,
+                series(cl, BIAS_EST[i], "estimate b̂", 1.0)?,
             ],
         });
     }
@@ -542,6 +558,11 @@ pub fn run(env: &Env) -> Result<Report, String> {
     report
         .figures
         .push(("DP closed loop: constant bias and its estimate".into(), fig));
+    Ok(())
+}
+
+/// The open-loop run, surge, as [Fossen1999, Fig. 9].
+fn open_loop_figure(env: &Env, ol: &Table, report: &mut Report) -> Result<(), String> {
     let fig = env.figure(
         "paper_surge.png",
         "Eq. 61 run (open loop), surge: as the paper's Fig. 9",
@@ -549,38 +570,37 @@ pub fn run(env: &Env) -> Result<Report, String> {
             Panel {
                 y_label: "north [m]".into(),
                 series: vec![
-                    series(&ol, MEAS[0], "measured y", 1.0)?,
-                    series(&ol, TRUE_ETA[0], "true η", 1.0)?,
-                    series(&ol, EST[0], "estimate η̂", 1.0)?,
+                    series(ol, MEAS[0], "measured y", 1.0)?,
+                    series(ol, TRUE_ETA[0], "true η", 1.0)?,
+                    series(ol, EST[0], "estimate η̂", 1.0)?,
                 ],
             },
             Panel {
                 y_label: "surge velocity [m/s]".into(),
                 series: vec![
-                    series(&ol, TRUE_NU[0], "true ν", 1.0)?,
-                    series(&ol, EST_NU[0], "estimate ν̂", 1.0)?,
+                    series(ol, TRUE_NU[0], "true ν", 1.0)?,
+                    series(ol, EST_NU[0], "estimate ν̂", 1.0)?,
                 ],
             },
             Panel {
                 y_label: "WF north [m]".into(),
                 series: vec![
-                    window(
-                        series(&ol, "waves.wf_motion_surge", "true η_w", 1.0)?,
+                    series_window(ol, "waves.wf_motion_surge", "true η_w", 1.0, 2000.0, 2200.0)?,
+                    series_window(
+                        ol,
+                        "observer.north_wf_estimate",
+                        "estimate η̂_w",
+                        1.0,
                         2000.0,
                         2200.0,
-                    ),
-                    window(
-                        series(&ol, "observer.north_wf_estimate", "estimate η̂_w", 1.0)?,
-                        2000.0,
-                        2200.0,
-                    ),
+                    )?,
                 ],
             },
             Panel {
                 y_label: "bias north [N]".into(),
                 series: vec![
-                    series(&ol, BIAS[0], "Markov bias b", 1.0)?,
-                    series(&ol, BIAS_EST[0], "estimate b̂", 1.0)?,
+                    series(ol, BIAS[0], "Markov bias b", 1.0)?,
+                    series(ol, BIAS_EST[0], "estimate b̂", 1.0)?,
                 ],
             },
         ],
@@ -590,7 +610,17 @@ pub fn run(env: &Env) -> Result<Report, String> {
         fig,
     ));
 
-    report.notes.extend([
+    Ok(())
+}
+
+/// The notes: readings, controller, bias equilibrium, what is not reproduced.
+fn notes(
+    (applied, expected): ([f64; 3], [f64; 3]),
+    bias_notes: &[String],
+    vel: &[String],
+    n: &mut Vec<String>,
+) {
+    n.extend([
         "Readings: the paper's σᵢ, noise levels and duration are not given; WF std 10/3 m, 10/3 m, \
          1/3° (3 std = the printed 10 m / 10 m / 1°), DGPS 0.5 m and gyro 0.1° white noise, 1 Hz \
          samples, observer and DP controller at 1 Hz, plant at 0.1 s (Jacobi). Mass-normalised \
@@ -623,5 +653,4 @@ pub fn run(env: &Env) -> Result<Report, String> {
          T = 1000 s, seed 3)."
             .to_string(),
     ]);
-    Ok(report)
 }

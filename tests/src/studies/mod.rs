@@ -9,6 +9,7 @@ use crate::study::{Env, Report};
 pub mod autopilot;
 pub mod dgps_trial;
 pub mod dp_observer;
+mod path_common;
 pub mod path_control;
 pub mod path_estimation;
 pub mod rrs;

@@ -1,25 +1,26 @@
-//! Rudder roll stabilization (van der Klugt 1987, seed 003): systems/rrs.toml with RRS off
-//! (course keeping only, "ASA") and on, same seed; roll reduction 100(1 − σ²_on/σ²_off)
-//! (eq. 5.7); a sweep over steering-gear rate and wave direction for the trends of results R3-R5
-//! and R7 (spec rrs_controller_results.md §4.2); and a robustness run in which the same
-//! autopilot and filters, designed on the control model, steer the thesis's 22-knot simulation
-//! model (systems/rrs_simulation_plant.toml, [`simulation_plant`]).
+//! Rudder roll stabilization [Klugt1987]: systems/rrs.toml with RRS off (course keeping only,
+//! "ASA") and on, same seed; roll reduction 100(1 − σ²_on/σ²_off) [Klugt1987, eq. (5.7)]; a sweep
+//! over steering-gear rate and wave direction for the trends of the MARIN and full-scale results
+//! (named R3-R5 and R7 in the report) [Klugt1987, secs. 7.2.3, 7.4]; and a robustness run in
+//! which the same autopilot and filters, designed on the control model, steer the thesis's
+//! 22-knot simulation model (systems/rrs_simulation_plant.toml, [`simulation_plant`]).
 //!
-//! The thesis gives no sea state for its analog-model trials (Table 7.1): as the issue and the
-//! spec prescribe, the open-loop roll is tuned to the reported variances (16 and 47 deg²) by the
-//! wave roll gain, and the closed-loop reduction is the result compared.
+//! The thesis gives no sea state for its analog-model trials [Klugt1987, sec. 7.2.2, Table 7.1]:
+//! as the issue prescribes, the open-loop roll is tuned to the reported variances (16 and 47 deg²)
+//! by the wave roll gain, and the closed-loop reduction is the result compared.
 
-use crate::study::{after, series_window, variance, Check, Env, Report};
+use crate::study::{after, mean, series_window, variance, Check, Env, Report};
+use models::hull::DEG;
 use shipsim::plot::{Panel, Table};
-
-const DEG: f64 = std::f64::consts::PI / 180.0;
 const SYSTEM: &str = "rrs.toml";
-/// The robustness system: plant = the 22-knot simulation model (RrsShip model 1, Tables 2.1/2.2)
+/// The robustness system: plant = the 22-knot simulation model (RrsShip model 1,
+/// [Klugt1987, Tables 2.1-2.2])
 /// driven by the wave height; its wave connection gain (0.014670) is tuned for 16 deg² open loop.
 const SYSTEM_SIM: &str = "rrs_simulation_plant.toml";
 /// Statistics skip the start-up transient (filters, innovation process, adaptation).
 const SETTLE: f64 = 200.0;
-/// Wave roll gain for 47 deg² open loop (Table 7.1, exp. 2): the roll gain of systems/rrs.toml
+/// Wave roll gain for 47 deg² open loop ([Klugt1987, Table 7.1], exp. 2): the roll gain of
+/// systems/rrs.toml
 /// (0.034319, tuned for 16 deg² with the wind gusts' 0.31 deg² included) scaled by
 /// √((47 − 0.31)/(16 − 0.31)).
 const GAIN_EXP2: f64 = 0.059201;
@@ -54,13 +55,10 @@ fn stats(t: &Table) -> Result<RunStats, String> {
             last = (*tk, *ck);
         }
     }
-    let mean = |c: &str| -> Result<f64, String> {
-        let v = after(t, c, SETTLE)?;
-        Ok(v.iter().sum::<f64>() / v.len() as f64 / DEG)
-    };
+    let mean_deg = |c: &str| -> Result<f64, String> { Ok(mean(after(t, c, SETTLE)?) / DEG) };
     Ok(RunStats {
-        mean_roll: mean("ship.roll")?,
-        mean_rudder: mean("gear.rudder_angle")?,
+        mean_roll: mean_deg("ship.roll")?,
+        mean_rudder: mean_deg("gear.rudder_angle")?,
         roll_var: deg2("ship.roll")?,
         heading_var: deg2("ship.heading")?,
         rudder_var: deg2("gear.rudder_angle")?,
@@ -165,7 +163,28 @@ pub fn run(env: &Env) -> Result<Report, String> {
     let (off1, on1, toff1, ton1) = pair(env, "exp1", &[])?;
     // Experiment 2: the same sea with the roll gain scaled for 47 deg².
     let (off2, on2, _, _) = pair(env, "exp2", &[format!("waves.roll_gain={GAIN_EXP2}")])?;
-    let c = &mut report.checks;
+    table_7_1_checks([&off1, &on1], [&off2, &on2], &mut report.checks);
+    // Robustness: the same autopilot and filters on the 22-knot simulation model.
+    let sim_fig = simulation_plant(env, &mut report, &off1, &on1)?;
+    let by_rate = gear_rate_sweep(env, &mut report.checks)?;
+    let by_dir = wave_direction_sweep(env, &mut report.checks)?;
+    report.notes.push(sweep_note(&by_rate, &by_dir));
+    experiment_notes([&off1, &on1], [&off2, &on2], &mut report.notes);
+    let fig = overlay(env, &toff1, &ton1, "rrs_off_on.png", TITLE_EXP1)?;
+    report.figures.push((
+        "Experiment 1: roll, heading and rudder with RRS off and on".into(),
+        fig,
+    ));
+    report.figures.push((
+        "Robustness: the same autopilot on the 22-knot simulation model (Tables 2.1/2.2), RRS off and on"
+            .into(),
+        sim_fig,
+    ));
+    Ok(report)
+}
+
+/// [Klugt1987, Table 7.1]: the two experiments (off, on) against the thesis, and the wind heel.
+fn table_7_1_checks([off1, on1]: [&RunStats; 2], [off2, on2]: [&RunStats; 2], c: &mut Vec<Check>) {
     c.push(Check::abs(
         "exp. 1: open-loop (ASA) roll variance, tuned",
         16.0,
@@ -176,7 +195,7 @@ pub fn run(env: &Env) -> Result<Report, String> {
     c.push(Check::range(
         "exp. 1: roll reduction 100(1 − σ²_on/σ²_off), 15 deg/s",
         "78 % (16 → 3.5 deg²); issue: 60-78 %",
-        reduction(&off1, &on1),
+        reduction(off1, on1),
         60.0,
         78.0,
         "%",
@@ -198,7 +217,7 @@ pub fn run(env: &Env) -> Result<Report, String> {
     c.push(Check::range(
         "exp. 2: roll reduction, 15 deg/s",
         "68 % (47 → 15 deg²); issue: 60-78 %",
-        reduction(&off2, &on2),
+        reduction(off2, on2),
         60.0,
         78.0,
         "%",
@@ -219,7 +238,7 @@ pub fn run(env: &Env) -> Result<Report, String> {
         ),
         on1.heading_var > off1.heading_var && on2.heading_var > off2.heading_var,
     ));
-    report.checks.push(Check::holds(
+    c.push(Check::holds(
         "the constant wind heel is left alone by the roll loop (roll filter removes the offset)",
         "a constant roll angle must not be counteracted (it would need constant rudder and turn \
          the ship): the roll filter rejects it (§4.4, §6.3.1)",
@@ -231,28 +250,36 @@ pub fn run(env: &Env) -> Result<Report, String> {
             && (on1.mean_roll - off1.mean_roll).abs() < 0.1 * off1.mean_roll
             && (on1.mean_rudder - off1.mean_rudder).abs() < 0.2,
     ));
-    // Robustness: the same autopilot and filters on the 22-knot simulation model.
-    let sim_fig = simulation_plant(env, &mut report, &off1, &on1)?;
-    // Gear-rate sweep (R3, R5, R7: 6-7 deg/s too slow, 15 much better, 22 a little better).
+}
+
+/// Off/on pairs of a sweep: (gear rate [deg/s] or wave direction γ [deg], off, on).
+type Sweep = Vec<(f64, RunStats, RunStats)>;
+
+/// The roll reduction of the sweep's pair at `key` (NaN if there is none).
+fn reduction_at(sweep: &Sweep, key: f64) -> f64 {
+    sweep
+        .iter()
+        .find(|x| x.0 == key)
+        .map(|(_, off, on)| reduction(off, on))
+        .unwrap_or(f64::NAN)
+}
+
+/// Gear-rate sweep at beam seas (R3, R5, R7: 6-7 deg/s too slow, 15 much better, 22 a little
+/// better).
+fn gear_rate_sweep(env: &Env, c: &mut Vec<Check>) -> Result<Sweep, String> {
     let mut by_rate = Vec::new();
     for rate in [7.0, 15.0, 22.0] {
         let (off, on, _, _) = pair(env, &format!("rate{rate}"), &rate_sets(rate))?;
-        by_rate.push((rate, reduction(&off, &on), on));
+        by_rate.push((rate, off, on));
     }
-    let red = |r: f64| {
-        by_rate
-            .iter()
-            .find(|x| x.0 == r)
-            .map(|x| x.1)
-            .unwrap_or(f64::NAN)
-    };
-    report.checks.push(Check::holds(
+    let red = |r: f64| reduction_at(&by_rate, r);
+    c.push(Check::holds(
         "7 deg/s gear clearly worse than 15 deg/s (beam seas)",
         "rates of 3-7 deg/s generally too low; 15 deg/s considerably better (R3)",
         format!("{:.1} % vs {:.1} %", red(7.0), red(15.0)),
         red(7.0) < red(15.0) - 10.0,
     ));
-    report.checks.push(Check::holds(
+    c.push(Check::holds(
         "22 deg/s gear at least as good as 15 deg/s",
         "+5-10 % roll reduction from 15 to 22 deg/s (R5, ship 2)",
         format!(
@@ -264,56 +291,70 @@ pub fn run(env: &Env) -> Result<Report, String> {
         red(22.0) >= red(15.0),
     ));
     let (_, _, slow) = &by_rate[0];
-    report.checks.push(Check::holds(
+    c.push(Check::holds(
         "AGC keeps the commanded rudder rate within the gear's limit (7 deg/s gear)",
         "with AGC |dδ_g/dt| ≤ δ̇_max (§5.3, eq. 5.3)",
         format!("max |dδ_g/dt| = {:.3} deg/s", slow.max_command_rate),
         slow.max_command_rate <= 7.0 * (1.0 + 1e-9),
     ));
-    // Wave-direction sweep with the 15 deg/s gear (γ: 0 following, 90 beam, 180 head).
+    Ok(by_rate)
+}
+
+/// Wave-direction sweep with the 15 deg/s gear (γ: 0 following, 90 beam, 180 head).
+fn wave_direction_sweep(env: &Env, c: &mut Vec<Check>) -> Result<Sweep, String> {
     let mut by_dir = Vec::new();
     for gamma in [30.0, 60.0, 90.0, 120.0, 150.0] {
         let sets = vec![format!("waves.wave_direction={}", gamma * DEG)];
         let (off, on, _, _) = pair(env, &format!("dir{gamma}"), &sets)?;
-        by_dir.push((gamma, off.roll_var, on.roll_var, reduction(&off, &on)));
+        by_dir.push((gamma, off, on));
     }
-    let dred = |g: f64| {
-        by_dir
-            .iter()
-            .find(|x| x.0 == g)
-            .map(|x| x.3)
-            .unwrap_or(f64::NAN)
-    };
-    report.checks.push(Check::holds(
+    let dred = |g: f64| reduction_at(&by_dir, g);
+    c.push(Check::holds(
         "quartering following seas (60°) give clearly less reduction than beam seas",
         "following seas (low encounter frequency): RRS very difficult (R7, day 4)",
         format!("{:.1} % at 60° vs {:.1} % at 90°", dred(60.0), dred(90.0)),
         dred(60.0) < dred(90.0) - 20.0,
     ));
-    report.checks.push(Check::holds(
+    c.push(Check::holds(
         "small roll in oblique seas: little rudder action, little reduction",
         "γ = 120°: adaptive reduction small but roll < 4°, adaptation nearly off (R4)",
         format!(
             "open-loop σ²_φ at 30/150° = {:.2}/{:.2} deg², reduction {:.1}/{:.1} %",
-            by_dir[0].1, by_dir[4].1, by_dir[0].3, by_dir[4].3
+            by_dir[0].1.roll_var,
+            by_dir[4].1.roll_var,
+            dred(30.0),
+            dred(150.0)
         ),
-        by_dir[0].1 < 4.0 && by_dir[4].1 < 4.0,
+        by_dir[0].1.roll_var < 4.0 && by_dir[4].1.roll_var < 4.0,
     ));
+    Ok(by_dir)
+}
+
+/// The sweeps in full (a note).
+fn sweep_note(by_rate: &Sweep, by_dir: &Sweep) -> String {
     let mut sweep = String::from("Sweep (same sea, seed 1): gear rate at beam seas — ");
-    for (r, red, on) in &by_rate {
+    for (r, off, on) in by_rate {
         sweep.push_str(&format!(
-            "{r} deg/s: {red:.1} % (rate-limited {:.0} s); ",
+            "{r} deg/s: {:.1} % (rate-limited {:.0} s); ",
+            reduction(off, on),
             on.rate_saturated
         ));
     }
     sweep.push_str("wave direction with the 15 deg/s gear — ");
-    for (g, off, on, red) in &by_dir {
+    for (g, off, on) in by_dir {
         sweep.push_str(&format!(
-            "{g}°: σ²_φ {off:.2} → {on:.2} deg² ({red:.1} %); "
+            "{g}°: σ²_φ {:.2} → {:.2} deg² ({:.1} %); ",
+            off.roll_var,
+            on.roll_var,
+            reduction(off, on)
         ));
     }
-    report.notes.push(sweep);
-    report.notes.push(format!(
+    sweep
+}
+
+/// The experiments in full, the plant and the autopilot (notes).
+fn experiment_notes([off1, on1]: [&RunStats; 2], [off2, on2]: [&RunStats; 2], n: &mut Vec<String>) {
+    n.push(format!(
         "Experiment 1 in full: σ²_φ {:.2} → {:.2} deg², σ²_ψ {:.3} → {:.3} deg², σ²_δ {:.3} → {:.1} deg², \
          rate limiter active {:.1} s of 1000 s. Experiment 2: σ²_φ {:.1} → {:.1}, σ²_δ {:.1} (thesis 74), \
          rate limiter {:.1} s.",
@@ -329,7 +370,7 @@ pub fn run(env: &Env) -> Result<Report, String> {
         on2.rudder_var,
         on2.rate_saturated
     ));
-    report.notes.push(
+    n.push(
         "Plant: the control model of Table 2.4 (ship model 2) at 11 m/s; the wave disturbance is \
          rudder-equivalent (eq. 3.29) with the sin γ / sin 2γ scaling of eqs. 2.23-2.24 on a \
          Bretschneider-ITTC sea (T̄ = 7.7 s, peak near ω_n), plus a 10 m/s beam wind with gusts \
@@ -341,38 +382,31 @@ pub fn run(env: &Env) -> Result<Report, String> {
          the published size."
             .into(),
     );
-    report.notes.push(
+    n.push(
         "Autopilot: AGC and on-line criterion adaptation on (q_φ from 10, target roll variance \
          4 deg²); with the adaptation off and q_φ fixed at 30 the reductions are 71.5 % and 69.3 %."
             .into(),
     );
-    let fig = overlay(env, &toff1, &ton1, "rrs_off_on.png", TITLE_EXP1)?;
-    report.figures.push((
-        "Experiment 1: roll, heading and rudder with RRS off and on".into(),
-        fig,
-    ));
-    report.figures.push((
-        "Robustness: the same autopilot on the 22-knot simulation model (Tables 2.1/2.2), RRS off and on"
-            .into(),
-        sim_fig,
-    ));
-    Ok(report)
 }
 
 /// Robustness run (systems/rrs_simulation_plant.toml): the autopilot and the roll/yaw filters,
-/// designed on the control model of Table 2.4 (evaluated at the plant's 22 kn), steer the
-/// thesis's 22-knot simulation model (Fig. 2.5, Tables 2.1/2.2) driven by the wave height
+/// designed on the control model of [Klugt1987, Table 2.4] (evaluated at the plant's 22 kn),
+/// steer the thesis's 22-knot simulation model [Klugt1987, Fig. 2.5, Tables 2.1-2.2] driven by
+/// the wave height
 /// through its own wave filters; wind as in rrs.toml; same seeds, RRS off and on. Pushes the
 /// checks and notes to `report`; `ctrl_off`/`ctrl_on` are experiment 1 on the control model (same
 /// sea, same tuned 16 deg²) for the comparison. Returns the overlay figure.
 ///
-/// The thesis gives no roll reduction for this model: its digital simulations (PSI, §7.2.1, the
-/// model used is not named) appear only as Fig. 7.2 ("a reasonable roll reduction"). What it does report at 15 deg/s is
-/// 78 % and 68 % on the analog model (Table 7.1), "up to 60 %" on the MARIN simulator with ship 2
-/// (R5) and ≈ 60 % on the scale model and at full scale (R6-R8). The band checked is therefore
+/// The thesis gives no roll reduction for this model: its digital simulations (PSI, the model
+/// used is not named) appear only as [Klugt1987, sec. 7.2.1, Fig. 7.2] ("a reasonable roll
+/// reduction"). What it does report at 15 deg/s is 78 % and 68 % on the analog model
+/// [Klugt1987, Table 7.1], "up to 60 %" on the MARIN simulator with ship 2 [Klugt1987, sec. 7.2.3]
+/// and ≈ 60 % on the scale model and at full scale [Klugt1987, secs. 7.3-7.4]. The band checked
+/// is therefore
 /// the issue's 60-78 % for beam seas, 15 deg/s: from the thesis's typical ≈ 60 % on plants that
 /// differ from the control model to its best laboratory figure. The second check is the thesis's
-/// own criterion for the control model (§7.2): results on a plant with dynamics outside the
+/// own criterion for the control model [Klugt1987, sec. 7.2]: results on a plant with dynamics
+/// outside the
 /// control model must agree with those on the model itself. "Agree" is ±10 points: the seed
 /// spread of one plant is ±3 points (waves.seed 1-8, both systems: control model 69.3-73.8 %,
 /// simulation model 71.2-75.0 %, measured when this run was added), while the thesis's platforms

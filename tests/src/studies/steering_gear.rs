@@ -1,10 +1,9 @@
-//! Steering machine requirements through the master (van der Klugt 1987 §2.3 and §6.5.2):
+//! Steering machine requirements through the master [Klugt1987, secs. 2.3, 6.5.2]:
 //! the classification rule (35° port to 35° starboard within 30 s at 2.5 deg/s) and the RRS gear.
 
-use crate::study::{series, Check, Env, Report};
+use crate::study::{col, max_abs, series, Check, Env, Report};
+use models::hull::DEG;
 use shipsim::plot::Panel;
-
-const DEG: f64 = std::f64::consts::PI / 180.0;
 
 /// Time from the hard-over order (t = 5 s) until the angle is within `eps` of +35°.
 fn arrival(t: &[f64], angle: &[f64], eps: f64) -> Option<f64> {
@@ -18,12 +17,8 @@ pub fn run(env: &Env) -> Result<Report, String> {
     let file = "steering_gear_classification.toml";
     let table = env.run(file, &[], "classification.csv")?;
     let t = table.time();
-    let slow = table
-        .column("slow.rudder_angle")
-        .map_err(|e| e.to_string())?;
-    let fast = table
-        .column("rrs.rudder_angle")
-        .map_err(|e| e.to_string())?;
+    let slow = col(&table, "slow.rudder_angle")?;
+    let fast = col(&table, "rrs.rudder_angle")?;
     let eps = 0.01 * DEG;
     let tau = 0.2;
     // Closed form of the exact piecewise solution (ramp at the rate limit, then the
@@ -61,11 +56,7 @@ pub fn run(env: &Env) -> Result<Report, String> {
         h,
         "s",
     ));
-    let peak = table
-        .column("rrs.rudder_rate")
-        .map_err(|e| e.to_string())?
-        .iter()
-        .fold(0.0f64, |m, v| m.max(v.abs()));
+    let peak = max_abs(col(&table, "rrs.rudder_rate")?);
     report.checks.push(Check::abs(
         "peak rudder rate of the RRS gear",
         15.0,
