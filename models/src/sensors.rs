@@ -20,7 +20,7 @@
 //!   but its own r_jj = 1.118e-8 gives √(r/Δt′) = 1.495e-3, as does σ = 0.01 m/s with
 //!   [Parsons1980, eq. (15)];
 //!   the printed value is taken as transposed digits and **1.495e-3** is used.
-//! * **DGPS [Artyszuk2003, sec. 2]**: σ = 2 m per axis at 1 s ([`SensorParams::dgps_002`]).
+//! * **DGPS [Artyszuk2003, sec. 2]**: σ = 2 m per axis at 1 s ([`SensorParams::dgps_artyszuk2003`]).
 //! * **DDG-51 [Taylor2000, sec. 5.2.3.1]**: "noisy measurements" of heading and y, level not given; use the [Parsons1980] compass
 //!   channel (0.1° class) or set σ.
 //! * **[Klugt1987]**: roll and speed noise levels not given (speed variance "1" in [Klugt1987, sec. 5.5.3] has no unit);
@@ -112,7 +112,7 @@ impl SensorParams {
     }
 
     /// DGPS of [Artyszuk2003, sec. 2]: north and east σ = 2 m at 1 s, everything else noise-free at 1 s.
-    pub fn dgps_002() -> Self {
+    pub fn dgps_artyszuk2003() -> Self {
         let mut p = Self::tokyo_maru_table3();
         for (i, c) in p.channels.iter_mut().enumerate() {
             c.interval = 1.0;
@@ -251,7 +251,7 @@ mod tests {
     use crate::random::{correlation, mean_variance};
 
     #[test]
-    fn per_sample_sigmas_reproduce_004_tables_3_and_9() {
+    fn per_sample_sigmas_reproduce_parsons1980_tables_3_and_9() {
         let d = std::f64::consts::PI / 180.0;
         let ul = TOKYO_MARU_U / TOKYO_MARU_L;
         let tau = |s: f64| s * ul; // τ′ = τ U/L
@@ -321,7 +321,7 @@ mod tests {
             );
         }
         // DGPS: σ 2 m at 1 s, north and east independent
-        let rec = run(SensorParams::dgps_002(), zero, 1.0, 100_000);
+        let rec = run(SensorParams::dgps_artyszuk2003(), zero, 1.0, 100_000);
         let n: Vec<f64> = rec.iter().map(|r| r[ch::NORTH]).collect();
         let e: Vec<f64> = rec.iter().map(|r| r[ch::EAST]).collect();
         let (_, v) = mean_variance(&n);
@@ -334,7 +334,7 @@ mod tests {
 
     #[test]
     fn zero_order_hold_sampling_and_step_independence() {
-        let mut p = SensorParams::dgps_002();
+        let mut p = SensorParams::dgps_artyszuk2003();
         p.channels[ch::HEADING] = ChannelParams {
             sigma: 0.01,
             interval: 0.5,
@@ -378,7 +378,7 @@ mod tests {
         let zero = |_t: f64| [0.0; CHANNELS];
         let mk = |seed| SensorParams {
             seed,
-            ..SensorParams::dgps_002()
+            ..SensorParams::dgps_artyszuk2003()
         };
         let a = run(mk(3), zero, 1.0, 100_000);
         let b = run(mk(3), zero, 1.0, 100_000);

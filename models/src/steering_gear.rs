@@ -77,7 +77,7 @@ impl SteeringGearParams {
     /// trials of [Klugt1987, Table 7.1]), τ_δ = 0.2 s (within the rule τ_δ ≤ 0.2/ω_n of
     /// [Klugt1987, eq. (6.37)] for ω_n = 0.63-0.75 rad/s; the thesis prints no single value),
     /// first-order servo.
-    pub fn rrs_003() -> Self {
+    pub fn rrs_klugt1987() -> Self {
         SteeringGearParams {
             angle_max: 22.0 * DEG,
             rate_max: 15.0 * DEG,
@@ -92,23 +92,23 @@ impl SteeringGearParams {
 
     /// The DDG-51 gear [Taylor2000, eq. (5.28)]: 6/(s+6) in nondimensional time, i.e.
     /// τ = L/(6U) seconds, ±30° command limit, no rate limit.
-    pub fn ddg51_000(length_m: f64, speed_m_s: f64) -> Self {
+    pub fn ddg51_taylor2000(length_m: f64, speed_m_s: f64) -> Self {
         SteeringGearParams {
             angle_max: 30.0 * DEG,
             rate_limited: false,
             time_constant: length_m / (6.0 * speed_m_s),
-            ..Self::rrs_003()
+            ..Self::rrs_klugt1987()
         }
     }
 
     /// The Tokyo Maru gear [Parsons1980, eq. (10)]: first-order lag T_r = 10 s full scale
     /// (T_r' = 0.212874, derived here), no rate limit; δ_max is not given there and is left at 35°.
-    pub fn tokyo_maru_004() -> Self {
+    pub fn tokyo_maru_parsons1980() -> Self {
         SteeringGearParams {
             angle_max: 35.0 * DEG,
             rate_limited: false,
             time_constant: 10.0,
-            ..Self::rrs_003()
+            ..Self::rrs_klugt1987()
         }
     }
 
@@ -126,7 +126,7 @@ impl SteeringGearParams {
 
 impl Default for SteeringGearParams {
     fn default() -> Self {
-        Self::rrs_003()
+        Self::rrs_klugt1987()
     }
 }
 
@@ -483,7 +483,7 @@ mod tests {
     #[test]
     fn ddg51_gear_step_response() {
         let (l, u) = (142.0, 22.0 * 1852.0 / 3600.0);
-        let p = SteeringGearParams::ddg51_000(l, u);
+        let p = SteeringGearParams::ddg51_taylor2000(l, u);
         let tau = l / (6.0 * u);
         assert!((tau - 2.0913).abs() < 1e-3); // ≈ 2.09 s at 22 kn (derived: L/(6U))
         let mut g = gear(p);
@@ -499,7 +499,7 @@ mod tests {
     /// same answer whatever the step size (exact integration).
     #[test]
     fn tokyo_maru_gear_step_response_is_step_size_independent() {
-        let p = SteeringGearParams::tokyo_maru_004();
+        let p = SteeringGearParams::tokyo_maru_parsons1980();
         for h in [0.01f64, 0.1, 1.0, 2.5, 10.0] {
             let mut g = gear(p.clone());
             let n = (10.0 / h).round() as usize;
@@ -514,7 +514,7 @@ mod tests {
     /// Exactness of the rate-limited first-order servo: one big step equals many small ones.
     #[test]
     fn first_order_rate_limited_is_step_size_independent() {
-        let p = SteeringGearParams::rrs_003();
+        let p = SteeringGearParams::rrs_klugt1987();
         let mut one = gear(p.clone());
         let mut many = gear(p);
         one.step(0.3, 3.0);

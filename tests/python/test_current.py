@@ -1,5 +1,5 @@
 """Current.fmu (models::disturbances::current) shows the passing-ship peaks of [Parsons1980, Fig. 3]
-(its surrogate). Its comparison with the Rust model (case `current_004`) in FMPy and libcosim is in
+(its surrogate). Its comparison with the Rust model (case `current_parsons1980`) in FMPy and libcosim is in
 test_fmu_cases.py."""
 import numpy as np
 from fmpy import simulate_fmu

@@ -246,7 +246,7 @@ CASES = [
                     "wind_direction": 1.0},
             scale=fixed_scale({"true_wind_speed": 10.0, "relative_wind_speed": 10.0,
                                "roll_moment": 1e6, "yaw_moment": 1e6})),
-    FmuCase("Current", "current_004", inputs=("heading",),
+    FmuCase("Current", "current_parsons1980", inputs=("heading",),
             outputs=("current_sway", "n_prime", "y_prime", "yaw_moment", "side_force",
                      "bias_surge", "bias_n"),
             params={"seed": 6, "current_speed_final": 5.0 * 1852.0 / 3600.0,

@@ -17,7 +17,7 @@ pub struct SteeringGearFmu {
 
 impl Default for SteeringGearFmu {
     fn default() -> Self {
-        let params = SteeringGearParams::rrs_003();
+        let params = SteeringGearParams::rrs_klugt1987();
         SteeringGearFmu {
             gear: SteeringGear::new(params.clone(), 0.0).expect("preset parameters are valid"),
             params,

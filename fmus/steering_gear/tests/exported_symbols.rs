@@ -9,7 +9,7 @@ fmi2_export::fmu_tests!(steering_gear_fmu::SteeringGearFmu);
 fn exported_api_reproduces_the_model() {
     let mut fmu = fmu();
     fmu.initialize(0.0);
-    let mut model = SteeringGear::new(SteeringGearParams::rrs_003(), 0.0).unwrap();
+    let mut model = SteeringGear::new(SteeringGearParams::rrs_klugt1987(), 0.0).unwrap();
     let outputs = [
         "rudder_angle",
         "rudder_rate",

@@ -915,7 +915,7 @@ mod tests {
         with_agc: bool,
         t_end: f64,
     ) -> (f64, f64, f64, Vec<f64>) {
-        let gp = SteeringGearParams::rrs_003();
+        let gp = SteeringGearParams::rrs_klugt1987();
         let mut gear = SteeringGear::new(gp.clone(), 0.0).unwrap();
         let mut agc = Agc::new(gp.rate_max, RrsAutopilotParams::default().agc_memory_time);
         let dt = 0.01;
@@ -961,7 +961,7 @@ mod tests {
     /// without. The input reaches a·ω = 3 δ̇_max [Klugt1987, eq. (5.2)] at the end, at 0.5 rad/s (near ω_n).
     #[test]
     fn t3_agc_increasing_amplitude() {
-        let rate = SteeringGearParams::rrs_003().rate_max;
+        let rate = SteeringGearParams::rrs_klugt1987().rate_max;
         let omega = 0.5;
         let t_end = 120.0;
         let amp = |t: f64| 3.0 * rate / omega * (t / t_end);
@@ -988,7 +988,7 @@ mod tests {
     /// the attenuation between peaks [interpretation; the thesis gives no number]).
     #[test]
     fn t4_agc_decreasing_amplitude() {
-        let rate = SteeringGearParams::rrs_003().rate_max;
+        let rate = SteeringGearParams::rrs_klugt1987().rate_max;
         let omega = 0.5;
         let amp = |t: f64| rate / omega * (3.0 - 2.7 * ((t - 60.0) / 10.0).clamp(0.0, 1.0));
         let (r_agc, _, _, hist) = run_agc(amp, omega, true, 300.0);

@@ -440,7 +440,7 @@ mod tests {
     }
 
     #[test]
-    fn passing_ship_peaks_rms_and_span_of_004() {
+    fn passing_ship_peaks_rms_and_span_of_parsons1980() {
         for (factor, tpass) in [(1.0, 7.0), (4.0, 20.0)] {
             let p = CurrentParams {
                 passing_factor: factor,
@@ -510,7 +510,7 @@ mod tests {
     }
 
     #[test]
-    fn bias_of_001_decays_with_t_1000_and_has_the_stationary_variance() {
+    fn bias_of_fossen1999_decays_with_t_1000_and_has_the_stationary_variance() {
         // deterministic decay from b0 with Ψ = 0
         let p = CurrentParams {
             bias_initial: [1.0e4, -2.0e4, 5.0e5],
@@ -550,7 +550,7 @@ mod tests {
     }
 
     #[test]
-    fn random_disturbances_of_004() {
+    fn random_disturbances_of_parsons1980() {
         let p = CurrentParams {
             white_sigma: [2e-5, 5e-5],
             shaping_sigma: [8.798e-5, 21.178e-5],

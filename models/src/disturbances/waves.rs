@@ -771,7 +771,7 @@ mod tests {
     }
 
     #[test]
-    fn wf_motion_has_the_001_variance() {
+    fn wf_motion_has_the_fossen1999_variance() {
         let mut w = Waves::new(WaveParams::default(), 0.0).unwrap();
         let n = 400_000;
         let mut x = [Vec::new(), Vec::new(), Vec::new()];

@@ -25,7 +25,7 @@
 //! the report's nondimensional N′ = 2N/(ρL³U²) and Y′ = 2Y/(ρL²U²) (the disturbance models of the
 //! report are all nondimensional). Outputs both prime and dimensional (U = 12 kn, L = 290 m).
 //! Rudder: by default the input is the *actual* rudder δ (the steering gear is a separate model,
-//! [`crate::steering_gear::SteeringGearParams::tokyo_maru_004`]); with
+//! [`crate::steering_gear::SteeringGearParams::tokyo_maru_parsons1980`]); with
 //! [`TokyoMaru::internal_steering_gear`] the input is the command δ_c and
 //! [Parsons1980, eq. (10)] is integrated inside (the full 5-state F_s of [Parsons1980, eq. (11)]).
 //! Current: v_c [m/s] is the lateral current toward +η; it is implemented with

@@ -25,7 +25,7 @@ pub fn params() -> CurrentParams {
 
 /// 1200 s at h = 0.5 s (t' up to 25.5: the 4x passing ship at t' = 20 on the ramp of
 /// [Parsons1980, Fig. 4]).
-pub fn disturbances_004(out: &mut dyn Write) -> std::io::Result<()> {
+pub fn disturbances_parsons1980(out: &mut dyn Write) -> std::io::Result<()> {
     let h = 0.5;
     let n = 2400;
     let heading = |t: f64| 0.2 * (0.01 * t).sin();

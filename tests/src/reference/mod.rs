@@ -150,11 +150,11 @@ pub const CASES: &[Case] = &[
         rrs_ship::control,
     ),
     (
-        "current_004",
+        "current_parsons1980",
         "Current: 5-kn beam current stepped in at 30 s, 004 design current, 4x passing ship at \
          t' = 20, white N', shaping Y', random-walk Y', 001 bias; seed 6; heading 0.2 sin(0.01 t); \
          h = 0.5 s, 1200 s",
-        current::disturbances_004,
+        current::disturbances_parsons1980,
     ),
     (
         "rrs_filter",

@@ -15,7 +15,7 @@ pub(super) const W_S11: [f64; 2] = [0.0010262, 0.0023277];
 /// controller (design 1.89, random walk, ε = 0 in the filter). The plant fixes ψ′ = β′, δ′
 /// (r′ = 0); the filter's stationarity with u = C x̂′ = δ′ fixes x̂′ and η′ (the report prints
 /// η′ = 0; it is 3.9e-5). Returns the plant state [ψ′, r′, β′, η′, δ′] and x̂′.
-pub(super) fn line_1145_equilibrium() -> Result<([f64; 5], [f64; 7]), String> {
+pub(super) fn s11_starting_state() -> Result<([f64; 5], [f64; 7]), String> {
     let (beta, delta) = plant_equilibrium()?;
     let (a, b) = filter_equilibrium_system(beta, delta)?;
     let v = solve(a, b)?;

@@ -3,7 +3,7 @@
 //! [`super::equilibrium`]), three updates; and the 5.0-L windows of [Parsons1980, Table 12] (first
 //! update).
 
-use super::equilibrium::{line_1145_equilibrium, W_S11};
+use super::equilibrium::{s11_starting_state, W_S11};
 use super::model_loop::{run_loop, LoopEstimator, LoopRun, LoopSpec};
 use super::wls::{wls_seed, wls_stats, wls_table_checks, WlsStats};
 use super::{err, noise_free_sets, run_until, within_seeds, SEEDS};
@@ -49,7 +49,7 @@ const TABLE_12_OFFSET: [f64; 2] = [1.273, 2.422];
 
 /// S11 at model level (see [`LoopSpec`]).
 fn s11_loop(noise: Option<u64>, exchange: bool) -> Result<LoopRun, String> {
-    let (x0, xhat0) = line_1145_equilibrium()?;
+    let (x0, xhat0) = s11_starting_state()?;
     let c = TABLE_2[2];
     let controller = PathControllerParams {
         design_depth_ratio: 1.89,
@@ -99,7 +99,7 @@ fn s11_loop(noise: Option<u64>, exchange: bool) -> Result<LoopRun, String> {
 /// [Parsons1980, Table 3] noise in the filter and
 /// the report's loop structure, figure and notes.
 pub(super) fn s11(env: &Env, report: &mut Report) -> Result<(), String> {
-    let (x_eq, xhat_eq) = line_1145_equilibrium()?;
+    let (x_eq, xhat_eq) = s11_starting_state()?;
     let eta_eq = x_eq[3] * L;
     let c = &mut report.checks;
     let results = Results {
