@@ -6,6 +6,7 @@ use super::err;
 use models::controllers::path::path_gains;
 use models::hull::tokyo_maru::TABLE_2;
 use models::observers::path_model::PathDesignModel;
+use nalgebra::{Matrix2, SMatrix, SVector, Vector2};
 
 /// The constant disturbance of [Parsons1980, Tables 12-13] (N′, Y′).
 pub(super) const W_S11: [f64; 2] = [0.0010262, 0.0023277];
@@ -18,7 +19,10 @@ pub(super) const W_S11: [f64; 2] = [0.0010262, 0.0023277];
 pub(super) fn s11_starting_state() -> Result<([f64; 5], [f64; 7]), String> {
     let (beta, delta) = plant_equilibrium()?;
     let (a, b) = filter_equilibrium_system(beta, delta)?;
-    let v = solve(a, b)?;
+    let v = a
+        .lu()
+        .solve(&b)
+        .ok_or("the filter's equilibrium system is singular")?;
     let xhat: [f64; 7] = std::array::from_fn(|i| v[i]);
     Ok(([beta, 0.0, beta, v[7], delta], xhat))
 }
@@ -27,22 +31,32 @@ pub(super) fn s11_starting_state() -> Result<([f64; 5], [f64; 7]), String> {
 fn plant_equilibrium() -> Result<(f64, f64), String> {
     let c = TABLE_2[4];
     let [n, y] = W_S11;
-    let beta_delta = solve(
-        vec![vec![c.f23, c.f25], vec![c.f33, c.f35]],
-        vec![-(c.g21 * n + c.g22 * y), -(c.g31 * n + c.g32 * y)],
-    )?;
+    let a = Matrix2::new(c.f23, c.f25, c.f33, c.f35);
+    let b = Vector2::new(-(c.g21 * n + c.g22 * y), -(c.g31 * n + c.g32 * y));
+    let beta_delta = a
+        .lu()
+        .solve(&b)
+        .ok_or("the plant's equilibrium system is singular")?;
     Ok((beta_delta[0], beta_delta[1]))
 }
 
 /// The filter's stationarity at the plant's equilibrium, unknowns [x̂′ (7), η′]:
 /// (F_e + G_e C − K H) x̂′ + K(:, η′) η′ = −K(:, ψ′) ψ′ and C x̂′ = δ′.
-fn filter_equilibrium_system(beta: f64, delta: f64) -> Result<(Vec<Vec<f64>>, Vec<f64>), String> {
+///
+/// The system is solved by LU with partial pivoting. Its condition number is about 4.6e5, so
+/// η′ (about 3.9e-5) is fixed only to about 1e-10 relative: another elimination order moves it
+/// by about 1.7e-15, which the report's noise-free S11 agreement between master and model loop
+/// shows at the rounding level.
+fn filter_equilibrium_system(
+    beta: f64,
+    delta: f64,
+) -> Result<(SMatrix<f64, 8, 8>, SVector<f64, 8>), String> {
     let d = PathDesignModel::random_walk(1.89);
     let g = path_gains(&d).map_err(err)?;
     let k = d.kalman_gain().map_err(err)?;
     let (fe, ge) = (d.f(false), d.g());
-    let mut a = vec![vec![0.0; 8]; 8];
-    let mut b = vec![0.0; 8];
+    let mut a = SMatrix::<f64, 8, 8>::zeros();
+    let mut b = SVector::<f64, 8>::zeros();
     for i in 0..7 {
         for j in 0..7 {
             let kh = match j {
@@ -51,84 +65,41 @@ fn filter_equilibrium_system(beta: f64, delta: f64) -> Result<(Vec<Vec<f64>>, Ve
                 3 => k[(i, 2)],
                 _ => 0.0,
             };
-            a[i][j] = fe[(i, j)] + ge[i] * g.c[j] - kh;
+            a[(i, j)] = fe[(i, j)] + ge[i] * g.c[j] - kh;
         }
-        a[i][7] = k[(i, 2)];
+        a[(i, 7)] = k[(i, 2)];
         b[i] = -k[(i, 0)] * beta;
     }
     for j in 0..7 {
-        a[7][j] = g.c[j];
+        a[(7, j)] = g.c[j];
     }
     b[7] = delta;
     Ok((a, b))
 }
 
-/// Solves A y = b by Gaussian elimination with partial pivoting (the row of the largest |a_rc|
-/// as pivot, multipliers a_rc / a_cc, back substitution row by row).
-///
-/// Kept instead of nalgebra's solvers on purpose: the report prints numbers that carry this
-/// solver's last bits. The 8×8 system of [`filter_equilibrium_system`] has a condition number of
-/// about 4.6e5, so its η′ and x̂_η′ components are fixed only to about 1e-10 relative, and any
-/// other order of rounding gives other last bits. nalgebra's `lu()` picks the same pivots but
-/// multiplies by 1/a_cc and substitutes back column by column (each of the two alone already
-/// changes the bits); `lu()`, `full_piv_lu()` and `qr()` all move η′ by about 1.7e-15 (4e-11
-/// relative), and the matrix is not symmetric, so there is no Cholesky. The S11 model-level loop
-/// starts at this equilibrium, and the report prints its noise-free agreement with the master at
-/// the rounding level (max |Δη′| 1.0520e-9, max |Δf̂| 1.2339e-8); with nalgebra's `lu()` they
-/// read 7.8503e-11 and 1.6816e-9 (both checks pass either way). The test below holds the two
-/// solvers together.
-fn solve(mut a: Vec<Vec<f64>>, mut b: Vec<f64>) -> Result<Vec<f64>, String> {
-    let n = b.len();
-    for c in 0..n {
-        let p = (c..n)
-            .max_by(|&i, &j| a[i][c].abs().total_cmp(&a[j][c].abs()))
-            .ok_or("empty system")?;
-        if a[p][c].abs() < 1e-300 {
-            return Err("singular equilibrium system".into());
-        }
-        a.swap(c, p);
-        b.swap(c, p);
-        for r in c + 1..n {
-            let f = a[r][c] / a[c][c];
-            for k in c..n {
-                a[r][k] -= f * a[c][k];
-            }
-            b[r] -= f * b[c];
-        }
-    }
-    let mut y = vec![0.0; n];
-    for r in (0..n).rev() {
-        y[r] = (b[r] - (r + 1..n).map(|k| a[r][k] * y[k]).sum::<f64>()) / a[r][r];
-    }
-    Ok(y)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-    use nalgebra::{DMatrix, DVector};
 
-    /// The solver agrees with nalgebra's LU to the rounding the system's conditioning allows.
+    /// The solution satisfies the system to the rounding its conditioning allows, and η′ is the
+    /// small steady offset of [Parsons1980, sec. 4.2.2] (the report prints 0), equal in the plant
+    /// and in the filter.
     #[test]
-    fn solve_agrees_with_nalgebra_lu() {
+    fn the_starting_state_solves_the_equilibrium_system() {
         let (beta, delta) = plant_equilibrium().unwrap();
         let (a, b) = filter_equilibrium_system(beta, delta).unwrap();
-        let n = b.len();
-        let lu = DMatrix::from_fn(n, n, |i, j| a[i][j])
-            .lu()
-            .solve(&DVector::from_vec(b.clone()))
-            .unwrap();
-        let y = solve(a, b).unwrap();
-        let scale = y.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-        for i in 0..n {
-            assert!(
-                (y[i] - lu[i]).abs() <= 1e-12 * scale,
-                "component {i}: {} vs nalgebra {}",
-                y[i],
-                lu[i]
-            );
+        let (x, xhat) = s11_starting_state().unwrap();
+        let mut v = SVector::<f64, 8>::zeros();
+        for i in 0..7 {
+            v[i] = xhat[i];
         }
-        // η′ of the plant and of the filter: the small steady offset of [Parsons1980, sec. 4.2.2]
-        assert!((y[7] / 3.8877e-5 - 1.0).abs() < 1e-4 && (y[3] / y[7] - 1.0).abs() < 1e-9);
+        v[7] = x[3];
+        let residual = (a * v - b).amax();
+        assert!(residual < 1e-15 * b.amax().max(1.0), "residual {residual:e}");
+        assert!((x[3] / 3.8877e-5 - 1.0).abs() < 1e-4, "eta' = {}", x[3]);
+        assert!((xhat[3] / x[3] - 1.0).abs() < 1e-9);
+        // the plant: ψ′ = β′ = −0.1428, δ′ = 0.1310 as printed (δ′ is 0.13093: within one unit
+        // of the last printed digit)
+        assert!((x[0] + 0.1428).abs() < 5e-5 && (x[4] - 0.1310).abs() < 1e-4, "{x:?}");
     }
 }
