@@ -1,7 +1,8 @@
 //! Manoeuvre system test: the shipsim master runs the `Manoeuvre` FMU in a loop with the
 //! `ContainerShip` FMU (systems/container_ship_turning_circle.toml) and the turning-circle metrics
 //! of the recorded run equal those of the Rust-only loop (`models::manoeuvre::run` with the same
-//! ship, generator and step), which the models tests state and check against the spec.
+//! ship, generator and step), which the models tests check against the container-ship model of
+//! Son & Nomoto (1982) as implemented in Fossen's MSS.
 //!
 //! Needs the release master (`cargo build --release -p shipsim`, or env SHIPSIM_BIN) and the
 //! FMUs (`cargo xtask build-fmus`, or env SHIPSIM_FMU_DIR). Fails with a message saying which is
@@ -220,7 +221,8 @@ fn container_ship_turning_circle_through_the_master_matches_the_rust_run() {
                 "{algorithm}: {name} {a} (shipsim) vs {b} (Rust)"
             );
         }
-        // Physics the spec states (container_ship.md sections 1 and 5.4).
+        // The physics of the container ship (Son & Nomoto 1982; MSS example exRRD3): outward
+        // steady heel and an inverse (non-minimum-phase) initial roll.
         assert!(f.steady_heel < 0.0, "outward heel in a starboard turn");
         assert!(f.initial_inward_heel > 0.0, "inverse initial roll");
     }
