@@ -218,7 +218,12 @@ fn parse_algorithm(a: &str) -> shipsim::Result<Algorithm> {
 
 /// `shipsim run`: Ctrl-C stops the run cleanly (a second one exits at once); warnings, then
 /// the run, then its summary on stderr.
-fn run_cli(sys: &System, output: Option<PathBuf>, verbose: bool, quiet: bool) -> shipsim::Result<()> {
+fn run_cli(
+    sys: &System,
+    output: Option<PathBuf>,
+    verbose: bool,
+    quiet: bool,
+) -> shipsim::Result<()> {
     let begin = Instant::now();
     let out_file = output.or_else(|| sys.output.file.clone());
     let out = match &out_file {

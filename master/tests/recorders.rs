@@ -71,7 +71,13 @@ fn memory_and_statistics_recorders_see_exactly_the_csv_rows() {
         let p = write_system(d.path(), "r.toml", &SYSTEM.replace("ALGO", algo));
         let (plan, fmus) = prepare(&System::load(&p).unwrap()).unwrap();
         let csv = d.path().join(format!("{algo}.csv"));
-        let s_csv = run(&plan, &fmus, Output::File(csv.clone()), &RunOptions::default()).unwrap();
+        let s_csv = run(
+            &plan,
+            &fmus,
+            Output::File(csv.clone()),
+            &RunOptions::default(),
+        )
+        .unwrap();
         let mut mem = MemoryRecorder::new();
         let s_mem = run_with(&plan, &fmus, Some(&mut mem), &RunOptions::default()).unwrap();
         let mut stats = Stats::default();
@@ -104,7 +110,10 @@ fn memory_and_statistics_recorders_see_exactly_the_csv_rows() {
         for (j, name) in stats.names.iter().enumerate() {
             let col = mem.column(name).unwrap();
             assert_eq!(stats.last[j], *col.last().unwrap());
-            assert_eq!(stats.max[j], col.iter().cloned().fold(f64::NEG_INFINITY, f64::max));
+            assert_eq!(
+                stats.max[j],
+                col.iter().cloned().fold(f64::NEG_INFINITY, f64::max)
+            );
         }
     }
 }

@@ -9,8 +9,8 @@
 //!
 //! A study is `fn(&Env) -> Result<Report, String>`; register it in [`crate::studies::STUDIES`].
 
-use shipsim::run::{run_system, Output, RunOptions};
 use shipsim::plot::{plot_panels, Panel, Series, Table};
+use shipsim::run::{run_system, Output, RunOptions};
 use shipsim::system::System;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};

@@ -7,13 +7,12 @@
 //! a `LinearTransformation` function between two `SignalConnection`s -> a connection with gain
 //! (`factor`) and `offset`. Events and outputs have no place in this file; `export-osp` says so.
 
-
 use super::{collected, line_of};
 use crate::error::{Error, Result};
 use crate::model_description::{Causality, ModelDescription};
 use crate::system::{
-    Algorithm, ConnectionSpec, InstanceSpec, OutputSpec, Plan, PlanConnection, System,
-    TypedValue, Value, ValueSpec, VarRef,
+    Algorithm, ConnectionSpec, InstanceSpec, OutputSpec, Plan, PlanConnection, System, TypedValue,
+    Value, ValueSpec, VarRef,
 };
 use serde::Deserialize;
 use std::collections::HashMap;
@@ -147,7 +146,6 @@ struct SignalEndpoint {
     #[serde(rename = "@name")]
     name: String,
 }
-
 
 /// Line of the first occurrence of `needle` (OSP errors point at the element when they can).
 fn line_of_needle(text: &str, needle: &str) -> Option<usize> {

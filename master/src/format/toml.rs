@@ -252,7 +252,13 @@ impl Reader<'_> {
         let line = self.line(c.span());
         let (from, to, gain, offset, convert) = match c.into_inner() {
             RawConnection::Short(s) => match s.split_once("->") {
-                Some((a, b)) => (a.trim().to_string(), b.trim().to_string(), None, None, false),
+                Some((a, b)) => (
+                    a.trim().to_string(),
+                    b.trim().to_string(),
+                    None,
+                    None,
+                    false,
+                ),
                 None => {
                     self.error(
                         line,

@@ -32,8 +32,11 @@ pub struct MacroStep<'a> {
 /// A fixed-step master algorithm.
 pub trait Algorithm {
     /// One round of exchange between instances in Initialization Mode.
-    fn initial_exchange<S: Readable>(&self, slots: &mut [Slot<S>], values: &mut Values)
-        -> Result<()>;
+    fn initial_exchange<S: Readable>(
+        &self,
+        slots: &mut [Slot<S>],
+        values: &mut Values,
+    ) -> Result<()>;
 
     /// Sets inputs, applies the step's events, steps the instances due at k, and publishes
     /// their outputs into `values`.

@@ -36,8 +36,7 @@ pub trait Kind {
     fn values_mut(v: &mut Values) -> &mut [Self::Value];
     fn map(value: Self::Value, map: Self::Map) -> Self::Value;
     fn set<S>(inst: &mut Instance<S>, vrs: &[VR], values: &[Self::Value]) -> Result<()>;
-    fn get<S: Readable>(inst: &mut Instance<S>, vrs: &[VR], out: &mut [Self::Value])
-        -> Result<()>;
+    fn get<S: Readable>(inst: &mut Instance<S>, vrs: &[VR], out: &mut [Self::Value]) -> Result<()>;
 }
 
 /// `fmi2Real`.
@@ -180,7 +179,11 @@ impl<K: Kind> Port<K> {
         if n == 0 {
             return Ok(());
         }
-        K::get(inst, &self.output_vrs, &mut K::values_mut(values)[self.at..self.at + n])
+        K::get(
+            inst,
+            &self.output_vrs,
+            &mut K::values_mut(values)[self.at..self.at + n],
+        )
     }
 }
 
@@ -203,7 +206,11 @@ impl Ports {
 
     /// Reads the instance's observed variables into `values` (Real, then Integer, then Boolean).
     #[inline]
-    pub fn get_outputs<S: Readable>(&self, inst: &mut Instance<S>, values: &mut Values) -> Result<()> {
+    pub fn get_outputs<S: Readable>(
+        &self,
+        inst: &mut Instance<S>,
+        values: &mut Values,
+    ) -> Result<()> {
         self.real.get_outputs(inst, values)?;
         self.integer.get_outputs(inst, values)?;
         self.boolean.get_outputs(inst, values)

@@ -39,7 +39,9 @@ pub fn initialize<A: Algorithm>(
             inst,
             ports,
             step_multiple: pi.step_multiple as u64,
-            var_step: fmu.co_simulation().can_handle_variable_communication_step_size,
+            var_step: fmu
+                .co_simulation()
+                .can_handle_variable_communication_step_size,
         });
     }
     let mut initializing = Vec::with_capacity(instantiated.len());
@@ -65,8 +67,16 @@ pub fn initialize<A: Algorithm>(
 
 /// The instance's start values of one phase: before initialization (settable in
 /// "Instantiated") or during it.
-fn apply_start_values<S>(inst: &mut Instance<S>, pi: &PlanInstance, before_init: bool) -> Result<()> {
-    for sv in pi.start_values.iter().filter(|s| s.before_init == before_init) {
+fn apply_start_values<S>(
+    inst: &mut Instance<S>,
+    pi: &PlanInstance,
+    before_init: bool,
+) -> Result<()> {
+    for sv in pi
+        .start_values
+        .iter()
+        .filter(|s| s.before_init == before_init)
+    {
         set_value(inst, sv.vr, &sv.value).map_err(|e| ctx_err(e, &pi.name, &sv.variable))?;
     }
     Ok(())

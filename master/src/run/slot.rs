@@ -84,7 +84,13 @@ impl Slot<Stepping> {
     /// `fmi2DoStep` from t_k = `t` over the slot's step (the last step may be shortened or
     /// dropped, [`TimeGrid::step_size`]); an early end by the FMU is noted in `count`.
     #[inline]
-    pub fn do_step(&mut self, k: u64, t: f64, grid: &TimeGrid, count: &mut StepCount) -> Result<()> {
+    pub fn do_step(
+        &mut self,
+        k: u64,
+        t: f64,
+        grid: &TimeGrid,
+        count: &mut StepCount,
+    ) -> Result<()> {
         let Some(h) = grid.step_size(k, self.step_multiple, grid.n_steps(), self.var_step) else {
             return Ok(());
         };

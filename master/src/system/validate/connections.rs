@@ -93,8 +93,13 @@ impl<'a> Checker<'a> {
             ok = false;
         }
         if tsv.causality != Causality::Input {
-            let e = self.err(line, format!(
-                "connection {name}: causality mismatch: target '{}' is {}, it must be an input", c.spec.to, tsv.causality));
+            let e = self.err(
+                line,
+                format!(
+                    "connection {name}: causality mismatch: target '{}' is {}, it must be an input",
+                    c.spec.to, tsv.causality
+                ),
+            );
             self.errors.push(e);
             ok = false;
         }
@@ -122,7 +127,13 @@ impl<'a> Checker<'a> {
             ));
         }
         if ft != VarType::Real && (spec.gain != 1.0 || spec.offset != 0.0) {
-            errors.push(self.err(line, format!("connection {name}: gain/offset apply only to Real variables ('{}' is {ft})", spec.from)));
+            errors.push(self.err(
+                line,
+                format!(
+                    "connection {name}: gain/offset apply only to Real variables ('{}' is {ft})",
+                    spec.from
+                ),
+            ));
         }
         if c.to.0 == c.from.0 {
             self.warnings.push(format!(

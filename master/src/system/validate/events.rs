@@ -47,9 +47,12 @@ impl Checker<'_> {
         let kf = (e.time - sys.start_time) / sys.step_size;
         let k = kf.round();
         if !(k >= 0.0) || (kf - k).abs() > 1e-6 || k as u64 >= grid.n_steps {
-            let err = self.err(e.line, format!(
+            let err = self.err(
+                e.line,
+                format!(
                 "event at t = {} for '{}': the time must be a base-step point t0 + k*h in [{}, {})",
-                e.time, e.target, sys.start_time, grid.stop_on_grid));
+                e.time, e.target, sys.start_time, grid.stop_on_grid),
+            );
             self.errors.push(err);
             return None;
         }

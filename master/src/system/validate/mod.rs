@@ -124,7 +124,10 @@ impl<'a> Checker<'a> {
         if !(sys.step_size > 0.0 && sys.step_size.is_finite()) {
             let e = self.err(
                 None,
-                format!("step_size = {}; it must be a positive number", sys.step_size),
+                format!(
+                    "step_size = {}; it must be a positive number",
+                    sys.step_size
+                ),
             );
             self.errors.push(e);
         }

@@ -55,10 +55,7 @@ impl Checker<'_> {
 
 /// Finds a cycle of direct feed-through: connection a.y -> b.u, and within b an output that
 /// depends on u (ModelStructure), and so on back to a. Returns it as text.
-fn find_algebraic_loop(
-    conns: &[PlanConnection],
-    mds: &[&ModelDescription],
-) -> Option<String> {
+fn find_algebraic_loop(conns: &[PlanConnection], mds: &[&ModelDescription]) -> Option<String> {
     // Graph over connections: edge c1 -> c2 if c2 leaves the instance c1 enters, and c2's source
     // output depends on c1's target input.
     let vr_index = |i: usize, vr: VR, input: bool| -> Option<usize> {

@@ -2,9 +2,9 @@
 //! instance checked against what FMI 2.0 lets a master set before and during initialization.
 
 use super::Checker;
+use crate::error::did_you_mean;
 use crate::model_description::VarType;
 use crate::system::{InstanceSpec, StartValue, TypedValue, Value};
-use crate::error::did_you_mean;
 
 /// A written value as a value of FMI type `t`, or why it does not fit.
 pub(super) fn convert(value: &Value, t: VarType) -> std::result::Result<TypedValue, String> {

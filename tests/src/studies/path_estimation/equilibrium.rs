@@ -95,11 +95,17 @@ mod tests {
         }
         v[7] = x[3];
         let residual = (a * v - b).amax();
-        assert!(residual < 1e-15 * b.amax().max(1.0), "residual {residual:e}");
+        assert!(
+            residual < 1e-15 * b.amax().max(1.0),
+            "residual {residual:e}"
+        );
         assert!((x[3] / 3.8877e-5 - 1.0).abs() < 1e-4, "eta' = {}", x[3]);
         assert!((xhat[3] / x[3] - 1.0).abs() < 1e-9);
         // the plant: ψ′ = β′ = −0.1428, δ′ = 0.1310 as printed (δ′ is 0.13093: within one unit
         // of the last printed digit)
-        assert!((x[0] + 0.1428).abs() < 5e-5 && (x[4] - 0.1310).abs() < 1e-4, "{x:?}");
+        assert!(
+            (x[0] + 0.1428).abs() < 5e-5 && (x[4] - 0.1310).abs() < 1e-4,
+            "{x:?}"
+        );
     }
 }
