@@ -116,7 +116,7 @@ fn test(extra: &[String]) -> Result<()> {
         "xtask",
         "--bins",
     ]))?;
-    lint_master(&root)?;
+    lint(&root)?;
     eprintln!("xtask: Rust tests (release, sharing the FMU build)");
     run(cargo()
         .current_dir(&root)
@@ -139,13 +139,23 @@ fn test(extra: &[String]) -> Result<()> {
     Ok(())
 }
 
-/// The master's function-length rule: no function in `master/src` over 100 lines
-/// (`master/clippy.toml`), so that each concern stays readable in one screen.
-fn lint_master(root: &Path) -> Result<()> {
-    let clippy = cargo().arg("clippy").arg("--version").output();
-    if !clippy.map(|o| o.status.success()).unwrap_or(false) {
-        bail!("cargo clippy is not installed; install it with `rustup component add clippy`");
+/// Formatting (rustfmt, whole workspace) and the master's function-length rule: no function in
+/// `master/src` over 100 lines (`master/clippy.toml`), so that each concern stays readable in
+/// one screen.
+fn lint(root: &Path) -> Result<()> {
+    for (tool, component) in [("fmt", "rustfmt"), ("clippy", "clippy")] {
+        let found = cargo().args([tool, "--version"]).output();
+        if !found.map(|o| o.status.success()).unwrap_or(false) {
+            bail!(
+                "cargo {tool} is not installed; install it with `rustup component add {component}`"
+            );
+        }
     }
+    eprintln!("xtask: rustfmt check of the workspace");
+    run(cargo()
+        .current_dir(root)
+        .args(["fmt", "--all", "--", "--check"]))
+    .context("code is not formatted: run `cargo fmt --all`")?;
     eprintln!("xtask: clippy too_many_lines (100) on master/src");
     run(cargo().current_dir(root).args([
         "clippy",

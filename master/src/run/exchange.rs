@@ -122,16 +122,21 @@ struct Link<K: Kind> {
     map: K::Map,
 }
 
+/// Observed variables of one instance and type (connection sources and recorded outputs), in
+/// the order of the batched fmi2GetXxx, stored at `Values[at..at + vrs.len()]`.
+#[derive(Default)]
+struct Observed {
+    vrs: Vec<VR>,
+    at: usize,
+}
+
 /// An instance's connected inputs and observed variables of one FMI type.
 pub struct Port<K: Kind> {
     /// Connected inputs, in the order of the batched fmi2SetXxx.
     input_vrs: Vec<VR>,
     links: Vec<Link<K>>,
     scratch: Vec<K::Value>,
-    /// Observed variables (connection sources and recorded outputs), in the order of the
-    /// batched fmi2GetXxx, stored at `Values[at..at + n]`.
-    output_vrs: Vec<VR>,
-    at: usize,
+    observed: Observed,
 }
 
 impl<K: Kind> Default for Port<K> {
@@ -140,8 +145,7 @@ impl<K: Kind> Default for Port<K> {
             input_vrs: Vec::new(),
             links: Vec::new(),
             scratch: Vec::new(),
-            output_vrs: Vec::new(),
-            at: 0,
+            observed: Observed::default(),
         }
     }
 }
@@ -151,14 +155,6 @@ impl<K: Kind> Port<K> {
         self.input_vrs.push(vr);
         self.links.push(Link { source, map });
         self.scratch.push(K::Value::default());
-    }
-
-    /// The local index of observed variable `vr`, registering it on first use.
-    fn observe(&mut self, vr: VR, known: &mut HashMap<VR, usize>) -> usize {
-        *known.entry(vr).or_insert_with(|| {
-            self.output_vrs.push(vr);
-            self.output_vrs.len() - 1
-        })
     }
 
     #[inline]
@@ -175,15 +171,11 @@ impl<K: Kind> Port<K> {
 
     #[inline]
     fn get_outputs<S: Readable>(&self, inst: &mut Instance<S>, values: &mut Values) -> Result<()> {
-        let n = self.output_vrs.len();
-        if n == 0 {
+        let Observed { vrs, at } = &self.observed;
+        if vrs.is_empty() {
             return Ok(());
         }
-        K::get(
-            inst,
-            &self.output_vrs,
-            &mut K::values_mut(values)[self.at..self.at + n],
-        )
+        K::get(inst, vrs, &mut K::values_mut(values)[*at..*at + vrs.len()])
     }
 }
 
@@ -215,6 +207,15 @@ impl Ports {
         self.integer.get_outputs(inst, values)?;
         self.boolean.get_outputs(inst, values)
     }
+
+    /// The observed variables of exchange type `t` (Real, Integer or Boolean).
+    fn observed_mut(&mut self, t: VarType) -> &mut Observed {
+        match t {
+            VarType::Real => &mut self.real.observed,
+            VarType::Boolean => &mut self.boolean.observed,
+            _ => &mut self.integer.observed,
+        }
+    }
 }
 
 /// Where a recorded column lives in [`Values`].
@@ -234,8 +235,8 @@ pub struct Exchange {
     pub columns: Vec<Column>,
 }
 
-/// The local index of each observed variable, per instance and type.
-type Observed = HashMap<(usize, VarType), HashMap<VR, usize>>;
+/// The exchange types, in the order of the batched calls and of [`Values`].
+const KINDS: [VarType; 3] = [VarType::Real, VarType::Integer, VarType::Boolean];
 
 /// The exchange's type of a plan variable type (Enumeration is already Integer in a plan).
 fn kind_of(t: VarType) -> VarType {
@@ -250,31 +251,44 @@ impl Exchange {
     pub fn build(plan: &Plan) -> Exchange {
         let n = plan.instances.len();
         let mut ports: Vec<Ports> = (0..n).map(|_| Ports::default()).collect();
-        let mut observed = Observed::new();
+        // (instance, type, vr) -> index among the instance's observed variables of that type
+        let mut local: HashMap<(usize, VarType, VR), usize> = HashMap::new();
         let sources = plan
             .connections
             .iter()
             .map(|c| (c.from_instance, c.var_type, c.from_vr));
         let recorded = plan.outputs.iter().map(|o| (o.instance, o.var_type, o.vr));
         for (i, t, vr) in sources.chain(recorded) {
-            let known = observed.entry((i, kind_of(t))).or_default();
-            match kind_of(t) {
-                VarType::Real => ports[i].real.observe(vr, known),
-                VarType::Boolean => ports[i].boolean.observe(vr, known),
-                _ => ports[i].integer.observe(vr, known),
-            };
+            let t = kind_of(t);
+            local.entry((i, t, vr)).or_insert_with(|| {
+                let observed = ports[i].observed_mut(t);
+                observed.vrs.push(vr);
+                observed.vrs.len() - 1
+            });
         }
         let values = place_outputs(&mut ports);
-        let global = |ports: &[Ports], i: usize, t: VarType, vr: VR| -> usize {
-            let local = observed[&(i, kind_of(t))][&vr];
-            match kind_of(t) {
-                VarType::Real => ports[i].real.at + local,
-                VarType::Boolean => ports[i].boolean.at + local,
-                _ => ports[i].integer.at + local,
-            }
+        let mut global = |i: usize, t: VarType, vr: VR| -> usize {
+            let t = kind_of(t);
+            ports[i].observed_mut(t).at + local[&(i, t, vr)]
         };
-        for c in &plan.connections {
-            let g = global(&ports, c.from_instance, c.var_type, c.from_vr);
+        let links: Vec<usize> = plan
+            .connections
+            .iter()
+            .map(|c| global(c.from_instance, c.var_type, c.from_vr))
+            .collect();
+        let columns = plan
+            .outputs
+            .iter()
+            .map(|o| {
+                let g = global(o.instance, o.var_type, o.vr);
+                match kind_of(o.var_type) {
+                    VarType::Real => Column::Real(g),
+                    VarType::Boolean => Column::Boolean(g),
+                    _ => Column::Integer(g),
+                }
+            })
+            .collect();
+        for (c, g) in plan.connections.iter().zip(links) {
             let p = &mut ports[c.to_instance];
             match kind_of(c.var_type) {
                 VarType::Real => p.real.connect(
@@ -289,18 +303,6 @@ impl Exchange {
                 _ => p.integer.connect(c.to_vr, g, ()),
             }
         }
-        let columns = plan
-            .outputs
-            .iter()
-            .map(|o| {
-                let g = global(&ports, o.instance, o.var_type, o.vr);
-                match kind_of(o.var_type) {
-                    VarType::Real => Column::Real(g),
-                    VarType::Boolean => Column::Boolean(g),
-                    _ => Column::Integer(g),
-                }
-            })
-            .collect();
         Exchange {
             ports,
             values,
@@ -311,18 +313,17 @@ impl Exchange {
 
 /// Lays the observed variables out instance after instance; returns the zeroed shared values.
 fn place_outputs(ports: &mut [Ports]) -> Values {
-    let (mut nr, mut ni, mut nb) = (0, 0, 0);
+    let mut len = [0usize; 3];
     for p in ports.iter_mut() {
-        p.real.at = nr;
-        nr += p.real.output_vrs.len();
-        p.integer.at = ni;
-        ni += p.integer.output_vrs.len();
-        p.boolean.at = nb;
-        nb += p.boolean.output_vrs.len();
+        for (n, t) in len.iter_mut().zip(KINDS) {
+            let observed = p.observed_mut(t);
+            observed.at = *n;
+            *n += observed.vrs.len();
+        }
     }
     Values {
-        real: vec![0.0; nr],
-        integer: vec![0; ni],
-        boolean: vec![0; nb],
+        real: vec![0.0; len[0]],
+        integer: vec![0; len[1]],
+        boolean: vec![0; len[2]],
     }
 }

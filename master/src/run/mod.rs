@@ -200,7 +200,9 @@ pub fn run_with(
 /// The rows a run records if it runs to its end: t_0, every `decimation` steps, and t_n.
 fn expected_rows(plan: &Plan) -> u64 {
     let dec = plan.decimation as u64;
-    1 + plan.n_steps / dec + u64::from(plan.n_steps % dec != 0)
+    (plan.n_steps / dec)
+        .saturating_add(1)
+        .saturating_add(u64::from(plan.n_steps % dec != 0))
 }
 
 fn execute<A: Algorithm>(

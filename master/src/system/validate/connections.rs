@@ -6,14 +6,16 @@ use super::Checker;
 use crate::error::Error;
 use crate::model_description::{Causality, ModelDescription, ScalarVariable, VarType};
 use crate::system::{ConnectionSpec, PlanConnection};
+use std::borrow::Cow;
 use std::collections::HashMap;
 
 /// Inputs driven by a connection: (instance, variable index) -> (connection name, line).
 pub(super) type Driven = HashMap<(usize, usize), (String, Option<usize>)>;
 
 /// A connection with both ends resolved, in output -> input direction.
-struct Ends {
-    spec: ConnectionSpec,
+struct Ends<'c> {
+    /// As written, or turned around (an owned copy) for an input-first OSP VariableConnection.
+    spec: Cow<'c, ConnectionSpec>,
     /// "from -> to" as written (after an OSP VariableConnection is turned around).
     name: String,
     from: (usize, usize),
@@ -52,7 +54,7 @@ impl<'a> Checker<'a> {
     }
 
     /// Resolves both ends; an OSP VariableConnection written input-first is turned around.
-    fn resolve_ends(&mut self, c: &ConnectionSpec) -> Option<Ends> {
+    fn resolve_ends<'c>(&mut self, c: &'c ConnectionSpec) -> Option<Ends<'c>> {
         let from = self.resolve(&c.from, c.line, "connection source");
         let from = from.map_err(|e| self.errors.push(e)).ok()?;
         let to = self.resolve(&c.to, c.line, "connection target");
@@ -66,9 +68,9 @@ impl<'a> Checker<'a> {
                 to: c.from.clone(),
                 ..c.clone()
             };
-            (swapped, to, from)
+            (Cow::Owned(swapped), to, from)
         } else {
-            (c.clone(), from, to)
+            (Cow::Borrowed(c), from, to)
         };
         Some(Ends {
             name: format!("{} -> {}", spec.from, spec.to),
