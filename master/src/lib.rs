@@ -25,6 +25,7 @@
 // `!(x > 0.0)` is the check that also rejects NaN, which `x <= 0.0` would let through.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+pub mod campaign;
 pub mod error;
 pub mod fmu;
 pub mod format;
