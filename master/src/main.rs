@@ -1,4 +1,6 @@
-//! The `shipsim` command line: `run`, `check`, `inspect`, `export-osp`, `plot`.
+//! The `shipsim` command line: `run`, `check`, `inspect`, `export-osp`, `plot`, `campaign`.
+mod cli;
+
 use clap::{Parser, Subcommand};
 use shipsim::error::Error;
 use shipsim::fmu::UnpackedFmu;
@@ -75,6 +77,11 @@ enum Command {
         #[arg(long, short)]
         output: PathBuf,
     },
+    /// Campaigns: many runs over factors, seeds and arms, one KPI row per run.
+    Campaign {
+        #[command(subcommand)]
+        command: cli::campaign::CampaignCommand,
+    },
     /// Write an OSP OspSystemStructure.xml for a native system file (runs in libcosim).
     ExportOsp {
         system: PathBuf,
@@ -88,6 +95,10 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     match dispatch(cli.command) {
         Ok(()) => ExitCode::SUCCESS,
+        Err(Error::Interrupted { time }) if time.is_nan() => {
+            eprintln!("interrupted; finished runs are kept, run the same command again to resume");
+            ExitCode::from(130)
+        }
         Err(Error::Interrupted { time }) => {
             eprintln!(
                 "interrupted at t = {time} s; instances terminated and freed, output flushed"
@@ -135,7 +146,20 @@ fn dispatch(cmd: Command) -> shipsim::Result<()> {
             run_cli(&sys, output, verbose, quiet)
         }
         Command::ExportOsp { system, output } => export_osp(&system, output),
+        Command::Campaign { command } => cli::campaign::dispatch(command, ctrl_c_flag),
     }
+}
+
+/// A flag that the first Ctrl-C sets (to stop cleanly); a second one exits at once.
+fn ctrl_c_flag() -> Arc<AtomicBool> {
+    let flag = Arc::new(AtomicBool::new(false));
+    let f = flag.clone();
+    let _ = ctrlc::set_handler(move || {
+        if f.swap(true, Ordering::SeqCst) {
+            std::process::exit(130);
+        }
+    });
+    flag
 }
 
 /// `shipsim plot`: one panel per --panel, columns against time.
