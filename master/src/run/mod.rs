@@ -408,8 +408,12 @@ fn execute<A: Algorithm>(
         cp.restore(&mut slots, &mut values)?;
     }
     let grid = TimeGrid::new(plan.start_time, plan.step_size, plan.n_steps);
+    let start_time = match first {
+        0 => plan.start_time,
+        k => grid.at(k),
+    };
     if let Some(r) = recording.as_mut() {
-        r.row(grid.at(first), &values)?;
+        r.row(start_time, &values)?;
     }
     let mut stepper = Stepper {
         grid,
@@ -450,7 +454,7 @@ fn execute<A: Algorithm>(
     let summary = Summary {
         macro_steps: end.steps - first,
         fmu_steps: end.count.fmu_steps,
-        start_time: grid.at(first),
+        start_time,
         end_time: grid.at(end.steps),
         wall_time: end.wall,
         total_wall_time: begin.elapsed(),

@@ -235,7 +235,10 @@ impl Checkpoint {
             return Err(r.err("corrupt: the checksum does not match the contents".into()));
         }
         if r.pos != bytes.len() {
-            return Err(r.err(format!("{} bytes after the checksum", bytes.len() - r.pos)));
+            return Err(r.err(format!(
+                "{} byte(s) after the checksum",
+                bytes.len() - r.pos
+            )));
         }
         Ok(Checkpoint {
             step,
