@@ -2,4 +2,5 @@
 //!
 //! - [`table`]: the run table (typed columns) and its files (CSV, Parquet).
 
+pub mod plot;
 pub mod table;
