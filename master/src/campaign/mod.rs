@@ -23,6 +23,7 @@ pub mod kpi;
 pub mod manoeuvre;
 pub mod merge;
 pub mod output;
+pub mod plot;
 pub mod spec;
 pub mod table;
 
