@@ -80,11 +80,14 @@ impl DerivedKpi {
                     let arm = match (arm, arms.is_empty()) {
                         (None, true) => 0,
                         (None, false) => {
-                            return Err(err(format!("write {kpi}[arm] with one of the arms {arms:?}")))
+                            return Err(err(format!(
+                                "write {kpi}[arm] with one of the arms {arms:?}"
+                            )))
                         }
-                        (Some(a), _) => arms.iter().position(|x| *x == a).ok_or_else(|| {
-                            err(format!("no arm '{a}' (arms: {arms:?})"))
-                        })?,
+                        (Some(a), _) => arms
+                            .iter()
+                            .position(|x| *x == a)
+                            .ok_or_else(|| err(format!("no arm '{a}' (arms: {arms:?})")))?,
                     };
                     inputs.push((col, arm));
                 }

@@ -211,7 +211,10 @@ pub fn runs(spec: &CampaignSpec, base_hash: &str) -> Result<Vec<Run>> {
         .and_then(|n| n.checked_mul(arms))
         .filter(|n| *n <= 100_000_000)
         .ok_or_else(|| {
-            Error::Other(format!("campaign {}: more than 10^8 runs", spec.source.display()))
+            Error::Other(format!(
+                "campaign {}: more than 10^8 runs",
+                spec.source.display()
+            ))
         })?;
     let mut out = Vec::with_capacity(total);
     for (point, values) in points.iter().enumerate() {
@@ -245,6 +248,16 @@ pub fn runs(spec: &CampaignSpec, base_hash: &str) -> Result<Vec<Run>> {
                     key,
                 });
             }
+        }
+    }
+    let mut seen = std::collections::HashMap::new();
+    for r in &out {
+        if let Some(first) = seen.insert(&r.key, r.index) {
+            return Err(Error::Other(format!(
+                "campaign {}: runs {first} and {} set the same values (identical factor values or arms?)",
+                spec.source.display(),
+                r.index
+            )));
         }
     }
     Ok(out)
@@ -287,7 +300,10 @@ fn canonical(v: &Value) -> String {
         Value::Text(t) => match t.as_str() {
             "true" => "1".into(),
             "false" => "0".into(),
-            t => t.parse::<f64>().map(number).unwrap_or_else(|_| format!("{t:?}")),
+            t => t
+                .parse::<f64>()
+                .map(number)
+                .unwrap_or_else(|_| format!("{t:?}")),
         },
     }
 }

@@ -116,7 +116,10 @@ impl std::fmt::Display for CampaignOutcome {
             write!(f, "\nwarm-up groups: {} ({lo}..={hi} runs each)", g.len())?;
         }
         if self.interrupted {
-            write!(f, "\ninterrupted: the runs in flight were not recorded and will run again")?;
+            write!(
+                f,
+                "\ninterrupted: the runs in flight were not recorded and will run again"
+            )?;
         }
         for p in &self.files {
             write!(f, "\nwrote {}", p.display())?;
@@ -387,10 +390,9 @@ pub fn run(campaign: &Campaign, opts: &CampaignOptions) -> Result<CampaignOutcom
         campaign,
         fmus: fmus.clone(),
         run_opts: RunOptions {
-            verbose: false,
-            progress: false,
             interrupt: opts.interrupt.clone(),
             log_sink: opts.log_sink.clone(),
+            ..Default::default()
         },
         journal: Mutex::new(journal),
         progress: opts.progress.then(|| progress_bar(todo.len())),
@@ -419,7 +421,9 @@ pub fn run(campaign: &Campaign, opts: &CampaignOptions) -> Result<CampaignOutcom
         Some(fork) => {
             let groups = fork.groups_of(&todo);
             outcome.groups = Some(groups.iter().map(Vec::len).collect());
-            groups.par_iter().for_each(|g| keep(fork.run_group(&ctx, g)));
+            groups
+                .par_iter()
+                .for_each(|g| keep(fork.run_group(&ctx, g)));
         }
     });
     if let Some(p) = &ctx.progress {
@@ -516,12 +520,8 @@ impl Fork {
         }
         let warm_up = |system: &System| -> Result<(Plan, run::Checkpoint)> {
             let plan = system.validate(&ctx.mds())?;
-            let k = plan.step_at(self.at).filter(|k| *k < plan.n_steps).ok_or_else(|| {
-                Error::Other(format!(
-                    "fork_at = {} s is not a communication point before the end of the run",
-                    self.at
-                ))
-            })?;
+            let k = run::checkpoint_step(&plan, self.at)
+                .map_err(|e| Error::Other(format!("fork_at: {e}")))?;
             let cp = run::run_to_checkpoint(&plan, &ctx.fmus, k, None, &ctx.run_opts)?;
             Ok((plan, cp))
         };
@@ -540,7 +540,14 @@ impl Fork {
                     let kpis = (missing_values(&ctx.campaign.spec.kpis), 0.0);
                     let status = Status::Error;
                     let message = message.clone();
-                    ctx.finish(r, Outcome::Done { status, message, kpis })?;
+                    ctx.finish(
+                        r,
+                        Outcome::Done {
+                            status,
+                            message,
+                            kpis,
+                        },
+                    )?;
                 }
                 return Ok(());
             }

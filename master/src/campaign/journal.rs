@@ -122,9 +122,8 @@ impl Journal {
             if line.is_empty() {
                 continue;
             }
-            let r: RunRecord = serde_json::from_slice(line).map_err(|e| {
-                Error::system(&path, Some(n + 1), format!("not a run record: {e}"))
-            })?;
+            let r: RunRecord = serde_json::from_slice(line)
+                .map_err(|e| Error::system(&path, Some(n + 1), format!("not a run record: {e}")))?;
             records.insert(r.key.clone(), r);
         }
         Ok(Journal {

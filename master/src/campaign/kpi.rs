@@ -239,10 +239,7 @@ impl StatAccumulator {
 
 /// One KPI's accumulator, bound to recorded columns.
 enum Accumulator {
-    Stat {
-        column: usize,
-        acc: StatAccumulator,
-    },
+    Stat { column: usize, acc: StatAccumulator },
     Manoeuvre(super::manoeuvre::ManoeuvreKpi),
 }
 

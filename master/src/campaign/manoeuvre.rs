@@ -3,7 +3,8 @@
 
 use super::kpi::{KpiSpec, KpiValue, Manoeuvre};
 use crate::run::Row;
-use models::manoeuvre::{Sample, TurningCircleTracker, ZigZagTracker};
+use models::hull::DEG;
+use models::manoeuvre::{imo, Sample, TurningCircleTracker, ZigZagMetrics, ZigZagTracker};
 
 enum Tracker {
     Turning(TurningCircleTracker),
@@ -44,7 +45,11 @@ impl ManoeuvreKpi {
                 speed,
                 ..
             } => (
-                Tracker::ZigZag(ZigZagTracker::new(*execute_time, *rudder_sign, *check_angle)),
+                Tracker::ZigZag(ZigZagTracker::new(
+                    *execute_time,
+                    *rudder_sign,
+                    *check_angle,
+                )),
                 *speed,
                 *check_angle,
             ),
@@ -91,29 +96,38 @@ impl ManoeuvreKpi {
         match &self.tracker {
             Tracker::Turning(tr) => match tr.finish() {
                 Ok(m) => {
-                    let check = models::manoeuvre::check_turning(&m, self.length);
+                    let pass = imo::check_turning(&m, self.length).ok().map(|c| c.pass);
                     out.extend([
                         n(m.advance),
                         n(m.transfer),
                         n(m.tactical_diameter),
-                        verdict(Some(check.pass)),
+                        verdict(pass),
                     ]);
                 }
                 Err(_) => out.extend([n(f64::NAN), n(f64::NAN), n(f64::NAN), verdict(None)]),
             },
             Tracker::ZigZag(tr) => match tr.finish() {
                 Ok(m) => {
-                    let pass = models::manoeuvre::check_zigzag(
-                        &m,
-                        self.check_angle,
-                        self.length,
-                        self.speed,
-                    )
-                    .map(|c| c.pass);
+                    let pass = self.zigzag_pass(&m);
                     out.extend([n(m.first_overshoot), n(m.second_overshoot), verdict(pass)]);
                 }
                 Err(_) => out.extend([n(f64::NAN), n(f64::NAN), verdict(None)]),
             },
+        }
+    }
+
+    /// The IMO yaw-checking verdict: the 10°/10° limits (by L/U) for a 10° check angle, the
+    /// 20°/20° limit for 20°, none for other tests.
+    fn zigzag_pass(&self, m: &ZigZagMetrics) -> Option<bool> {
+        let is = |deg: f64| (self.check_angle - deg * DEG).abs() < 1e-9;
+        if is(10.0) {
+            imo::check_zigzag_10_10(m, self.length, self.speed)
+                .ok()
+                .map(|c| c.pass)
+        } else if is(20.0) {
+            Some(imo::check_zigzag_20_20(m).pass)
+        } else {
+            None
         }
     }
 }

@@ -31,7 +31,12 @@ impl std::fmt::Display for MergeReport {
             self.found, self.total, self.duplicates
         )?;
         if !self.missing.is_empty() {
-            let shown: Vec<String> = self.missing.iter().take(20).map(|i| i.to_string()).collect();
+            let shown: Vec<String> = self
+                .missing
+                .iter()
+                .take(20)
+                .map(|i| i.to_string())
+                .collect();
             write!(
                 f,
                 "\nmissing {} run(s): {}{}",
@@ -50,7 +55,9 @@ impl std::fmt::Display for MergeReport {
 /// Merges the output folders `inputs` of one campaign into `out`.
 pub fn merge(inputs: &[PathBuf], out: &Path) -> Result<MergeReport> {
     let Some(first) = inputs.first() else {
-        return Err(Error::Other("campaign merge: give the output folders to merge".into()));
+        return Err(Error::Other(
+            "campaign merge: give the output folders to merge".into(),
+        ));
     };
     let prov = Provenance::read(first)?;
     let mut records: HashMap<String, RunRecord> = HashMap::new();

@@ -44,8 +44,8 @@ pub struct Campaign {
 
 /// SHA-256 of a file's bytes, hex.
 pub fn file_hash(path: &Path) -> Result<String> {
-    let bytes = std::fs::read(path)
-        .map_err(|e| Error::io(format!("cannot read {}", path.display()), e))?;
+    let bytes =
+        std::fs::read(path).map_err(|e| Error::io(format!("cannot read {}", path.display()), e))?;
     Ok(design::hex(&Sha256::digest(&bytes)))
 }
 
@@ -57,7 +57,10 @@ impl Campaign {
 
     pub fn from_spec(spec: CampaignSpec) -> Result<Campaign> {
         let mut system = System::load(&spec.system).map_err(|e| {
-            Error::Other(format!("campaign {}: base system: {e}", spec.source.display()))
+            Error::Other(format!(
+                "campaign {}: base system: {e}",
+                spec.source.display()
+            ))
         })?;
         if let Some(t) = spec.stop_time {
             system.stop_time = Some(t);
@@ -174,7 +177,10 @@ fn set_start_values(system: &mut System, sets: &[(String, Value)]) -> Result<()>
         let r = VarRef::parse(v)
             .ok_or_else(|| Error::Other(format!("'{v}' is not instance.variable")))?;
         system.set_value(r, value.clone()).map_err(|e| {
-            Error::Other(format!("campaign sets '{v}' in {}: {e}", system.source.display()))
+            Error::Other(format!(
+                "campaign sets '{v}' in {}: {e}",
+                system.source.display()
+            ))
         })?;
     }
     Ok(())

@@ -60,8 +60,13 @@ impl Provenance {
         let path = dir.join("campaign.json");
         let text = std::fs::read_to_string(&path)
             .map_err(|e| Error::io(format!("cannot read {}", path.display()), e))?;
-        serde_json::from_str(&text)
-            .map_err(|e| Error::system(&path, Some(e.line()), format!("not a campaign sidecar: {e}")))
+        serde_json::from_str(&text).map_err(|e| {
+            Error::system(
+                &path,
+                Some(e.line()),
+                format!("not a campaign sidecar: {e}"),
+            )
+        })
     }
 }
 
@@ -144,10 +149,16 @@ pub fn run_table(spec: &CampaignSpec, finished: &[(&Run, &RunRecord)]) -> Table 
         t.push("arm", ColumnData::Text(arm));
     }
     for (j, f) in spec.factors.iter().enumerate() {
-        t.push(&f.name, ColumnData::Float(runs.iter().map(|r| r.factors[j]).collect()));
+        t.push(
+            &f.name,
+            ColumnData::Float(runs.iter().map(|r| r.factors[j]).collect()),
+        );
     }
     for (j, s) in spec.replications.seeds.iter().enumerate() {
-        t.push(s, ColumnData::Int(runs.iter().map(|r| r.seeds[j]).collect()));
+        t.push(
+            s,
+            ColumnData::Int(runs.iter().map(|r| r.seeds[j]).collect()),
+        );
     }
     let mut j = 0;
     for k in &spec.kpis {
@@ -161,10 +172,14 @@ pub fn run_table(spec: &CampaignSpec, finished: &[(&Run, &RunRecord)]) -> Table 
             j += 1;
         }
     }
-    let text = |f: &dyn Fn(&RunRecord) -> String| ColumnData::Text(done.iter().map(|r| f(r)).collect());
+    let text =
+        |f: &dyn Fn(&RunRecord) -> String| ColumnData::Text(done.iter().map(|r| f(r)).collect());
     t.push("status", text(&|r| r.status.name().to_string()));
     t.push("message", text(&|r| r.message.clone()));
-    t.push("wall_time", ColumnData::Float(done.iter().map(|r| r.wall_time).collect()));
+    t.push(
+        "wall_time",
+        ColumnData::Float(done.iter().map(|r| r.wall_time).collect()),
+    );
     t.push("key", text(&|r| r.key.clone()));
     t
 }
@@ -198,13 +213,25 @@ pub fn derived_table(
     }
     let rows: Vec<&Cell> = cells.values().collect();
     let mut t = Table::default();
-    t.push("point", ColumnData::Int(rows.iter().map(|c| c.0.point as i64).collect()));
-    t.push("replication", ColumnData::Int(rows.iter().map(|c| c.0.replication as i64).collect()));
+    t.push(
+        "point",
+        ColumnData::Int(rows.iter().map(|c| c.0.point as i64).collect()),
+    );
+    t.push(
+        "replication",
+        ColumnData::Int(rows.iter().map(|c| c.0.replication as i64).collect()),
+    );
     for (j, f) in spec.factors.iter().enumerate() {
-        t.push(&f.name, ColumnData::Float(rows.iter().map(|c| c.0.factors[j]).collect()));
+        t.push(
+            &f.name,
+            ColumnData::Float(rows.iter().map(|c| c.0.factors[j]).collect()),
+        );
     }
     for (j, s) in spec.replications.seeds.iter().enumerate() {
-        t.push(s, ColumnData::Int(rows.iter().map(|c| c.0.seeds[j]).collect()));
+        t.push(
+            s,
+            ColumnData::Int(rows.iter().map(|c| c.0.seeds[j]).collect()),
+        );
     }
     // values[row][arm][kpi column]
     let n_kpis = kpi_columns(spec).len();
@@ -220,7 +247,10 @@ pub fn derived_table(
         })
         .collect();
     for d in &kpis {
-        t.push(&d.name, ColumnData::Float(values.iter().map(|v| d.eval(v)).collect()));
+        t.push(
+            &d.name,
+            ColumnData::Float(values.iter().map(|v| d.eval(v)).collect()),
+        );
     }
     let status = rows
         .iter()

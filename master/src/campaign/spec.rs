@@ -384,7 +384,10 @@ impl Reader<'_> {
             }
             match value(v) {
                 Some(v) => out.push((k.clone(), v)),
-                None => self.error(line, format!("{what}: '{k}' = {v} is not a number, boolean or string")),
+                None => self.error(
+                    line,
+                    format!("{what}: '{k}' = {v} is not a number, boolean or string"),
+                ),
             }
         }
         out
@@ -396,10 +399,16 @@ impl Reader<'_> {
         let name = f.name.clone().unwrap_or_else(|| f.variable.clone());
         let what = format!("factor '{name}'");
         if crate::system::VarRef::parse(&f.variable).is_none() {
-            self.error(line, format!("{what}: variable '{}' is not instance.variable", f.variable));
+            self.error(
+                line,
+                format!("{what}: variable '{}' is not instance.variable", f.variable),
+            );
         }
         if !(f.scale.is_finite() && f.scale != 0.0) {
-            self.error(line, format!("{what}: scale = {} must be finite and non-zero", f.scale));
+            self.error(
+                line,
+                format!("{what}: scale = {} must be finite and non-zero", f.scale),
+            );
         }
         let given = [
             f.values.is_some(),
@@ -409,9 +418,10 @@ impl Reader<'_> {
             f.normal.is_some(),
         ];
         if given.iter().filter(|g| **g).count() != 1 {
-            self.error(line, format!(
-                "{what}: give exactly one of values, range, linspace, uniform, normal"
-            ));
+            self.error(
+                line,
+                format!("{what}: give exactly one of values, range, linspace, uniform, normal"),
+            );
         }
         let levels = match self.levels(&f) {
             Ok(l) => l,
@@ -421,7 +431,10 @@ impl Reader<'_> {
             }
         };
         if levels.is_random() && f.zip.is_some() {
-            self.error(line, format!("{what}: random factors are sampled jointly; zip is for grids"));
+            self.error(
+                line,
+                format!("{what}: random factors are sampled jointly; zip is for grids"),
+            );
         }
         Factor {
             name,
@@ -451,7 +464,9 @@ impl Reader<'_> {
                 return Err("range = [start, stop, step] (stop included)".into());
             };
             if !finite(r) || !(step > 0.0) || b < a {
-                return Err(format!("range = {r:?}: needs finite start <= stop and step > 0"));
+                return Err(format!(
+                    "range = {r:?}: needs finite start <= stop and step > 0"
+                ));
             }
             // Points a + i*step up to b, with b included when it lies on the grid (to within
             // 1e-9 steps, the rounding of decimal steps).
@@ -466,7 +481,9 @@ impl Reader<'_> {
                 return Err("linspace = [start, stop, count]".into());
             };
             if !finite(l) || n < 1.0 || n.fract() != 0.0 || n > 1e6 {
-                return Err(format!("linspace = {l:?}: needs finite ends and a whole count >= 1"));
+                return Err(format!(
+                    "linspace = {l:?}: needs finite ends and a whole count >= 1"
+                ));
             }
             let n = n as usize;
             if n == 1 {
@@ -474,19 +491,25 @@ impl Reader<'_> {
             }
             let d = (b - a) / (n - 1) as f64;
             return Ok(Levels::Grid(
-                (0..n).map(|i| if i == n - 1 { b } else { a + i as f64 * d }).collect(),
+                (0..n)
+                    .map(|i| if i == n - 1 { b } else { a + i as f64 * d })
+                    .collect(),
             ));
         }
         if let Some(u) = &f.uniform {
             return match u[..] {
                 [low, high] if finite(u) && low < high => Ok(Levels::Uniform { low, high }),
-                _ => Err(format!("uniform = {u:?}: needs finite [low, high] with low < high")),
+                _ => Err(format!(
+                    "uniform = {u:?}: needs finite [low, high] with low < high"
+                )),
             };
         }
         if let Some(n) = &f.normal {
             return match n[..] {
                 [mean, std] if finite(n) && std > 0.0 => Ok(Levels::Normal { mean, std }),
-                _ => Err(format!("normal = {n:?}: needs finite [mean, std] with std > 0")),
+                _ => Err(format!(
+                    "normal = {n:?}: needs finite [mean, std] with std > 0"
+                )),
             };
         }
         Ok(Levels::Grid(Vec::new()))
@@ -496,7 +519,10 @@ impl Reader<'_> {
         let random = factors.iter().any(|f| f.levels.is_random());
         let Some(s) = s else {
             if random {
-                self.error(None, "random factors need [sampling] with method and samples".into());
+                self.error(
+                    None,
+                    "random factors need [sampling] with method and samples".into(),
+                );
             }
             return Sampling {
                 method: SamplingMethod::MonteCarlo,
@@ -507,17 +533,24 @@ impl Reader<'_> {
             "monte_carlo" => SamplingMethod::MonteCarlo,
             "latin_hypercube" => SamplingMethod::LatinHypercube,
             m => {
-                self.error(None, format!(
-                    "sampling: method '{m}' is not monte_carlo or latin_hypercube"
-                ));
+                self.error(
+                    None,
+                    format!("sampling: method '{m}' is not monte_carlo or latin_hypercube"),
+                );
                 SamplingMethod::MonteCarlo
             }
         };
         if !random {
-            self.error(None, "[sampling] is given but no factor is uniform or normal".into());
+            self.error(
+                None,
+                "[sampling] is given but no factor is uniform or normal".into(),
+            );
         }
         if s.samples == 0 || s.samples > 10_000_000 {
-            self.error(None, format!("sampling: samples = {} must be 1 ..= 10^7", s.samples));
+            self.error(
+                None,
+                format!("sampling: samples = {} must be 1 ..= 10^7", s.samples),
+            );
         }
         Sampling {
             method,
@@ -536,11 +569,17 @@ impl Reader<'_> {
             self.error(None, "replications: count must be at least 1".into());
         }
         if r.seeds.is_empty() {
-            self.error(None, "replications: name the seed parameters in seeds = [...]".into());
+            self.error(
+                None,
+                "replications: name the seed parameters in seeds = [...]".into(),
+            );
         }
         for s in &r.seeds {
             if crate::system::VarRef::parse(s).is_none() {
-                self.error(None, format!("replications: seed '{s}' is not instance.variable"));
+                self.error(
+                    None,
+                    format!("replications: seed '{s}' is not instance.variable"),
+                );
             }
         }
         Replications {
@@ -591,16 +630,22 @@ impl Reader<'_> {
                 && !n.starts_with(|c: char| c.is_ascii_digit())
                 && n.chars().all(|c| c.is_ascii_alphanumeric() || c == '_');
             if !ident {
-                self.error(None, format!(
+                self.error(
+                    None,
+                    format!(
                     "{what} name '{n}' must be letters, digits and '_' (not starting with a digit)"
-                ));
+                ),
+                );
             }
             if what != "arm" && !seen.insert(n.clone()) {
                 self.error(None, format!("{what} name '{n}' is used twice"));
             }
         }
         if spec.arms.len() == 1 {
-            self.error(None, "a single arm compares nothing: give two or more, or none".into());
+            self.error(
+                None,
+                "a single arm compares nothing: give two or more, or none".into(),
+            );
         }
         let factor_names: std::collections::HashSet<_> =
             spec.factors.iter().map(|f| &f.name).collect();

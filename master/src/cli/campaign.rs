@@ -127,7 +127,10 @@ pub fn dispatch(
             if report.missing.is_empty() {
                 Ok(())
             } else {
-                Err(Error::Other(format!("{} run(s) missing", report.missing.len())))
+                Err(Error::Other(format!(
+                    "{} run(s) missing",
+                    report.missing.len()
+                )))
             }
         }
         CampaignCommand::Plot {
@@ -139,15 +142,31 @@ pub fn dispatch(
             group,
             title,
             output,
-        } => plot(&table, &kind, &x, &y, z.as_deref(), group.as_deref(), title, &output),
+        } => plot(
+            &table,
+            &kind,
+            &x,
+            &y,
+            z.as_deref(),
+            group.as_deref(),
+            title,
+            &output,
+        ),
     }
 }
 
 /// `I/N` with I < N.
 fn parse_shard(s: &str) -> shipsim::Result<(usize, usize)> {
-    let bad = || Error::Other(format!("--shard {s}: expected I/N with 0 <= I < N, e.g. 0/4"));
+    let bad = || {
+        Error::Other(format!(
+            "--shard {s}: expected I/N with 0 <= I < N, e.g. 0/4"
+        ))
+    };
     let (i, n) = s.split_once('/').ok_or_else(bad)?;
-    let (i, n): (usize, usize) = (i.trim().parse().map_err(|_| bad())?, n.trim().parse().map_err(|_| bad())?);
+    let (i, n): (usize, usize) = (
+        i.trim().parse().map_err(|_| bad())?,
+        n.trim().parse().map_err(|_| bad())?,
+    );
     if n == 0 || i >= n {
         return Err(bad());
     }
@@ -157,13 +176,21 @@ fn parse_shard(s: &str) -> shipsim::Result<(usize, usize)> {
 /// The campaign in a few lines: system, factors, replications, arms, KPIs, runs.
 fn describe(c: &Campaign) -> String {
     let s = &c.spec;
-    let mut out = format!("campaign '{}': {} runs of {}", s.name, c.runs.len(), s.system.display());
+    let mut out = format!(
+        "campaign '{}': {} runs of {}",
+        s.name,
+        c.runs.len(),
+        s.system.display()
+    );
     for f in &s.factors {
         let levels = match &f.levels {
             campaign::spec::Levels::Grid(v) => format!("{} values {:?}", v.len(), v),
             l => format!("{l:?} ({} samples)", s.sampling.samples),
         };
-        out += &format!("\n  factor {} -> {} (x {}): {levels}", f.name, f.variable, f.scale);
+        out += &format!(
+            "\n  factor {} -> {} (x {}): {levels}",
+            f.name, f.variable, f.scale
+        );
     }
     if !s.replications.seeds.is_empty() {
         out += &format!(

@@ -179,7 +179,9 @@ impl System {
     /// Applies `--set inst.var=value` overrides (they replace values from the file).
     pub fn apply_overrides(&mut self, sets: &[String]) -> Result<()> {
         for s in sets {
-            let parsed = s.split_once('=').and_then(|(l, r)| Some((VarRef::parse(l)?, r)));
+            let parsed = s
+                .split_once('=')
+                .and_then(|(l, r)| Some((VarRef::parse(l)?, r)));
             let Some((r, rhs)) = parsed else {
                 return Err(Error::Other(format!(
                     "--set {s}: expected instance.variable=value"

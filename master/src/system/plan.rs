@@ -73,13 +73,3 @@ pub struct Plan {
     pub decimation: u32,
     pub warnings: Vec<String>,
 }
-
-impl Plan {
-    /// The base step k with t_k = `t` (to within 1e-6 steps, the rule events follow), if `t`
-    /// is a communication point of the run in [t0, t_n].
-    pub fn step_at(&self, t: f64) -> Option<u64> {
-        let kf = (t - self.start_time) / self.step_size;
-        let k = kf.round();
-        (k >= 0.0 && (kf - k).abs() <= 1e-6 && k as u64 <= self.n_steps).then_some(k as u64)
-    }
-}
