@@ -65,6 +65,20 @@ impl Env {
         csv: &str,
         steps: Option<u64>,
     ) -> Result<Table, String> {
+        let mut system = self.system(file)?;
+        system.apply_overrides(sets).map_err(|e| e.to_string())?;
+        if let Some(n) = steps {
+            system.stop_time = Some(system.start_time + n as f64 * system.step_size);
+        }
+        std::fs::create_dir_all(&self.out_dir).map_err(|e| e.to_string())?;
+        let out = self.out_dir.join(csv);
+        run_system(&system, Output::File(out.clone()), &RunOptions::default())
+            .map_err(|e| format!("{file}: {e}"))?;
+        Table::read(&out).map_err(|e| e.to_string())
+    }
+
+    /// `systems/<file>` with its FMU paths resolved by file name in [`Env::fmu_dir`].
+    pub fn system(&self, file: &str) -> Result<System, String> {
         let path = self.root.join("systems").join(file);
         let mut system = System::load(&path).map_err(|e| e.to_string())?;
         for inst in &mut system.instances {
@@ -83,15 +97,7 @@ impl Env {
             }
             inst.fmu = candidate;
         }
-        system.apply_overrides(sets).map_err(|e| e.to_string())?;
-        if let Some(n) = steps {
-            system.stop_time = Some(system.start_time + n as f64 * system.step_size);
-        }
-        std::fs::create_dir_all(&self.out_dir).map_err(|e| e.to_string())?;
-        let out = self.out_dir.join(csv);
-        run_system(&system, Output::File(out.clone()), &RunOptions::default())
-            .map_err(|e| format!("{file}: {e}"))?;
-        Table::read(&out).map_err(|e| e.to_string())
+        Ok(system)
     }
 
     /// Draws a figure into the output folder; returns its path.

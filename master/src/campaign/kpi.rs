@@ -240,7 +240,7 @@ impl StatAccumulator {
 /// One KPI's accumulator, bound to recorded columns.
 enum Accumulator {
     Stat { column: usize, acc: StatAccumulator },
-    Manoeuvre(super::manoeuvre::ManoeuvreKpi),
+    Manoeuvre(Box<super::manoeuvre::ManoeuvreKpi>),
 }
 
 /// The KPIs of one run, as a [`Recorder`].
@@ -321,7 +321,7 @@ impl Recorder for KpiRecorder<'_> {
                         .into_iter()
                         .map(find)
                         .collect::<Result<Vec<_>>>()?;
-                    Accumulator::Manoeuvre(super::manoeuvre::ManoeuvreKpi::new(k, &cols))
+                    Accumulator::Manoeuvre(Box::new(super::manoeuvre::ManoeuvreKpi::new(k, &cols)))
                 }
             });
         }

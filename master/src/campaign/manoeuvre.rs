@@ -6,6 +6,8 @@ use crate::run::Row;
 use models::hull::DEG;
 use models::manoeuvre::{imo, Sample, TurningCircleTracker, ZigZagMetrics, ZigZagTracker};
 
+// Both trackers are a few hundred bytes; the KPI is boxed as a whole (kpi.rs).
+#[allow(clippy::large_enum_variant)]
 enum Tracker {
     Turning(TurningCircleTracker),
     ZigZag(ZigZagTracker),

@@ -55,13 +55,17 @@ impl Campaign {
         Campaign::from_spec(CampaignSpec::load(path)?)
     }
 
+    /// A checked campaign file with its base system read from the file it names.
     pub fn from_spec(spec: CampaignSpec) -> Result<Campaign> {
-        let mut system = System::load(&spec.system).map_err(|e| {
-            Error::Other(format!(
-                "campaign {}: base system: {e}",
-                spec.source.display()
-            ))
+        let system = System::load(&spec.system).map_err(|e| {
+            Error::Other(format!("campaign {}: base system: {e}", spec.source.display()))
         })?;
+        Campaign::new(spec, system)
+    }
+
+    /// A checked campaign file with its base system given (e.g. with the FMU paths pointed
+    /// elsewhere): records the KPI variables, hashes the system file and FMUs, expands the runs.
+    pub fn new(spec: CampaignSpec, mut system: System) -> Result<Campaign> {
         if let Some(t) = spec.stop_time {
             system.stop_time = Some(t);
         }
@@ -91,7 +95,7 @@ impl Campaign {
         }
         let base_hash = design::hex(&h.finalize());
         if let Some(t) = spec.fork_at {
-            for k in spec.kpis.iter().filter(|k| k.start() < t) {
+            if let Some(k) = spec.kpis.iter().find(|k| k.start() < t) {
                 return Err(Error::Other(format!(
                     "campaign {}: kpi '{}' starts before fork_at = {t} s; runs that fork share \
                      everything before it, so windows must start at or after it",

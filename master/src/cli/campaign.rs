@@ -50,15 +50,16 @@ pub enum CampaignCommand {
     Plot {
         table: PathBuf,
         /// line (KPI against a factor, mean and 5-95 % band over seeds), heatmap (over two
-        /// factors) or polar (KPI against a direction factor in degrees).
+        /// factors), polar (KPI against a direction factor in degrees) or histogram (the
+        /// distribution of the KPI --x).
         #[arg(long, default_value = "line")]
         kind: String,
-        /// The factor on the x axis (polar: the angle, in degrees).
+        /// The factor on the x axis (polar: the angle, in degrees; histogram: the KPI).
         #[arg(long)]
         x: String,
-        /// The KPI (line, polar), or the second factor (heatmap).
+        /// The KPI (line, polar), or the second factor (heatmap); histogram: not used.
         #[arg(long)]
-        y: String,
+        y: Option<String>,
         /// heatmap: the KPI coloured over (x, y).
         #[arg(long)]
         z: Option<String>,
@@ -142,16 +143,16 @@ pub fn dispatch(
             group,
             title,
             output,
-        } => plot(
-            &table,
-            &kind,
-            &x,
-            &y,
-            z.as_deref(),
-            group.as_deref(),
-            title,
-            &output,
-        ),
+        } => {
+            let req = PlotRequest {
+                kind: &kind,
+                x: &x,
+                y: y.as_deref(),
+                z: z.as_deref(),
+                group: group.as_deref(),
+            };
+            plot(&table, &req, title, &output)
+        }
     }
 }
 
@@ -211,17 +212,24 @@ fn describe(c: &Campaign) -> String {
     out
 }
 
-#[allow(clippy::too_many_arguments)]
-fn plot(
+/// The figure a `campaign plot` asks for.
+pub struct PlotRequest<'a> {
+    pub kind: &'a str,
+    pub x: &'a str,
+    pub y: Option<&'a str>,
+    pub z: Option<&'a str>,
+    pub group: Option<&'a str>,
+}
+
+/// `shipsim campaign plot`: a table file, or an output folder (its derived table if it has
+/// one, else its run table).
+fn plot<'r>(
     table: &Path,
-    kind: &str,
-    x: &str,
-    y: &str,
-    z: Option<&str>,
-    group: Option<&str>,
+    req: &PlotRequest<'r>,
     title: Option<String>,
     output: &Path,
 ) -> shipsim::Result<()> {
+    use campaign::plot;
     let file = if table.is_dir() {
         let derived = table.join("derived.parquet");
         if derived.exists() {
@@ -233,6 +241,38 @@ fn plot(
         table.to_path_buf()
     };
     let t = campaign::table::Table::read(&file)?;
-    let _ = (&t, kind, x, y, z, group, title, output);
-    todo!("wire the plots")
+    let mut opts = plot::PlotOptions::new(output);
+    opts.title = title;
+    let need = |v: Option<&'r str>, what: &str| -> shipsim::Result<&'r str> {
+        v.ok_or_else(|| Error::Other(format!("campaign plot --kind {}: give {what}", req.kind)))
+    };
+    let summary = match req.kind {
+        "line" => plot::line_band(&t, req.x, need(req.y, "--y (the KPI)")?, req.group, &opts)?,
+        "polar" => plot::polar(&t, req.x, need(req.y, "--y (the KPI)")?, req.group, &opts)?,
+        "heatmap" => plot::heatmap(
+            &t,
+            req.x,
+            need(req.y, "--y (the second factor)")?,
+            need(req.z, "--z (the KPI)")?,
+            &opts,
+        )?,
+        // "histogram" => plot::histogram(&t, req.x, req.group, &opts)?, (helper)
+        k => {
+            return Err(Error::Other(format!(
+                "campaign plot --kind {k}: use line, polar, heatmap or histogram"
+            )))
+        }
+    };
+    println!(
+        "wrote {} ({} rows of {}{})",
+        output.display(),
+        summary.rows_used,
+        file.display(),
+        if summary.rows_skipped > 0 {
+            format!(", {} skipped: not finite", summary.rows_skipped)
+        } else {
+            String::new()
+        }
+    );
+    Ok(())
 }
