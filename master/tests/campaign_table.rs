@@ -361,6 +361,41 @@ fn truncated_and_garbage_files_give_errors_naming_the_file() {
 }
 
 #[test]
+fn parquet_with_any_single_byte_flipped_reads_or_fails_naming_the_file() {
+    // Every byte of a small file, flipped in turn: the read returns the table, other values or
+    // an error naming the file; a panic inside the parquet crate must not escape.
+    let mut t = Table::default();
+    t.push("x", ColumnData::Float(vec![1.0, 2.5, f64::NAN, 4.0]));
+    t.push("n", ColumnData::Int(vec![1, 2, 3, 4]));
+    t.push("ok", ColumnData::Bool(vec![true, false, true, true]));
+    t.push(
+        "s",
+        ColumnData::Text(["a", "bb", "", "ccc"].map(String::from).to_vec()),
+    );
+    let d = tempfile::tempdir().unwrap();
+    let p = d.path().join("good.parquet");
+    t.write_parquet(&p).unwrap();
+    let bytes = std::fs::read(&p).unwrap();
+    let q = d.path().join("flipped.parquet");
+    let mut failed = 0;
+    for i in 0..bytes.len() {
+        let mut b = bytes.clone();
+        b[i] ^= 0xff;
+        std::fs::write(&q, &b).unwrap();
+        if let Err(e) = Table::read_parquet(&q) {
+            let e = e.to_string();
+            assert!(
+                e.starts_with(&format!("{}: ", q.display())),
+                "byte {i}: {e}"
+            );
+            failed += 1;
+        }
+    }
+    // Most flips break the file (the footer, the page headers, the magic numbers).
+    assert!(failed > bytes.len() / 4, "{failed} of {}", bytes.len());
+}
+
+#[test]
 fn unknown_extensions_are_refused_by_name() {
     let d = tempfile::tempdir().unwrap();
     let p = d.path().join("runs.xlsx");
@@ -425,67 +460,156 @@ fn writes_replace_whole_files_and_a_failed_write_changes_nothing() {
     assert_eq!(listing(d.path()), ["runs.csv", "runs.parquet"]);
 }
 
+/// One column chunk for [`write_raw`]: the non-null values, and the definition levels of an
+/// optional column (1 = a value, 0 = null).
+enum Chunk {
+    F32(Vec<f32>, Option<Vec<i16>>),
+    F64(Vec<f64>, Option<Vec<i16>>),
+    I32(Vec<i32>, Option<Vec<i16>>),
+    I64(Vec<i64>, Option<Vec<i16>>),
+    Bytes(Vec<&'static [u8]>, Option<Vec<i16>>),
+}
+
+/// Writes a Parquet file as another writer might: the schema in Parquet's message syntax, and
+/// one list of column chunks per row group.
+fn write_raw(path: &Path, message: &str, groups: Vec<Vec<Chunk>>) {
+    use parquet::column::writer::ColumnWriter as W;
+    let schema = std::sync::Arc::new(parquet::schema::parser::parse_message_type(message).unwrap());
+    let file = std::fs::File::create(path).unwrap();
+    let mut w =
+        parquet::file::writer::SerializedFileWriter::new(file, schema, Default::default()).unwrap();
+    for chunks in groups {
+        let mut group = w.next_row_group().unwrap();
+        for chunk in chunks {
+            let mut c = group.next_column().unwrap().unwrap();
+            match (c.untyped(), chunk) {
+                (W::FloatColumnWriter(w), Chunk::F32(v, l)) => {
+                    w.write_batch(&v, l.as_deref(), None)
+                }
+                (W::DoubleColumnWriter(w), Chunk::F64(v, l)) => {
+                    w.write_batch(&v, l.as_deref(), None)
+                }
+                (W::Int32ColumnWriter(w), Chunk::I32(v, l)) => {
+                    w.write_batch(&v, l.as_deref(), None)
+                }
+                (W::Int64ColumnWriter(w), Chunk::I64(v, l)) => {
+                    w.write_batch(&v, l.as_deref(), None)
+                }
+                (W::ByteArrayColumnWriter(w), Chunk::Bytes(v, l)) => {
+                    let v: Vec<parquet::data_type::ByteArray> =
+                        v.into_iter().map(Into::into).collect();
+                    w.write_batch(&v, l.as_deref(), None)
+                }
+                _ => panic!("chunk of another type than its column"),
+            }
+            .unwrap();
+            c.close().unwrap();
+        }
+        group.close().unwrap();
+    }
+    w.close().unwrap();
+}
+
 #[test]
 fn parquet_from_other_writers_reads_close_types_and_nulls() {
-    use arrow_array::{ArrayRef, Float32Array, Int32Array, RecordBatch, StringArray, UInt64Array};
-    use std::sync::Arc;
+    use Chunk::*;
     let d = tempfile::tempdir().unwrap();
-    let write = |name: &str, columns: Vec<(&str, ArrayRef)>| -> PathBuf {
-        let p = d.path().join(name);
-        let batch = RecordBatch::try_from_iter(columns).unwrap();
-        let f = std::fs::File::create(&p).unwrap();
-        let mut w = parquet::arrow::ArrowWriter::try_new(f, batch.schema(), None).unwrap();
-        w.write(&batch).unwrap();
-        w.close().unwrap();
-        p
-    };
-    let p = write(
-        "close.parquet",
+    // Two row groups; nullable float, string and double; INT32; unsigned 64 and 32 bits (an
+    // unsigned value is stored in the bits of the signed type: -1 is u32::MAX).
+    let p = d.path().join("close.parquet");
+    write_raw(
+        &p,
+        "message m { optional float f32; required int32 i32; \
+         required int64 u64 (INTEGER(64,false)); optional binary s (STRING); \
+         optional double f64; required int32 u32 (INTEGER(32,false)); }",
         vec![
-            ("f32", Arc::new(Float32Array::from(vec![Some(0.5), None]))),
-            ("i32", Arc::new(Int32Array::from(vec![-3, 4]))),
-            ("u64", Arc::new(UInt64Array::from(vec![0, 1 << 40]))),
-            ("s", Arc::new(StringArray::from(vec![None, Some("é")]))),
+            vec![
+                F32(vec![0.5], Some(vec![1, 0])),
+                I32(vec![-3, 4], None),
+                I64(vec![0, 1 << 40], None),
+                Bytes(vec!["é".as_bytes()], Some(vec![0, 1])),
+                F64(vec![-0.0], Some(vec![0, 1])),
+                I32(vec![-1, 7], None),
+            ],
+            vec![
+                F32(vec![1.25], Some(vec![1])),
+                I32(vec![7], None),
+                I64(vec![5], None),
+                Bytes(vec![b"x"], Some(vec![1])),
+                F64(vec![2.5], Some(vec![1])),
+                I32(vec![3], None),
+            ],
         ],
     );
     let t = Table::read_parquet(&p).unwrap();
     let mut want = Table::default();
-    want.push("f32", ColumnData::Float(vec![0.5, f64::NAN]));
-    want.push("i32", ColumnData::Int(vec![-3, 4]));
-    want.push("u64", ColumnData::Int(vec![0, 1 << 40]));
-    want.push("s", ColumnData::Text(vec![String::new(), "é".into()]));
+    want.push("f32", ColumnData::Float(vec![0.5, f64::NAN, 1.25]));
+    want.push("i32", ColumnData::Int(vec![-3, 4, 7]));
+    want.push("u64", ColumnData::Int(vec![0, 1 << 40, 5]));
+    want.push(
+        "s",
+        ColumnData::Text(vec![String::new(), "é".into(), "x".into()]),
+    );
+    want.push("f64", ColumnData::Float(vec![f64::NAN, -0.0, 2.5]));
+    want.push("u32", ColumnData::Int(vec![4294967295, 7, 3]));
     assert_same(&t, &want);
 
-    let p = write(
-        "null_int.parquet",
-        vec![("seed", Arc::new(Int32Array::from(vec![Some(1), None])))],
+    // Errors name the file, the column and the row counted over all row groups.
+    let p = d.path().join("null_int.parquet");
+    write_raw(
+        &p,
+        "message m { optional int32 seed; }",
+        vec![
+            vec![I32(vec![1], Some(vec![1]))],
+            vec![I32(vec![2], Some(vec![1, 0]))],
+        ],
     );
     let e = error_of(Table::read_parquet(&p));
     assert!(
-        e.contains("null_int.parquet") && e.contains("column 'seed', row 1: null value"),
+        e.contains(&format!(
+            "{}: column 'seed', row 2: null value",
+            p.display()
+        )),
         "{e}"
     );
-    let p = write(
-        "big_u64.parquet",
-        vec![("seed", Arc::new(UInt64Array::from(vec![1, u64::MAX])))],
+    let p = d.path().join("big_u64.parquet");
+    write_raw(
+        &p,
+        "message m { required int64 seed (INTEGER(64,false)); }",
+        vec![vec![I64(vec![1, -1], None)]],
     );
     let e = error_of(Table::read_parquet(&p));
     assert!(
         e.contains("column 'seed', row 1: 18446744073709551615 does not fit"),
         "{e}"
     );
-    let p = write(
-        "date.parquet",
-        vec![(
-            "day",
-            Arc::new(arrow_array::Date32Array::from(vec![1])) as ArrayRef,
-        )],
+    let p = d.path().join("bad_utf8.parquet");
+    write_raw(
+        &p,
+        "message m { required binary s (STRING); }",
+        vec![vec![Bytes(vec![b"ok", b"\xff"], None)]],
     );
     let e = error_of(Table::read_parquet(&p));
-    assert!(
-        e.contains("date.parquet") && e.contains("column 'day' has type Date32"),
-        "{e}"
-    );
+    assert!(e.contains("column 's', row 1: not valid UTF-8"), "{e}");
+
+    // Types a run table cannot hold.
+    for (message, what) in [
+        ("required int32 day (DATE);", "column 'day' is INT32 (Date)"),
+        ("required binary b;", "column 'b' is BYTE_ARRAY,"),
+        ("repeated int64 r;", "column 'r' is a repeated INT64"),
+        (
+            "required group g { required int32 a; }",
+            "column 'g' is a group",
+        ),
+    ] {
+        let p = d.path().join("type.parquet");
+        write_raw(&p, &format!("message m {{ {message} }}"), vec![]);
+        let e = error_of(Table::read_parquet(&p));
+        assert!(
+            e.contains(&p.display().to_string()) && e.contains(what),
+            "{message}: {e}"
+        );
+    }
 }
 
 /// Writes `table.csv`, `table.parquet` and `rows0.parquet` (the columns of the table without

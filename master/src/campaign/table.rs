@@ -5,9 +5,10 @@
 //!
 //! Files ([`Table::write`], [`Table::read`], chosen by extension):
 //!
-//! - **Parquet** (`.parquet`, [`parquet_io`]): Float -> Float64, Int -> Int64, Bool -> Boolean,
-//!   Text -> Utf8, Snappy-compressed. Keeps every value bit for bit (NaN payloads too) and every
-//!   column's type, also for an empty table.
+//! - **Parquet** (`.parquet`, [`parquet_io`]): Float -> DOUBLE, Int -> INT64, Bool -> BOOLEAN,
+//!   Text -> UTF-8 string (Arrow's Float64, Int64, Boolean, Utf8 in pandas and polars),
+//!   Snappy-compressed. Keeps every value bit for bit (NaN payloads too) and every column's
+//!   type, also for a table without rows.
 //! - **CSV** (`.csv`, [`csv_io`]): a header row, fields quoted only when needed (RFC 4180,
 //!   sec. 2). Floats keep their bits (except a NaN's sign and payload) and their type; see
 //!   [`csv_io`] for what CSV cannot keep.
