@@ -674,3 +674,113 @@ fn reduced_rrs_polar_following_seas_are_worse_and_beam_seas_agree_with_table_7_1
     );
     assert!((mean(&r90) - 72.1).abs() < 10.0, "{r90:?}");
 }
+
+// ------------------------------------------------------------------------------------------
+// Manoeuvring KPIs (the container ship and the Manoeuvre FMU)
+// ------------------------------------------------------------------------------------------
+
+/// The samples of a `shipsim run` CSV of the container-ship manoeuvre system.
+fn manoeuvre_samples(csv: &Path) -> Vec<models::manoeuvre::Sample> {
+    let (header, rows) = read_csv(csv);
+    let (x, y, psi) = (
+        col(&header, "ship.x"),
+        col(&header, "ship.y"),
+        col(&header, "ship.heading"),
+    );
+    rows.iter()
+        .map(|r| models::manoeuvre::Sample {
+            t: r[0],
+            x: r[x],
+            y: r[y],
+            psi: r[psi],
+            ..Default::default()
+        })
+        .collect()
+}
+
+fn shipsim_run(system: &Path, sets: &[(String, shipsim::system::Value)], csv: &Path) {
+    let mut cmd = std::process::Command::new(env!("CARGO_BIN_EXE_shipsim"));
+    cmd.args(["run", "-q", "-o"]).arg(csv).arg(system);
+    for (k, v) in sets {
+        cmd.arg("--set").arg(format!("{k}={v}"));
+    }
+    assert!(cmd.status().unwrap().success());
+}
+
+#[test]
+fn turning_circle_and_zigzag_kpis_equal_the_batch_metrics_and_the_imo_limits() {
+    let dir = tempfile::tempdir().unwrap();
+    let system = root().join("systems/container_ship_turning_circle.toml");
+    let text = format!(
+        r#"system = "{}"
+stop_time = 900.0
+[[arms]]
+name = "turn"
+set = {{ "manoeuvre.kind" = 1, "manoeuvre.rudder_angle" = 0.17453292519943295 }}
+[[arms]]
+name = "zigzag"
+set = {{ "manoeuvre.kind" = 2, "manoeuvre.rudder_angle" = 0.17453292519943295, "manoeuvre.check_angle" = 0.17453292519943295 }}
+[[kpis]]
+name = "tc"
+manoeuvre = "turning_circle"
+x = "ship.x"
+y = "ship.y"
+heading = "ship.heading"
+execute_time = 10.0
+length = 175.0
+[[kpis]]
+name = "zz"
+manoeuvre = "zigzag"
+heading = "ship.heading"
+execute_time = 10.0
+check_angle = 0.17453292519943295
+rudder_angle = 0.17453292519943295
+length = 175.0
+speed = 8.37667
+"#,
+        system.display()
+    );
+    let c = Campaign::from_spec(spec(dir.path(), "imo.toml", &text)).unwrap();
+    execute::run(&c, &opts(&dir.path().join("out"), 2)).unwrap();
+    let t = Table::read(&dir.path().join("out/runs.parquet")).unwrap();
+    assert_eq!(texts(&t, "status"), ["ok", "ok"]);
+    // The turning run: the batch metrics over the CSV of the same run by `shipsim run`.
+    let csv = dir.path().join("turn.csv");
+    shipsim_run(&system, &c.runs[0].sets, &csv);
+    let s = manoeuvre_samples(&csv);
+    let m = models::manoeuvre::turning_circle(&s, 10.0).unwrap();
+    let got = [
+        floats(&t, "tc_advance")[0],
+        floats(&t, "tc_transfer")[0],
+        floats(&t, "tc_tactical_diameter")[0],
+    ];
+    assert!(
+        same_bits(&got, &[m.advance, m.transfer, m.tactical_diameter]),
+        "{got:?} vs {m:?}"
+    );
+    // IMO 5.3.1 by hand: advance <= 4.5 L = 787.5 m, tactical diameter <= 5 L = 875 m.
+    let pass = m.advance <= 787.5 && m.tactical_diameter <= 875.0;
+    assert_eq!(texts(&t, "tc_imo")[0], if pass { "pass" } else { "fail" });
+    // The zig-zag run has no 90 deg turn (NaN, no verdict), and the turning run no zig-zag.
+    assert!(floats(&t, "tc_advance")[1].is_nan() && texts(&t, "tc_imo")[1].is_empty());
+    assert!(floats(&t, "zz_first_overshoot")[0].is_nan());
+    let csv = dir.path().join("zz.csv");
+    shipsim_run(&system, &c.runs[1].sets, &csv);
+    let z =
+        models::manoeuvre::zigzag(&manoeuvre_samples(&csv), 10.0, 1.0, 10f64.to_radians()).unwrap();
+    let got = [
+        floats(&t, "zz_first_overshoot")[1],
+        floats(&t, "zz_second_overshoot")[1],
+    ];
+    assert!(
+        same_bits(&got, &[z.first_overshoot, z.second_overshoot]),
+        "{got:?} vs {z:?}"
+    );
+    // IMO 5.3.3 by hand at L/U = 175 / 8.37667 = 20.89 s: first overshoot <= 5 + 0.5 L/U =
+    // 15.45 deg, second <= 17.5 + 0.75 L/U = 33.17 deg.
+    let lu = 175.0 / 8.37667;
+    let pass = z.first_overshoot.to_degrees() <= 5.0 + 0.5 * lu
+        && z.second_overshoot.to_degrees() <= 17.5 + 0.75 * lu;
+    assert_eq!(texts(&t, "zz_imo")[1], if pass { "pass" } else { "fail" });
+    assert!(z.first_overshoot > 0.0 && z.second_overshoot > 0.0);
+}
