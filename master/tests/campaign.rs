@@ -784,3 +784,101 @@ speed = 8.37667
     assert_eq!(texts(&t, "zz_imo")[1], if pass { "pass" } else { "fail" });
     assert!(z.first_overshoot > 0.0 && z.second_overshoot > 0.0);
 }
+
+#[test]
+fn selected_runs_write_their_decimated_series() {
+    let dir = tempfile::tempdir().unwrap();
+    test_system(dir.path(), 0.1);
+    let text =
+        format!("{MANY}{KPIS}[series]\nruns = [3, 150]\nvariables = [\"m.y2\"]\ndecimation = 10\n");
+    let c = Campaign::from_spec(spec(dir.path(), "c.toml", &text)).unwrap();
+    execute::run(&c, &opts(&dir.path().join("out"), 2)).unwrap();
+    let series: Vec<_> = std::fs::read_dir(dir.path().join("out/series"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .collect::<std::collections::BTreeSet<_>>()
+        .into_iter()
+        .collect();
+    assert_eq!(series, ["run-000003.csv", "run-000150.csv"]);
+    let (header, rows) = read_csv(&dir.path().join("out/series/run-000003.csv"));
+    assert_eq!(header, ["time", "m.y", "m.y2"]);
+    // 100 steps of 1 ms recorded every 10th row from t = 0: 0, 0.01, ..., 0.1.
+    assert_eq!(rows.len(), 11);
+    assert!((rows[10][0] - 0.1).abs() < 1e-12);
+    // y2 = k u with run 3's k from the linspace (0.5 + 0 * ...: point 0) and u = 1.
+    let k = c.runs[3].factors[0];
+    assert!(rows.iter().all(|r| r[2] == k), "{k}");
+}
+
+#[test]
+fn an_fmu_that_allows_one_instance_per_process_runs_the_campaign_with_one_job() {
+    let dir = tempfile::tempdir().unwrap();
+    let md = model_description(GUID, "2.0").replace(
+        "<CoSimulation",
+        "<CoSimulation canBeInstantiatedOnlyOncePerProcess=\"true\"",
+    );
+    let fmu = build_fmu(
+        dir.path(),
+        "once",
+        Variant {
+            md_override: Some(&md),
+            ..Default::default()
+        },
+    );
+    write_system(
+        dir.path(),
+        "sys.toml",
+        &format!("[simulation]\nstop_time = 0.01\nstep_size = 0.001\n[[instances]]\nname = \"m\"\nfmu = \"{}\"\n", fmu.display()),
+    );
+    let c = Campaign::from_spec(spec(dir.path(), "c.toml", &format!("{MANY}{KPIS}"))).unwrap();
+    let outcome = execute::run(&c, &opts(&dir.path().join("out"), 2)).unwrap();
+    assert_eq!((outcome.jobs, outcome.ran, outcome.failed), (1, 200, 0));
+    let note = outcome.jobs_note.unwrap();
+    assert!(
+        note.contains("once.fmu") && note.contains("canBeInstantiatedOnlyOncePerProcess"),
+        "{note}"
+    );
+}
+
+#[test]
+fn ctrl_c_stops_a_campaign_cleanly_and_the_same_command_finishes_it() {
+    let dir = tempfile::tempdir().unwrap();
+    test_system(dir.path(), 20.0);
+    let file = dir.path().join("c.toml");
+    std::fs::write(&file, format!("{MANY}{KPIS}")).unwrap();
+    let out = dir.path().join("out");
+    let bin = env!("CARGO_BIN_EXE_shipsim");
+    let cmd = || {
+        let mut c = std::process::Command::new(bin);
+        c.args(["campaign", "run", "-q", "-j", "2", "-o"])
+            .arg(&out)
+            .arg(&file);
+        c
+    };
+    let mut child = cmd().spawn().unwrap();
+    let journal = out.join("runs.jsonl");
+    let t0 = std::time::Instant::now();
+    while std::fs::read_to_string(&journal).map_or(0, |s| s.lines().count()) < 5 {
+        assert!(t0.elapsed().as_secs() < 120, "the campaign did not start");
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    let pid = child.id().to_string();
+    assert!(std::process::Command::new("kill")
+        .args(["-INT", &pid])
+        .status()
+        .unwrap()
+        .success());
+    let status = child.wait().unwrap();
+    assert_eq!(status.code(), Some(130), "interrupted runs exit 130");
+    let before = journal_keys(&out);
+    assert!(before.len() < 200);
+    // The tables of the finished runs are written on the way out.
+    assert_eq!(
+        Table::read(&out.join("runs.csv")).unwrap().rows(),
+        before.len()
+    );
+    assert!(cmd().status().unwrap().success());
+    let after = journal_keys(&out);
+    let unique: HashSet<_> = after.iter().collect();
+    assert_eq!((after.len(), unique.len()), (200, 200));
+}
