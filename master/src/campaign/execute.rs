@@ -29,7 +29,7 @@ use crate::system::{Plan, System};
 use rayon::prelude::*;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::PathBuf;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
@@ -135,7 +135,9 @@ struct Context<'a> {
     run_opts: RunOptions,
     journal: Mutex<Journal>,
     progress: Option<indicatif::ProgressBar>,
-    failed: std::sync::atomic::AtomicUsize,
+    failed: AtomicUsize,
+    /// Runs finished (recorded) by this call.
+    done: AtomicUsize,
     slowest: Mutex<Option<(usize, f64)>>,
     interrupted: AtomicBool,
     series_dir: PathBuf,
@@ -168,6 +170,7 @@ impl Context<'_> {
             } => (status, message, kpis),
         };
         let wall = result_wall(&kpis);
+        self.done.fetch_add(1, Ordering::Relaxed);
         if status.failed() {
             self.failed.fetch_add(1, Ordering::Relaxed);
         }
@@ -397,6 +400,7 @@ pub fn run(campaign: &Campaign, opts: &CampaignOptions) -> Result<CampaignOutcom
         journal: Mutex::new(journal),
         progress: opts.progress.then(|| progress_bar(todo.len())),
         failed: Default::default(),
+        done: Default::default(),
         slowest: Mutex::new(None),
         interrupted: AtomicBool::new(false),
         series_dir: dir.join("series"),
@@ -432,7 +436,7 @@ pub fn run(campaign: &Campaign, opts: &CampaignOptions) -> Result<CampaignOutcom
     if let Some(e) = errors.into_inner().unwrap_or_else(|e| e.into_inner()).pop() {
         return Err(e);
     }
-    outcome.ran = todo.len();
+    outcome.ran = ctx.done.load(Ordering::Relaxed);
     outcome.interrupted = ctx.interrupted.load(Ordering::Relaxed) || ctx.stop();
     outcome.failed = ctx.failed.load(Ordering::Relaxed);
     outcome.slowest = *ctx.slowest.lock().unwrap_or_else(|e| e.into_inner());

@@ -5,7 +5,8 @@
 //! `fdatasync`ed before the run counts as done. A process killed during a write leaves at most
 //! one partial last line; [`Journal::open`] drops it (truncating the file to its last complete
 //! line), so that run is simply run again. A run is never written twice: a resumed campaign
-//! skips every key already in the journal ([`Journal::done`]). Numbers round-trip exactly
+//! skips every key already in the journal ([`Journal::done`]), and the journal is locked
+//! (`flock`) while a campaign writes it, so two processes never run into one folder. Numbers round-trip exactly
 //! (serde_json's `float_roundtrip`); non-finite KPI values are written as `null` and read back
 //! as NaN.
 
@@ -107,6 +108,20 @@ impl Journal {
             .create(true)
             .open(&path)
             .map_err(|e| io("cannot open the run journal", e))?;
+        // One process at a time per output folder: a second `campaign run` on the same folder
+        // would run the same runs and write them twice. The lock goes with the process (also
+        // on SIGKILL).
+        match file.try_lock() {
+            Ok(()) => {}
+            Err(std::fs::TryLockError::WouldBlock) => {
+                return Err(Error::Other(format!(
+                    "{} is in use by another shipsim process (a campaign is running into {})",
+                    path.display(),
+                    dir.display()
+                )))
+            }
+            Err(std::fs::TryLockError::Error(e)) => return Err(io("cannot lock", e)),
+        }
         let mut text = Vec::new();
         file.read_to_end(&mut text)
             .map_err(|e| io("cannot read the run journal", e))?;

@@ -58,7 +58,10 @@ impl Campaign {
     /// A checked campaign file with its base system read from the file it names.
     pub fn from_spec(spec: CampaignSpec) -> Result<Campaign> {
         let system = System::load(&spec.system).map_err(|e| {
-            Error::Other(format!("campaign {}: base system: {e}", spec.source.display()))
+            Error::Other(format!(
+                "campaign {}: base system: {e}",
+                spec.source.display()
+            ))
         })?;
         Campaign::new(spec, system)
     }
