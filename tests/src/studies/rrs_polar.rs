@@ -52,7 +52,10 @@ pub fn run(env: &Env) -> Result<Report, String> {
     checks.push(Check::holds(
         "beam seas (90°, H_s = 3 m): seed spread covers the Table 7.1 study",
         "72.1 % in the Table 7.1 study (seed 1; thesis 78 %, [Klugt1987, Table 7.1])",
-        format!("mean {:.1} %, 5–95 % {:.1}..{:.1} %", b90.mean, b90.p05, b90.p95),
+        format!(
+            "mean {:.1} %, 5–95 % {:.1}..{:.1} %",
+            b90.mean, b90.p05, b90.p95
+        ),
         b90.p05 <= 72.1 && 72.1 <= b90.p95,
     ));
     checks.push(Check::holds(
@@ -67,7 +70,10 @@ pub fn run(env: &Env) -> Result<Report, String> {
     checks.push(Check::holds(
         "oblique seas (30°, 150°): little roll, little reduction",
         "γ = 120°: adaptive reduction small (R4)",
-        format!("H_s = 3 m: {:.1} % at 30°, {:.1} % at 150°", f30.mean, h150.mean),
+        format!(
+            "H_s = 3 m: {:.1} % at 30°, {:.1} % at 150°",
+            f30.mean, h150.mean
+        ),
         f30.mean < 25.0 && h150.mean < 25.0,
     ));
     let mut figures = Vec::new();
@@ -76,8 +82,14 @@ pub fn run(env: &Env) -> Result<Report, String> {
     polar.x_label = Some("wave direction γ [deg] (0 following, 90 beam)".into());
     polar.y_label = Some("roll reduction [%]".into());
     polar.group_label = Some("H_s [m]".into());
-    plot::polar(&derived, "direction_deg", "roll_reduction", Some("hs"), &polar)
-        .map_err(|e| e.to_string())?;
+    plot::polar(
+        &derived,
+        "direction_deg",
+        "roll_reduction",
+        Some("hs"),
+        &polar,
+    )
+    .map_err(|e| e.to_string())?;
     figures.push(("Roll reduction 100 (1 − σ²_φ,on / σ²_φ,off) over the wave direction, mean and 5–95 % band over 10 seeds".to_string(), polar.path));
     Ok(Report {
         id: "rrs_polar".into(),
@@ -92,9 +104,7 @@ pub fn run(env: &Env) -> Result<Report, String> {
 
 /// The polar as a Markdown table: mean [5–95 %] per direction and H_s.
 fn table_note(agg: &plot::Aggregate) -> String {
-    let mut s = String::from(
-        "Roll reduction [%], seed mean [5–95 %]:\n\n| γ [deg] |",
-    );
+    let mut s = String::from("Roll reduction [%], seed mean [5–95 %]:\n\n| γ [deg] |");
     for g in &agg.series {
         s += &format!(" H_s = {} m |", g.group.as_deref().unwrap_or("?"));
     }
