@@ -95,7 +95,7 @@ pub fn run(env: &Env) -> Result<Report, String> {
         id: "rrs_polar".into(),
         title: "Campaign: RRS roll reduction polar".into(),
         source: "[Klugt1987], experiment 1 of Table 7.1 swept over direction and sea state".into(),
-        systems: vec!["campaigns/rrs_polar.toml (systems/rrs.toml)".into()],
+        systems: vec!["rrs.toml` through `campaigns/rrs_polar.toml".into()],
         checks,
         figures,
         notes: vec![table_note(&agg), grouping_note(&outcome)],
