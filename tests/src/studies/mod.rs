@@ -7,6 +7,7 @@
 use crate::study::{Env, Report};
 
 pub mod autopilot;
+pub mod autopilot_robustness;
 pub mod dgps_trial;
 pub mod dp_observer;
 mod path_common;
@@ -31,7 +32,10 @@ pub const STUDIES: &[Study] = &[
 
 /// Studies in the report only (`cargo xtask report`): campaigns too long for the test suite,
 /// which runs reduced versions of them.
-pub const REPORT_ONLY: &[Study] = &[("rrs_polar", rrs_polar::run)];
+pub const REPORT_ONLY: &[Study] = &[
+    ("rrs_polar", rrs_polar::run),
+    ("autopilot_robustness", autopilot_robustness::run),
+];
 
 /// Runs the study `id` in `target/studies/<id>/`.
 pub fn run(id: &str) -> Result<Report, String> {
