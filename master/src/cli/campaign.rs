@@ -256,7 +256,7 @@ fn plot<'r>(
             need(req.z, "--z (the KPI)")?,
             &opts,
         )?,
-        // "histogram" => plot::histogram(&t, req.x, req.group, &opts)?, (helper)
+        "histogram" => plot::histogram(&t, req.x, req.group, &opts)?,
         k => {
             return Err(Error::Other(format!(
                 "campaign plot --kind {k}: use line, polar, heatmap or histogram"

@@ -6,7 +6,6 @@
 use crate::study::{Check, Env, Report};
 use shipsim::campaign::plot::{self, PlotOptions};
 use shipsim::campaign::table::{ColumnData, Table};
-use shipsim::campaign::{execute, Campaign, CampaignOptions, CampaignSpec};
 
 fn column(t: &Table, name: &str) -> Result<Vec<f64>, String> {
     match t.column(name) {
@@ -33,19 +32,8 @@ fn correlation(a: &[f64], b: &[f64]) -> f64 {
 }
 
 pub fn run(env: &Env) -> Result<Report, String> {
-    let spec = CampaignSpec::load(&env.root.join("campaigns/autopilot_robustness.toml"))
-        .map_err(|e| e.to_string())?;
-    let campaign =
-        Campaign::new(spec, env.system("autopilot_current.toml")?).map_err(|e| e.to_string())?;
-    let out = env.out_dir.join("campaign");
-    let _ = std::fs::remove_dir_all(&out);
-    let opts = CampaignOptions {
-        output: out.clone(),
-        ..Default::default()
-    };
-    let outcome = execute::run(&campaign, &opts).map_err(|e| e.to_string())?;
-    let runs = Table::read(&out.join("runs.parquet")).map_err(|e| e.to_string())?;
-    let derived = Table::read(&out.join("derived.parquet")).map_err(|e| e.to_string())?;
+    let result = env.campaign("autopilot_robustness.toml", "autopilot_current.toml")?;
+    let (outcome, runs, derived) = (result.outcome, result.runs, result.derived);
     let settling = column(&runs, "settling_time")?;
     let overshoot = column(&derived, "overshoot_deg")?;
     let mut checks = vec![Check::holds(

@@ -6,8 +6,7 @@
 
 use crate::study::{Check, Env, Report};
 use shipsim::campaign::plot::{self, PlotOptions, Stats};
-use shipsim::campaign::table::Table;
-use shipsim::campaign::{execute, Campaign, CampaignOptions, CampaignSpec};
+use shipsim::campaign::execute;
 
 /// The seed mean and 5–95 % spread of the roll reduction at (direction, H_s).
 fn cell(agg: &plot::Aggregate, hs: f64, dir: f64) -> Result<Stats, String> {
@@ -25,19 +24,8 @@ fn cell(agg: &plot::Aggregate, hs: f64, dir: f64) -> Result<Stats, String> {
 }
 
 pub fn run(env: &Env) -> Result<Report, String> {
-    let spec = CampaignSpec::load(&env.root.join("campaigns/rrs_polar.toml"))
-        .map_err(|e| e.to_string())?;
-    let system = env.system("rrs.toml")?;
-    let campaign = Campaign::new(spec, system).map_err(|e| e.to_string())?;
-    let out = env.out_dir.join("campaign");
-    let _ = std::fs::remove_dir_all(&out);
-    let opts = CampaignOptions {
-        output: out.clone(),
-        ..Default::default()
-    };
-    let outcome = execute::run(&campaign, &opts).map_err(|e| e.to_string())?;
-    let runs = Table::read(&out.join("runs.parquet")).map_err(|e| e.to_string())?;
-    let derived = Table::read(&out.join("derived.parquet")).map_err(|e| e.to_string())?;
+    let result = env.campaign("rrs_polar.toml", "rrs.toml")?;
+    let (outcome, runs, derived) = (result.outcome, result.runs, result.derived);
     let agg = plot::aggregate(&derived, "direction_deg", "roll_reduction", Some("hs"))
         .map_err(|e| e.to_string())?;
     let red = |hs: f64, dir: f64| cell(&agg, hs, dir);
