@@ -3,7 +3,10 @@
 //! - [`line_band`]: a KPI against one factor, the mean over the runs of each design point
 //!   (the seeds) with its 5–95 % band, one coloured series per value of a group column;
 //! - [`heatmap`]: the mean of a KPI over two factors, on the viridis colour map, with a colour bar;
-//! - [`polar`]: a KPI against a direction on polar axes (e.g. roll reduction over wave heading).
+//! - [`polar`]: a KPI against a direction on polar axes (e.g. roll reduction over wave heading);
+//! - [`histogram`]: the distribution of a KPI over the runs (e.g. a Monte-Carlo robustness
+//!   study), on [`bins`] chosen by the Freedman–Diaconis rule, with its mean and 5 % / 95 %
+//!   percentiles, one semi-transparent histogram per value of a group column.
 //!
 //! Every plot reduces the rows that share a design point to their [`Stats`]: the mean, and the
 //! 5 % and 95 % empirical percentiles of [`percentile`]. A row is skipped when one of its
@@ -17,8 +20,9 @@
 use crate::campaign::table::{ColumnData, Table};
 use crate::error::{suggest, Error, Result};
 use crate::plot::{create_parent_dir, register_font, COLORS};
-use plotters::coord::types::RangedCoordf64;
+use plotters::coord::types::{RangedCoordf64, RangedCoordu32};
 use plotters::coord::Shift;
+use plotters::element::DashedPathElement;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 use std::path::PathBuf;
@@ -115,8 +119,8 @@ pub struct PlotSummary {
 /// The mapping from data to pixels (image coordinates: x to the right, y down).
 #[derive(Clone, Debug, PartialEq)]
 pub enum Frame {
-    /// [`line_band`]: the data ranges `x` and `y` span the pixel rectangle `left..=right`,
-    /// `bottom..=top` (y grows upwards in the data).
+    /// [`line_band`] and [`histogram`] (`y` in runs): the data ranges `x` and `y` span the
+    /// pixel rectangle `left..=right`, `bottom..=top` (y grows upwards in the data).
     Cartesian {
         left: i32,
         top: i32,
@@ -133,6 +137,26 @@ pub enum Frame {
         radius_px: f64,
         r: (f64, f64),
     },
+}
+
+impl Frame {
+    /// Cartesian axes whose data ranges `x` and `y` span the pixels from `top_left` to
+    /// `bottom_right`.
+    fn cartesian(
+        (left, top): (i32, i32),
+        (right, bottom): (i32, i32),
+        x: (f64, f64),
+        y: (f64, f64),
+    ) -> Frame {
+        Frame::Cartesian {
+            left,
+            top,
+            right,
+            bottom,
+            x,
+            y,
+        }
+    }
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -304,6 +328,188 @@ pub fn grid(table: &Table, x: &str, y: &str, z: &str) -> Result<Grid> {
         cells: values.iter().map(|v| Stats::of(v)).collect(),
         xs,
         ys,
+        rows_used: rows.len(),
+        rows_skipped: skipped,
+    })
+}
+
+/// The most bins [`bins`] makes.
+pub const MAX_BINS: usize = 100;
+
+/// The rule by which [`bins`] chose the bins.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BinRule {
+    /// Freedman and Diaconis: width 2 IQR n^(-1/3).
+    FreedmanDiaconis,
+    /// Sturges: ceil(log₂ n) + 1 bins (the interquartile range is 0).
+    Sturges,
+    /// All values are equal: one bin centred on them.
+    SingleValue,
+}
+
+/// Bins of equal width over the values' range and the values in each.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Bins {
+    /// Ascending, one more than the bins: bin `i` is `edges[i] <= v < edges[i + 1]`, the last
+    /// one closed (`v <= edges[n]`), as in numpy's `histogram`.
+    pub edges: Vec<f64>,
+    /// The values in each bin.
+    pub counts: Vec<usize>,
+    pub rule: BinRule,
+    /// The rule asked for more than [`MAX_BINS`] bins; there are [`MAX_BINS`].
+    pub capped: bool,
+}
+
+impl Bins {
+    /// The number of bins.
+    pub fn len(&self) -> usize {
+        self.edges.len().saturating_sub(1)
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The width of every bin.
+    pub fn width(&self) -> f64 {
+        match (self.edges.first(), self.edges.last()) {
+            (Some(a), Some(b)) if !self.is_empty() => (b - a) / self.len() as f64,
+            _ => f64::NAN,
+        }
+    }
+
+    /// The bin holding `v`; `None` outside the edges (or for NaN).
+    pub fn index(&self, v: f64) -> Option<usize> {
+        let n = self.len();
+        if n == 0 || !(self.edges[0]..=self.edges[n]).contains(&v) {
+            return None;
+        }
+        Some((self.edges.partition_point(|e| *e <= v).saturating_sub(1)).min(n - 1))
+    }
+
+    /// The number of `values` in each bin (values outside the edges are not counted): a
+    /// group's histogram on bins chosen for all runs.
+    pub fn count(&self, values: &[f64]) -> Vec<usize> {
+        let mut counts = vec![0; self.len()];
+        for i in values.iter().filter_map(|v| self.index(*v)) {
+            counts[i] += 1;
+        }
+        counts
+    }
+}
+
+/// Bins for a histogram of `values`: equal widths from the smallest value to the largest, as
+/// many as the rule of Freedman and Diaconis asks for (D. Freedman and P. Diaconis, *On the
+/// histogram as a density estimator: L₂ theory*, Zeitschrift für Wahrscheinlichkeitstheorie
+/// und verwandte Gebiete 57 (1981) 453–476): width 2 IQR n^(-1/3), with the
+/// interquartile range IQR from [`percentile`] (75 % minus 25 %); the count is the range over
+/// that width rounded up, and the width is then the range over the count. This is numpy's
+/// `histogram_bin_edges(values, "fd")`, edges and all.
+///
+/// - When the IQR is 0 (most runs share one value), the width would be 0: Sturges' rule gives
+///   ceil(log₂ n) + 1 bins instead (H. A. Sturges, *The choice of a class interval*, Journal of
+///   the American Statistical Association 21 (1926) 65–66). numpy makes one bin there.
+/// - At most [`MAX_BINS`] bins (a few outliers far out would ask for thousands).
+/// - A single distinct value v gets one bin centred on it, v ± |v|/10 (± 1 for 0; numpy:
+///   ± 0.5).
+///
+/// `None` for no values, a value that is not finite, or a range too wide for an `f64`.
+pub fn bins(values: &[f64]) -> Option<Bins> {
+    if values.is_empty() || values.iter().any(|v| !v.is_finite()) {
+        return None;
+    }
+    let mut sorted = values.to_vec();
+    sorted.sort_by(f64::total_cmp);
+    let (lo, hi) = (sorted[0], sorted[sorted.len() - 1]);
+    let n = sorted.len() as f64;
+    let iqr = percentile_sorted(&sorted, 75.0) - percentile_sorted(&sorted, 25.0);
+    let (rule, wanted, (first, last)) = if hi == lo {
+        (BinRule::SingleValue, 1.0, widen(lo, hi))
+    } else if iqr > 0.0 {
+        let width = 2.0 * iqr * n.powf(-1.0 / 3.0);
+        (
+            BinRule::FreedmanDiaconis,
+            ((hi - lo) / width).ceil(),
+            (lo, hi),
+        )
+    } else {
+        (BinRule::Sturges, n.log2().ceil() + 1.0, (lo, hi))
+    };
+    if !(last - first).is_finite() {
+        return None;
+    }
+    // `as` saturates: an infinite count (a width that underflowed) is capped too.
+    let count = (wanted as usize).clamp(1, MAX_BINS);
+    let step = (last - first) / count as f64;
+    let mut edges: Vec<f64> = (0..count).map(|i| i as f64 * step + first).collect();
+    edges.push(last);
+    let mut bins = Bins {
+        edges,
+        counts: Vec::new(),
+        rule,
+        capped: wanted > MAX_BINS as f64,
+    };
+    bins.counts = bins.count(values);
+    Some(bins)
+}
+
+/// One group's histogram on the shared [`Bins`], and its statistics.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GroupCounts {
+    /// The group's value as text (`None` without a group column).
+    pub group: Option<String>,
+    pub counts: Vec<usize>,
+    pub stats: Stats,
+}
+
+/// The distribution of a KPI over the runs: bins chosen for all of them, and each group's
+/// counts on those bins.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Distribution {
+    pub bins: Bins,
+    /// Groups with at least one finite value, in [`aggregate`]'s order.
+    pub groups: Vec<GroupCounts>,
+    pub rows_used: usize,
+    pub rows_skipped: usize,
+}
+
+/// The [`bins`] of KPI `x` over the rows with a finite value, and the counts and [`Stats`] of
+/// each value of `group` on them. Rows with a non-finite `x` (or a NaN group value) are
+/// skipped and counted.
+pub fn distribution(table: &Table, x: &str, group: Option<&str>) -> Result<Distribution> {
+    let groups = Groups::of(table, group)?;
+    let (rows, skipped) = finite_rows(table, [numeric(table, x, "x")?], &groups);
+    no_rows_error(table, rows.len(), &[x])?;
+    let all: Vec<f64> = rows.iter().map(|(_, [v])| *v).collect();
+    let bins = bins(&all).ok_or_else(|| {
+        let (lo, hi) = all
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+                (a.min(*v), b.max(*v))
+            });
+        Error::Other(format!(
+            "plot x: the values of {x:?} run from {lo:e} to {hi:e}, a range too wide to bin"
+        ))
+    })?;
+    let mut per_group = vec![Vec::new(); groups.labels.len()];
+    for (g, [v]) in &rows {
+        per_group[*g].push(*v);
+    }
+    let groups = groups
+        .labels
+        .iter()
+        .zip(per_group)
+        .filter_map(|(label, values)| {
+            Some(GroupCounts {
+                group: group.map(|_| label.clone()),
+                counts: bins.count(&values),
+                stats: Stats::of(&values)?,
+            })
+        })
+        .collect();
+    Ok(Distribution {
+        bins,
+        groups,
         rows_used: rows.len(),
         rows_skipped: skipped,
     })
@@ -497,12 +703,27 @@ fn short_value(v: f64) -> String {
     format!("{v:.decimals$}")
 }
 
+/// A value as [`plain`] writes it when that is no longer than [`short_value`] (4 rather than
+/// 4.00, 19.8 rather than 19.80; 1.17 rather than 1.169607).
+fn compact(v: f64) -> String {
+    let (p, s) = (plain(v), short_value(v));
+    if p.len() <= s.len() {
+        p
+    } else {
+        s
+    }
+}
+
 /// `(lo, hi)` widened when empty (a single value) so that it can be mapped onto pixels.
 fn widen(lo: f64, hi: f64) -> (f64, f64) {
     if hi > lo {
         return (lo, hi);
     }
-    let d = if lo == 0.0 { 1.0 } else { lo.abs() * 0.1 };
+    let d = if (lo.abs() * 0.1).is_normal() {
+        lo.abs() * 0.1
+    } else {
+        1.0
+    };
     (lo - d, hi + d)
 }
 
@@ -672,11 +893,15 @@ fn caption(runs_per_point: (usize, usize), used: usize, skipped: usize, band: bo
     if band {
         first.push_str("; band: 5 to 95 % percentiles (linear interpolation, numpy's default)");
     }
-    let second = match skipped {
+    vec![first, runs_line(used, skipped)]
+}
+
+/// The caption's line of runs used and skipped.
+fn runs_line(used: usize, skipped: usize) -> String {
+    match skipped {
         0 => format!("{used} runs"),
         s => format!("{used} runs; {s} skipped (a plotted value is not finite, as in failed runs)"),
-    };
-    vec![first, second]
+    }
 }
 
 fn runs_per_point(series: &[SeriesStats]) -> (usize, usize) {
@@ -684,11 +909,26 @@ fn runs_per_point(series: &[SeriesStats]) -> (usize, usize) {
     (n.clone().min().unwrap_or(0), n.max().unwrap_or(0))
 }
 
-/// One legend line: a series (line and marker) or the band swatch.
+/// One legend line.
 struct Entry {
     label: String,
     color: RGBColor,
-    band: bool,
+    mark: Mark,
+}
+
+/// How a legend entry shows its colour.
+#[derive(Clone, Copy)]
+enum Mark {
+    /// A line with a marker: a series of means.
+    Series,
+    /// A swatch in the band's tint.
+    Band,
+    /// A bar filled with the colour at this opacity, outlined in the colour.
+    Bar(f64),
+    /// A plain line.
+    Line,
+    /// A dashed line.
+    Dashed,
 }
 
 /// The legend's entries for `series` (labelled by `group_label = value`), and the band swatch.
@@ -702,7 +942,7 @@ fn entries(series: &[SeriesStats], group_label: &str, y_label: &str, band: bool)
                 None => format!("mean {y_label}"),
             },
             color: series_color(i),
-            band: false,
+            mark: Mark::Series,
         })
         .collect();
     if band {
@@ -714,7 +954,7 @@ fn entries(series: &[SeriesStats], group_label: &str, y_label: &str, band: bool)
         out.push(Entry {
             label: "5 to 95 % of runs".into(),
             color,
-            band: true,
+            mark: Mark::Band,
         });
     }
     out
@@ -731,9 +971,9 @@ fn legend_width(area: &Area, entries: &[Entry]) -> u32 {
     (widest + 36).max(210).min(area.dim_in_pixel().0 * 2 / 5)
 }
 
-/// Draws a boxed legend at the top of `area`, and `notes` under it.
+/// Draws a boxed legend at the top of `area`, and `notes` under it (as many lines as fit).
 fn draw_legend(area: &Area, entries: &[Entry], notes: &[String]) -> Result<()> {
-    let (w, _) = area.dim_in_pixel();
+    let (w, h) = area.dim_in_pixel();
     let (x0, y0, row) = (8, 24, 24);
     let box_h = 10 + row * entries.len() as i32;
     let x1 = w as i32 - 12;
@@ -744,16 +984,7 @@ fn draw_legend(area: &Area, entries: &[Entry], notes: &[String]) -> Result<()> {
     .map_err(drawing)?;
     for (k, e) in entries.iter().enumerate() {
         let y = y0 + 17 + row * k as i32;
-        if e.band {
-            let style = e.color.mix(BAND_ALPHA * 1.5).filled();
-            area.draw(&Rectangle::new([(x0 + 8, y - 7), (x0 + 36, y + 7)], style))
-                .map_err(drawing)?;
-        } else {
-            let line = PathElement::new(vec![(x0 + 8, y), (x0 + 36, y)], e.color.stroke_width(2));
-            area.draw(&line).map_err(drawing)?;
-            area.draw(&Circle::new((x0 + 22, y), 4, e.color.filled()))
-                .map_err(drawing)?;
-        }
+        draw_mark(area, e, (x0 + 8, y))?;
         let label = words(
             e.label.as_str(),
             (x0 + 44, y),
@@ -767,6 +998,9 @@ fn draw_legend(area: &Area, entries: &[Entry], notes: &[String]) -> Result<()> {
         .collect();
     for (k, note) in notes.iter().enumerate() {
         let y = y0 + box_h + 22 + 20 * k as i32;
+        if y + 10 > h as i32 {
+            break;
+        }
         area.draw(&words(
             note.as_str(),
             (x0, y),
@@ -775,6 +1009,37 @@ fn draw_legend(area: &Area, entries: &[Entry], notes: &[String]) -> Result<()> {
         .map_err(drawing)?;
     }
     Ok(())
+}
+
+/// An entry's mark, 28 pixels wide from `(x, y)` (the middle of its left side).
+fn draw_mark(area: &Area, e: &Entry, (x, y): (i32, i32)) -> Result<()> {
+    let line = vec![(x, y), (x + 28, y)];
+    match e.mark {
+        Mark::Series => {
+            area.draw(&PathElement::new(line, e.color.stroke_width(2)))
+                .map_err(drawing)?;
+            area.draw(&Circle::new((x + 14, y), 4, e.color.filled()))
+                .map_err(drawing)
+        }
+        Mark::Band => {
+            let style = e.color.mix(BAND_ALPHA * 1.5).filled();
+            area.draw(&Rectangle::new([(x, y - 7), (x + 28, y + 7)], style))
+                .map_err(drawing)
+        }
+        Mark::Bar(alpha) => {
+            let corners = [(x + 4, y - 7), (x + 24, y + 7)];
+            area.draw(&Rectangle::new(corners, e.color.mix(alpha).filled()))
+                .map_err(drawing)?;
+            area.draw(&Rectangle::new(corners, e.color.stroke_width(1)))
+                .map_err(drawing)
+        }
+        Mark::Line => area
+            .draw(&PathElement::new(line, e.color.stroke_width(2)))
+            .map_err(drawing),
+        Mark::Dashed => area
+            .draw(&DashedPathElement::new(line, 6, 5, e.color.stroke_width(2)))
+            .map_err(drawing),
+    }
 }
 
 /// Splits off the legend panel at the right and draws it; returns the plotting part.
@@ -856,7 +1121,12 @@ fn padded_range(values: impl Iterator<Item = f64>, pad: f64) -> (f64, f64) {
 
 /// The step between the 8 (at most) labels that plotters puts on an axis over `range`.
 fn label_step(range: (f64, f64)) -> f64 {
-    let points = RangedCoordf64::from(range.0..range.1).key_points(8);
+    label_step_of(range, 8)
+}
+
+/// The step between the `n` (at most) labels that plotters puts on an axis over `range`.
+fn label_step_of(range: (f64, f64), n: usize) -> f64 {
+    let points = RangedCoordf64::from(range.0..range.1).key_points(n);
     let step = points
         .windows(2)
         .map(|w| w[1] - w[0])
@@ -924,16 +1194,9 @@ fn draw_line_chart(
             .draw_series(means.map(|p| Circle::new(p, 4, color.filled())))
             .map_err(drawing)?;
     }
-    let (left, top) = chart.backend_coord(&(xr.0, yr.1));
-    let (right, bottom) = chart.backend_coord(&(xr.1, yr.0));
-    Ok(Frame::Cartesian {
-        left,
-        top,
-        right,
-        bottom,
-        x: xr,
-        y: yr,
-    })
+    let top_left = chart.backend_coord(&(xr.0, yr.1));
+    let bottom_right = chart.backend_coord(&(xr.1, yr.0));
+    Ok(Frame::cartesian(top_left, bottom_right, xr, yr))
 }
 
 /// A factor value as written in a campaign file: the fewest decimals (up to 6) that give it
@@ -1516,6 +1779,422 @@ fn draw_polar_series(
         .map_err(drawing)?;
     for (deg, st) in &s.points {
         area.draw(&Circle::new(axes.point(*deg, st.mean), 4, color.filled()))
+            .map_err(drawing)?;
+    }
+    Ok(())
+}
+
+// ---------------------------------------------------------------------------------------------
+// Distribution of a KPI
+
+/// Opacity of a group's bars where groups overlay.
+const OVERLAY_ALPHA: f64 = 0.45;
+/// The mean and percentile lines of a histogram without groups.
+const STAT_INK: RGBColor = RGBColor(20, 20, 20);
+/// The height of a row of line tags above the bars, in pixels.
+const TAG_ROW: i32 = 19;
+
+/// Draws the distribution of KPI `x` over the rows (e.g. the Monte-Carlo runs of a robustness
+/// study): bars of the runs in each of the [`bins`] (Freedman–Diaconis, or Sturges when the
+/// interquartile range is 0), a solid line at the mean and dashed lines at the 5 % and 95 %
+/// percentiles ([`percentile`]), tagged above the bars, with their values in the legend.
+///
+/// With `group`, each value of the group column gets its own semi-transparent histogram
+/// (outlined in its colour) on the bins chosen for all rows, and its own mean and percentile
+/// lines, so that the arms or variants of a study compare bin by bin.
+pub fn histogram(
+    table: &Table,
+    x: &str,
+    group: Option<&str>,
+    opts: &PlotOptions,
+) -> Result<PlotSummary> {
+    let d = distribution(table, x, group)?;
+    let x_label = label_or(&opts.x_label, x);
+    let group_label = label_or(&opts.group_label, group.unwrap_or(""));
+    let title = opts
+        .title
+        .clone()
+        .unwrap_or_else(|| format!("Distribution of {x_label}"));
+    let caption = [
+        bins_caption(&d.bins, d.rows_used, d.groups.len()),
+        runs_line(d.rows_used, d.rows_skipped),
+    ];
+    let (legend, notes) = histogram_legend(&d, group_label);
+    render(opts, |root| {
+        let body = figure(root, &title, &caption)?;
+        let plot = with_legend(&body, &legend, &notes)?;
+        Ok(PlotSummary {
+            rows_used: d.rows_used,
+            rows_skipped: d.rows_skipped,
+            series: d.groups.len(),
+            frame: draw_histogram(&plot, &d, x_label)?,
+        })
+    })
+}
+
+/// The caption's line on the bins: the rule, its numbers, and the percentiles' definition.
+fn bins_caption(b: &Bins, n: usize, groups: usize) -> String {
+    let (k, w) = (b.len(), compact(b.width()));
+    let mut line = match b.rule {
+        BinRule::FreedmanDiaconis => format!(
+            "Bins: Freedman–Diaconis rule, width 2 IQR n^(-1/3) with n = {n}, rounded to {k} bins of {w}"
+        ),
+        BinRule::Sturges => format!(
+            "Bins: Sturges' rule (the interquartile range is 0), ceil(log2 {n}) + 1 = {k} bins of {w}"
+        ),
+        BinRule::SingleValue => format!(
+            "All runs have the value {}: one bin centred on it",
+            compact((b.edges[0] + b.edges[1]) / 2.0)
+        ),
+    };
+    if b.capped {
+        line.push_str(&format!(" (capped at {MAX_BINS} bins)"));
+    }
+    if groups > 1 {
+        line.push_str("; the groups share the bins");
+    }
+    line.push_str("; percentiles: linear interpolation (numpy's default)");
+    line
+}
+
+/// The colour of group `i`'s bars and lines, and the opacity of its bars.
+fn bar_style(i: usize, groups: usize) -> (RGBColor, RGBColor, f64) {
+    match groups {
+        1 => (series_color(0), STAT_INK, 1.0),
+        _ => (series_color(i), series_color(i), OVERLAY_ALPHA),
+    }
+}
+
+/// The legend (bars, mean, percentiles) and its notes. Without groups the entries carry the
+/// values; with groups the notes give each group's mean and percentiles.
+fn histogram_legend(d: &Distribution, group_label: &str) -> (Vec<Entry>, Vec<String>) {
+    let many = d.groups.len();
+    let mut entries: Vec<Entry> = d
+        .groups
+        .iter()
+        .enumerate()
+        .map(|(i, g)| {
+            let (color, _, alpha) = bar_style(i, many);
+            Entry {
+                label: match &g.group {
+                    Some(v) => format!("{group_label} = {v} ({} runs)", g.stats.n),
+                    None => format!("runs per bin ({} runs)", g.stats.n),
+                },
+                color,
+                mark: Mark::Bar(alpha),
+            }
+        })
+        .collect();
+    let (mean, band, ink) = match &d.groups[..] {
+        [one] => (
+            format!("mean {}", compact(one.stats.mean)),
+            format!(
+                "5 % {} and 95 % {}",
+                compact(one.stats.p05),
+                compact(one.stats.p95)
+            ),
+            STAT_INK,
+        ),
+        _ => (
+            "mean (group colour)".to_string(),
+            "5 % and 95 % (group colour)".to_string(),
+            RGBColor(110, 110, 110),
+        ),
+    };
+    for (label, mark) in [(mean, Mark::Line), (band, Mark::Dashed)] {
+        entries.push(Entry {
+            label,
+            color: ink,
+            mark,
+        });
+    }
+    let mut notes = Vec::new();
+    for g in d.groups.iter().filter(|_| many > 1) {
+        let (s, v) = (g.stats, g.group.as_deref().unwrap_or(""));
+        notes.push(format!("{group_label} = {v}: mean {}", compact(s.mean)));
+        notes.push(format!("5 % {}, 95 % {}", compact(s.p05), compact(s.p95)));
+    }
+    (entries, notes)
+}
+
+/// A line at a statistic of a group, and its tag above the bars.
+struct Tag {
+    value: f64,
+    text: String,
+    color: RGBColor,
+    dashed: bool,
+    group: usize,
+}
+
+fn tags(d: &Distribution) -> Vec<Tag> {
+    let many = d.groups.len();
+    let mut out = Vec::new();
+    for (i, g) in d.groups.iter().enumerate() {
+        let (_, color, _) = bar_style(i, many);
+        for (value, text, dashed) in [
+            (g.stats.p05, "5 %", true),
+            (g.stats.mean, "mean", false),
+            (g.stats.p95, "95 %", true),
+        ] {
+            out.push(Tag {
+                value,
+                text: text.to_string(),
+                color,
+                dashed,
+                group: i,
+            });
+        }
+    }
+    out
+}
+
+/// The tags with their pixel columns `xs`, those of a group within 2 pixels of each other
+/// merged into one ("5 %, mean, 95 %" when all runs are equal), solid if one of them is.
+fn merge_tags(tags: Vec<Tag>, xs: &[i32]) -> (Vec<Tag>, Vec<i32>) {
+    let (mut kept, mut kept_xs): (Vec<Tag>, Vec<i32>) = (Vec::new(), Vec::new());
+    for (t, x) in tags.into_iter().zip(xs) {
+        let same = kept
+            .iter()
+            .zip(&kept_xs)
+            .position(|(k, kx)| k.group == t.group && (kx - x).abs() <= 2);
+        match same {
+            Some(k) => {
+                kept[k].text = format!("{}, {}", kept[k].text, t.text);
+                kept[k].dashed &= t.dashed;
+            }
+            None => {
+                kept.push(t);
+                kept_xs.push(*x);
+            }
+        }
+    }
+    (kept, kept_xs)
+}
+
+/// Rows for tags centred at `xs` (pixels) and `widths` wide: each tag goes to the first row
+/// (from the top) where it clears the tags already there, taking them from left to right.
+/// Returns each tag's row and the number of rows.
+fn tag_rows(xs: &[i32], widths: &[i32]) -> (Vec<usize>, usize) {
+    let mut order: Vec<usize> = (0..xs.len()).collect();
+    order.sort_by_key(|&k| xs[k]);
+    let mut ends: Vec<i32> = Vec::new();
+    let mut rows = vec![0; xs.len()];
+    for k in order {
+        let left = xs[k] - widths[k] / 2;
+        let row = ends
+            .iter()
+            .position(|e| left > *e + 4)
+            .unwrap_or(ends.len());
+        if row == ends.len() {
+            ends.push(0);
+        }
+        ends[row] = left + widths[k];
+        rows[k] = row;
+    }
+    (rows, ends.len())
+}
+
+type HistogramChart<'a, 'b> =
+    ChartContext<'a, BitMapBackend<'b>, Cartesian2d<RangedCoordf64, RangedCoordu32>>;
+
+/// The chart of a histogram: `x` over the data range, counts 0 to `y_top` (integers, so that
+/// the axis has no fractional runs).
+fn histogram_chart<'a, 'b>(
+    area: &'a Area<'b>,
+    x: (f64, f64),
+    y_top: u32,
+) -> Result<HistogramChart<'a, 'b>> {
+    ChartBuilder::on(area)
+        .margin_top(16)
+        .margin_left(12)
+        .margin_right(16)
+        .x_label_area_size(56)
+        .y_label_area_size(78)
+        .build_cartesian_2d(x.0..x.1, 0..y_top)
+        .map_err(drawing)
+}
+
+fn draw_histogram(area: &Area, d: &Distribution, x_label: &str) -> Result<Frame> {
+    let b = &d.bins;
+    let pad = if b.rule == BinRule::SingleValue {
+        0.5
+    } else {
+        0.04
+    };
+    let xr = padded_range([b.edges[0], b.edges[b.len()]].into_iter(), pad);
+    let tags = tags(d);
+    // The chart's pixels along x do not depend on the count axis: lay the tags out on a probe
+    // chart, then leave room above the tallest bar for their rows.
+    let probe = histogram_chart(area, xr, 1)?;
+    let (px, py) = probe.plotting_area().get_pixel_range();
+    let xs: Vec<i32> = tags
+        .iter()
+        .map(|t| probe.backend_coord(&(t.value, 0)).0)
+        .collect();
+    let (tags, xs) = merge_tags(tags, &xs);
+    let widths: Vec<i32> = tags
+        .iter()
+        .map(|t| text_width(area, &t.text, 13) as i32 + 8)
+        .collect();
+    let xs: Vec<i32> = xs
+        .iter()
+        .zip(&widths)
+        .map(|(x, w)| (*x).clamp(px.start + w / 2, (px.end - w / 2).max(px.start + w / 2)))
+        .collect();
+    let (rows, n_rows) = tag_rows(&xs, &widths);
+    let height = (py.end - py.start) as f64;
+    let free = (height - (n_rows as i32 * TAG_ROW + 24) as f64).max(0.3 * height);
+    let tallest = d.groups.iter().flat_map(|g| g.counts.iter()).max().copied();
+    let tallest = tallest.unwrap_or(1).max(1) as u32;
+    let y_top = ((tallest as f64 * height / free).ceil() as u32).max(tallest + 1);
+    let mut chart = histogram_chart(area, xr, y_top)?;
+    let n_labels = x_labels_that_fit(area, xr, px.end - px.start);
+    let x_step = label_step_of(xr, n_labels);
+    chart
+        .configure_mesh()
+        .disable_x_mesh()
+        .x_desc(typeset(x_label))
+        .y_desc("runs")
+        .x_labels(n_labels)
+        .y_labels(8)
+        .x_label_formatter(&|v| tick_label(*v, x_step))
+        .label_style(font(14))
+        .axis_desc_style(font(17))
+        .bold_line_style(RGBColor(225, 225, 225))
+        // Counts are whole: no lines between the labelled ones (and `max_light_lines(0)` hangs
+        // plotters 0.3.7).
+        .light_line_style(TRANSPARENT)
+        .axis_style(AXIS)
+        .draw()
+        .map_err(drawing)?;
+    draw_bars(&mut chart, d)?;
+    let (bx, by) = area.get_base_pixel();
+    let base = chart.backend_coord(&(xr.0, 0)).1 - by;
+    let placed: Vec<(i32, i32)> = xs
+        .iter()
+        .zip(&rows)
+        .map(|(x, r)| (*x - bx, py.start - by + 4 + *r as i32 * TAG_ROW))
+        .collect();
+    draw_tags(area, &chart, &tags, &placed, base)?;
+    let top_left = chart.backend_coord(&(xr.0, y_top));
+    let bottom_right = chart.backend_coord(&(xr.1, 0));
+    Ok(Frame::cartesian(
+        top_left,
+        bottom_right,
+        xr,
+        (0.0, y_top as f64),
+    ))
+}
+
+/// The most labels (2 to 8) along `range` whose widest label, 12 pixels apart, fits `width`.
+fn x_labels_that_fit(area: &Area, range: (f64, f64), width: i32) -> usize {
+    (2..=8)
+        .rev()
+        .find(|&n| {
+            let step = label_step_of(range, n);
+            let widest = ticks(range.0, range.1, step)
+                .iter()
+                .map(|v| text_width(area, &tick_label(*v, step), 14) as i32)
+                .max()
+                .unwrap_or(0);
+            let count = ((range.1 - range.0) / step).floor() as i32 + 1;
+            count * (widest + 12) <= width
+        })
+        .unwrap_or(2)
+}
+
+/// Each group's bars: without groups solid, with white lines between bins; with groups
+/// semi-transparent, each outlined by its steps.
+fn draw_bars(chart: &mut HistogramChart, d: &Distribution) -> Result<()> {
+    let e = &d.bins.edges;
+    let many = d.groups.len();
+    for (i, g) in d.groups.iter().enumerate() {
+        let (color, _, alpha) = bar_style(i, many);
+        let bars = g.counts.iter().enumerate().filter(|(_, c)| **c > 0);
+        chart
+            .draw_series(bars.map(|(k, c)| {
+                Rectangle::new(
+                    [(e[k], 0), (e[k + 1], *c as u32)],
+                    color.mix(alpha).filled(),
+                )
+            }))
+            .map_err(drawing)?;
+        if many == 1 {
+            let between = (1..g.counts.len()).map(|k| {
+                let h = g.counts[k - 1].max(g.counts[k]) as u32;
+                PathElement::new(vec![(e[k], 0), (e[k], h)], WHITE.stroke_width(1))
+            });
+            chart.draw_series(between).map_err(drawing)?;
+        } else {
+            chart
+                .draw_series(
+                    outlines(e, &g.counts)
+                        .into_iter()
+                        .map(|steps| PathElement::new(steps, color.stroke_width(2))),
+                )
+                .map_err(drawing)?;
+        }
+    }
+    Ok(())
+}
+
+/// The outlines of the runs of non-empty bins, each up from the base, along the bins' tops and
+/// back down (not along the base under another group's bars).
+fn outlines(edges: &[f64], counts: &[usize]) -> Vec<Vec<(f64, u32)>> {
+    let mut out = Vec::new();
+    let mut k = 0;
+    while k < counts.len() {
+        if counts[k] == 0 {
+            k += 1;
+            continue;
+        }
+        let mut path = vec![(edges[k], 0)];
+        while k < counts.len() && counts[k] > 0 {
+            let c = counts[k] as u32;
+            path.extend([(edges[k], c), (edges[k + 1], c)]);
+            k += 1;
+        }
+        path.push((edges[k], 0));
+        out.push(path);
+    }
+    out
+}
+
+/// The lines from the bars' base (`base`, area pixels) up to their tags, dashed ones first,
+/// then the tags at `placed` (the top middle of each, area pixels) on white.
+fn draw_tags(
+    area: &Area,
+    chart: &HistogramChart,
+    tags: &[Tag],
+    placed: &[(i32, i32)],
+    base: i32,
+) -> Result<()> {
+    let (bx, _) = area.get_base_pixel();
+    for dashed in [true, false] {
+        for (t, (_, y)) in tags.iter().zip(placed).filter(|(t, _)| t.dashed == dashed) {
+            let x = chart.backend_coord(&(t.value, 0)).0 - bx;
+            let line = vec![(x, base), (x, y + TAG_ROW - 2)];
+            let style = t.color.stroke_width(2);
+            if dashed {
+                area.draw(&DashedPathElement::new(line, 7, 5, style))
+            } else {
+                area.draw(&PathElement::new(line, style))
+            }
+            .map_err(drawing)?;
+        }
+    }
+    for (t, (x, y)) in tags.iter().zip(placed) {
+        let half = text_width(area, &t.text, 13) as i32 / 2 + 4;
+        let bg = Rectangle::new(
+            [(x - half, y + 1), (x + half, y + TAG_ROW - 2)],
+            WHITE.mix(0.9).filled(),
+        );
+        area.draw(&bg).map_err(drawing)?;
+        let style = (FONT, 13)
+            .into_font()
+            .color(&t.color)
+            .pos(Pos::new(HPos::Center, VPos::Center));
+        area.draw(&words(&t.text, (*x, y + TAG_ROW / 2), style))
             .map_err(drawing)?;
     }
     Ok(())
