@@ -158,7 +158,7 @@ impl Context<'_> {
 
     /// Records a finished run (journal, progress, slowest); an interrupted one is not.
     fn finish(&self, run: &Run, result: Outcome) -> Result<()> {
-        let (status, message, kpis) = match result {
+        let (status, message, kpis, wall) = match result {
             Outcome::Interrupted => {
                 self.interrupted.store(true, Ordering::Relaxed);
                 return Ok(());
@@ -167,17 +167,17 @@ impl Context<'_> {
                 status,
                 message,
                 kpis,
-            } => (status, message, kpis),
+                wall,
+            } => (status, message, kpis, wall),
         };
-        let wall = result_wall(&kpis);
         self.done.fetch_add(1, Ordering::Relaxed);
         if status.failed() {
             self.failed.fetch_add(1, Ordering::Relaxed);
         }
         {
             let mut s = self.slowest.lock().unwrap_or_else(|e| e.into_inner());
-            if s.is_none_or(|(_, t)| wall.1 > t) {
-                *s = Some((run.index, wall.1));
+            if s.is_none_or(|(_, t)| wall > t) {
+                *s = Some((run.index, wall));
             }
         }
         let record = RunRecord {
@@ -185,8 +185,8 @@ impl Context<'_> {
             key: run.key.clone(),
             status,
             message,
-            kpis: wall.0.iter().map(JsonKpi::from).collect(),
-            wall_time: wall.1,
+            kpis: kpis.iter().map(JsonKpi::from).collect(),
+            wall_time: wall,
         };
         if let Some(o) = &self.observer {
             o.finished(run, &record);
@@ -203,17 +203,14 @@ impl Context<'_> {
     }
 }
 
-fn result_wall(k: &(Vec<KpiValue>, f64)) -> (&[KpiValue], f64) {
-    (&k.0, k.1)
-}
-
 /// How one run ended.
 enum Outcome {
     Done {
         status: Status,
         message: String,
-        /// (KPIs, wall time [s]).
-        kpis: (Vec<KpiValue>, f64),
+        kpis: Vec<KpiValue>,
+        /// Wall time of the run [s].
+        wall: f64,
     },
     Interrupted,
 }
@@ -263,7 +260,8 @@ fn classify(
     let failed = |status, message: String| Outcome::Done {
         status,
         message,
-        kpis: (missing_values(specs), wall),
+        kpis: missing_values(specs),
+        wall,
     };
     match result {
         Ok(Ok(summary)) => {
@@ -274,7 +272,8 @@ fn classify(
             Outcome::Done {
                 status,
                 message,
-                kpis: (recorders.kpis.values(), wall),
+                kpis: recorders.kpis.values(),
+                wall,
             }
         }
         Ok(Err(Error::Interrupted { .. })) => Outcome::Interrupted,
@@ -334,7 +333,8 @@ impl Context<'_> {
                 return Outcome::Done {
                     status: Status::Error,
                     message: e.to_string(),
-                    kpis: (missing_values(&self.campaign.spec.kpis), 0.0),
+                    kpis: missing_values(&self.campaign.spec.kpis),
+                    wall: 0.0,
                 }
             }
         };
@@ -541,17 +541,13 @@ impl Fork {
                     _ => "warm-up: panic".into(),
                 };
                 for r in runs {
-                    let kpis = (missing_values(&ctx.campaign.spec.kpis), 0.0);
-                    let status = Status::Error;
-                    let message = message.clone();
-                    ctx.finish(
-                        r,
-                        Outcome::Done {
-                            status,
-                            message,
-                            kpis,
-                        },
-                    )?;
+                    let done = Outcome::Done {
+                        status: Status::Error,
+                        message: message.clone(),
+                        kpis: missing_values(&ctx.campaign.spec.kpis),
+                        wall: 0.0,
+                    };
+                    ctx.finish(r, done)?;
                 }
                 return Ok(());
             }

@@ -5,8 +5,8 @@
 //! suite runs the reduced campaign (master/tests/campaign.rs).
 
 use crate::study::{Check, Env, Report};
-use shipsim::campaign::plot::{self, PlotOptions, Stats};
 use shipsim::campaign::execute;
+use shipsim::campaign::plot::{self, PlotOptions, Stats};
 
 /// The seed mean and 5–95 % spread of the roll reduction at (direction, H_s).
 fn cell(agg: &plot::Aggregate, hs: f64, dir: f64) -> Result<Stats, String> {
