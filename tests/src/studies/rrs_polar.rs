@@ -114,9 +114,8 @@ fn grouping_note(o: &execute::CampaignOutcome) -> String {
     let groups = o.groups.as_ref().map_or(0, Vec::len);
     format!(
         "Each of the {groups} (H_s, seeds) groups ran its first 200 s once and forked its 18 runs \
-         (direction and roll mode set at 200 s, statistics from 300 s); {} runs in {:.0} s on {} job(s).",
-        o.ran,
-        o.wall.as_secs_f64(),
-        o.jobs
+         (direction and roll mode set at 200 s, statistics from 300 s); {} runs (timings: \
+         docs/bench.md).",
+        o.ran
     )
 }
