@@ -31,6 +31,11 @@ pub enum Error {
     #[error("{} error(s):\n{}", .0.len(), .0.iter().map(|e| format!("  - {e}")).collect::<Vec<_>>().join("\n"))]
     Many(Vec<Error>),
 
+    /// A checkpoint file that cannot be used: not one, another version, truncated, corrupt,
+    /// or from a different system.
+    #[error("checkpoint file {}: {message}", file.display())]
+    Checkpoint { file: PathBuf, message: String },
+
     /// The run was interrupted (Ctrl-C) at the given time.
     #[error("interrupted at t = {time} s")]
     Interrupted { time: f64 },

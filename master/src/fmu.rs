@@ -191,10 +191,20 @@ impl UnpackedFmu {
     }
 }
 
+/// Shared libraries loaded by [`Fmu::load`] in this process (a statistic: campaigns and
+/// workers load each FMU once and make every run's instances from it).
+static LOADS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+
+/// How many FMU shared libraries [`Fmu::load`] has loaded in this process so far.
+pub fn load_count() -> usize {
+    LOADS.load(std::sync::atomic::Ordering::Relaxed)
+}
+
 impl Fmu {
     /// Unpacks, parses, checks and loads an FMU.
     pub fn load(path: impl AsRef<Path>) -> Result<Fmu> {
         let path = path.as_ref();
+        LOADS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
         let unpacked = UnpackedFmu::open(path)?;
         let cs = unpacked.check()?.clone();
         let bin = unpacked.binary_path()?;

@@ -12,10 +12,12 @@
 
 use crate::error::{Error, Result};
 use crate::fmu::{Fmu, FmuLibrary, VR};
+use crate::model_description::CoSimulation;
 use fmi2::*;
 use std::collections::VecDeque;
 use std::ffi::{c_char, c_int, c_void, CString};
 use std::marker::PhantomData;
+use std::path::PathBuf;
 use std::sync::{Arc, Mutex};
 
 /// Type states.
@@ -109,6 +111,31 @@ unsafe extern "C" fn fmi_free(p: *mut c_void) {
     free(p)
 }
 
+/// The largest serialized FMU state accepted: a larger size reported by an FMU is an error,
+/// not an allocation.
+const MAX_STATE_BYTES: usize = 1 << 30;
+
+/// The FMU-state capability (FMI 2.0, sec. 4.3.1) a checkpoint needs that `cs` lacks, if any.
+fn missing_state_capability(cs: &CoSimulation) -> Option<&'static str> {
+    if !cs.can_get_and_set_fmu_state {
+        Some("canGetAndSetFMUstate")
+    } else if !cs.can_serialize_fmu_state {
+        Some("canSerializeFMUstate")
+    } else {
+        None
+    }
+}
+
+/// The error for an instance of an FMU that lacks capability `cap`.
+fn state_support_error(fmu: &std::path::Path, instance: &str, cap: &str) -> Error {
+    Error::fmu(
+        fmu,
+        format!(
+            "instance '{instance}': the FMU does not declare {cap}=\"true\" (FMI 2.0, sec. 4.3.1), so its state cannot be saved or restored"
+        ),
+    )
+}
+
 #[derive(Clone, Copy, PartialEq, Eq, Debug)]
 enum Phase {
     Instantiated,
@@ -128,6 +155,11 @@ struct Core {
     _target: Box<LogTarget>,
     log: Box<LogCtx>,
     _name_c: CString,
+    /// The `.fmu` file, for errors about its capabilities.
+    fmu_path: PathBuf,
+    /// Which of canGetAndSetFMUstate and canSerializeFMUstate the FMU lacks (FMI 2.0,
+    /// sec. 4.3.1), if any.
+    missing_state_capability: Option<&'static str>,
 }
 
 impl Core {
@@ -268,9 +300,22 @@ impl Fmu {
                 _target: target,
                 log,
                 _name_c: name_c,
+                fmu_path: self.path.clone(),
+                missing_state_capability: missing_state_capability(self.co_simulation()),
             }),
             _s: PhantomData,
         })
+    }
+}
+
+impl Fmu {
+    /// The FMU can save and restore serialized states (canGetAndSetFMUstate and
+    /// canSerializeFMUstate, FMI 2.0, sec. 4.3.1), else an error naming the FMU and `instance`.
+    pub fn require_state_support(&self, instance: &str) -> Result<()> {
+        match missing_state_capability(self.co_simulation()) {
+            None => Ok(()),
+            Some(cap) => Err(state_support_error(&self.path, instance, cap)),
+        }
     }
 }
 
@@ -507,6 +552,97 @@ impl Instance<Stepping> {
         }
         self.core.check("fmi2DoStep", s, Some(t))?;
         Err(self.core.fmi_error("fmi2DoStep", s, Some(t)))
+    }
+
+    /// The instance's complete state as bytes (FMI 2.0, sec. 2.1.8): `fmi2GetFMUstate`,
+    /// `fmi2SerializedFMUstateSize`, `fmi2SerializeFMUstate`, then `fmi2FreeFMUstate` (also when
+    /// serializing fails). The bytes are the FMU's own format; [`Self::restore_state`] of an
+    /// instance of the same FMU takes them back. An FMU without canGetAndSetFMUstate or
+    /// canSerializeFMUstate is refused before any call.
+    pub fn serialize_state(&mut self) -> Result<Vec<u8>> {
+        self.require_state_support()?;
+        let mut state: fmi2FMUstate = std::ptr::null_mut();
+        let s = unsafe { (self.core.lib.api.fmi2GetFMUstate)(self.core.comp, &mut state) };
+        if let Err(e) = self.core.check("fmi2GetFMUstate", s, None) {
+            let _ = self.free_state(&mut state);
+            return Err(e);
+        }
+        let bytes = self.serialize_held(state);
+        let freed = self.free_state(&mut state);
+        let bytes = bytes?;
+        freed?;
+        Ok(bytes)
+    }
+
+    /// Sets the instance to a state from [`Self::serialize_state`] (FMI 2.0, sec. 2.1.8):
+    /// `fmi2DeSerializeFMUstate`, `fmi2SetFMUstate`, then `fmi2FreeFMUstate`.
+    pub fn restore_state(&mut self, bytes: &[u8]) -> Result<()> {
+        self.require_state_support()?;
+        let mut state: fmi2FMUstate = std::ptr::null_mut();
+        let s = unsafe {
+            (self.core.lib.api.fmi2DeSerializeFMUstate)(
+                self.core.comp,
+                bytes.as_ptr() as *const fmi2Byte,
+                bytes.len(),
+                &mut state,
+            )
+        };
+        if let Err(e) = self.core.check("fmi2DeSerializeFMUstate", s, None) {
+            let _ = self.free_state(&mut state);
+            return Err(e);
+        }
+        let s = unsafe { (self.core.lib.api.fmi2SetFMUstate)(self.core.comp, state) };
+        let set = self.core.check("fmi2SetFMUstate", s, None);
+        let freed = self.free_state(&mut state);
+        set?;
+        freed
+    }
+
+    /// The FMU declares both FMU-state capabilities, else an error naming the FMU.
+    fn require_state_support(&self) -> Result<()> {
+        match self.core.missing_state_capability {
+            None => Ok(()),
+            Some(cap) => Err(state_support_error(
+                &self.core.fmu_path,
+                &self.core.name,
+                cap,
+            )),
+        }
+    }
+
+    /// Serializes a state got by `fmi2GetFMUstate`.
+    fn serialize_held(&mut self, state: fmi2FMUstate) -> Result<Vec<u8>> {
+        let mut size = 0usize;
+        let s = unsafe {
+            (self.core.lib.api.fmi2SerializedFMUstateSize)(self.core.comp, state, &mut size)
+        };
+        self.core.check("fmi2SerializedFMUstateSize", s, None)?;
+        if size > MAX_STATE_BYTES {
+            return Err(Error::Other(format!(
+                "instance '{}': fmi2SerializedFMUstateSize reported {size} bytes, more than the {MAX_STATE_BYTES} accepted",
+                self.core.name
+            )));
+        }
+        let mut bytes = vec![0u8; size];
+        let s = unsafe {
+            (self.core.lib.api.fmi2SerializeFMUstate)(
+                self.core.comp,
+                state,
+                bytes.as_mut_ptr() as *mut fmi2Byte,
+                size,
+            )
+        };
+        self.core.check("fmi2SerializeFMUstate", s, None)?;
+        Ok(bytes)
+    }
+
+    /// `fmi2FreeFMUstate` of a state the FMU handed out (nothing for NULL or after fmi2Fatal).
+    fn free_state(&mut self, state: &mut fmi2FMUstate) -> Result<()> {
+        if state.is_null() || self.core.phase == Phase::Fatal {
+            return Ok(());
+        }
+        let s = unsafe { (self.core.lib.api.fmi2FreeFMUstate)(self.core.comp, state) };
+        self.core.check("fmi2FreeFMUstate", s, None)
     }
 
     /// `fmi2Terminate` then `fmi2FreeInstance`.

@@ -1,8 +1,12 @@
-//! The `shipsim` command line: `run`, `check`, `inspect`, `export-osp`, `plot`.
+//! The `shipsim` command line: `run`, `check`, `inspect`, `export-osp`, `plot`, `campaign`.
+mod cli;
+
 use clap::{Parser, Subcommand};
 use shipsim::error::Error;
 use shipsim::fmu::UnpackedFmu;
-use shipsim::run::{prepare, run, Output, RunOptions};
+use shipsim::run::{
+    checkpoint_step, prepare, resume, run, Checkpoint, CheckpointRequest, Output, RunOptions,
+};
 use shipsim::system::{Algorithm, System};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -46,6 +50,14 @@ enum Command {
         /// No progress bar and no summary.
         #[arg(long, short)]
         quiet: bool,
+        /// Write a checkpoint to FILE when the run passes t = T (a base-step point strictly
+        /// inside the run) and go on to the end.
+        #[arg(long, num_args = 2, value_names = ["T", "FILE"])]
+        checkpoint_at: Option<Vec<String>>,
+        /// Continue from a checkpoint of this system (same system file, --set and
+        /// --stop-time); the output has the rows from the checkpoint's time on.
+        #[arg(long, value_name = "FILE")]
+        resume: Option<PathBuf>,
     },
     /// Validate a system without running it.
     Check {
@@ -75,6 +87,11 @@ enum Command {
         #[arg(long, short)]
         output: PathBuf,
     },
+    /// Campaigns: many runs over factors, seeds and arms, one KPI row per run.
+    Campaign {
+        #[command(subcommand)]
+        command: cli::campaign::CampaignCommand,
+    },
     /// Write an OSP OspSystemStructure.xml for a native system file (runs in libcosim).
     ExportOsp {
         system: PathBuf,
@@ -88,6 +105,10 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     match dispatch(cli.command) {
         Ok(()) => ExitCode::SUCCESS,
+        Err(Error::Interrupted { time }) if time.is_nan() => {
+            eprintln!("interrupted; finished runs are kept, run the same command again to resume");
+            ExitCode::from(130)
+        }
         Err(Error::Interrupted { time }) => {
             eprintln!(
                 "interrupted at t = {time} s; instances terminated and freed, output flushed"
@@ -123,7 +144,13 @@ fn dispatch(cmd: Command) -> shipsim::Result<()> {
             algorithm,
             verbose,
             quiet,
+            checkpoint_at,
+            resume,
         } => {
+            let checkpoints = Checkpoints {
+                at: checkpoint_at.map(parse_checkpoint_at).transpose()?,
+                resume,
+            };
             let mut sys = System::load(&system)?;
             sys.apply_overrides(&set)?;
             if let Some(t) = stop_time {
@@ -132,10 +159,23 @@ fn dispatch(cmd: Command) -> shipsim::Result<()> {
             if let Some(a) = algorithm {
                 sys.algorithm = parse_algorithm(&a)?;
             }
-            run_cli(&sys, output, verbose, quiet)
+            run_cli(&sys, output, verbose, quiet, checkpoints)
         }
         Command::ExportOsp { system, output } => export_osp(&system, output),
+        Command::Campaign { command } => cli::campaign::dispatch(command, ctrl_c_flag),
     }
+}
+
+/// A flag that the first Ctrl-C sets (to stop cleanly); a second one exits at once.
+fn ctrl_c_flag() -> Arc<AtomicBool> {
+    let flag = Arc::new(AtomicBool::new(false));
+    let f = flag.clone();
+    let _ = ctrlc::set_handler(move || {
+        if f.swap(true, Ordering::SeqCst) {
+            std::process::exit(130);
+        }
+    });
+    flag
 }
 
 /// `shipsim plot`: one panel per --panel, columns against time.
@@ -216,6 +256,25 @@ fn parse_algorithm(a: &str) -> shipsim::Result<Algorithm> {
     }
 }
 
+/// `shipsim run --checkpoint-at T FILE` and `--resume FILE`.
+struct Checkpoints {
+    at: Option<(f64, PathBuf)>,
+    resume: Option<PathBuf>,
+}
+
+/// `--checkpoint-at T FILE` (clap gives exactly two values).
+fn parse_checkpoint_at(v: Vec<String>) -> shipsim::Result<(f64, PathBuf)> {
+    let [t, file] = <[String; 2]>::try_from(v)
+        .map_err(|_| Error::Other("--checkpoint-at: expected T FILE".into()))?;
+    let time = t.trim().parse::<f64>().ok().filter(|x| x.is_finite());
+    let time = time.ok_or_else(|| {
+        Error::Other(format!(
+            "--checkpoint-at {t} {file}: T must be a time in seconds"
+        ))
+    })?;
+    Ok((time, PathBuf::from(file)))
+}
+
 /// `shipsim run`: Ctrl-C stops the run cleanly (a second one exits at once); warnings, then
 /// the run, then its summary on stderr.
 fn run_cli(
@@ -223,6 +282,7 @@ fn run_cli(
     output: Option<PathBuf>,
     verbose: bool,
     quiet: bool,
+    checkpoints: Checkpoints,
 ) -> shipsim::Result<()> {
     let begin = Instant::now();
     let out_file = output.or_else(|| sys.output.file.clone());
@@ -240,17 +300,39 @@ fn run_cli(
             }
         });
     }
-    let opts = RunOptions {
+    let mut opts = RunOptions {
         verbose,
         progress: !quiet && std::io::stderr().is_terminal(),
         interrupt: Some(flag),
         log_sink: None,
+        checkpoint: None,
     };
     let (plan, fmus) = prepare(sys)?;
     print_warnings(&plan.warnings);
-    let mut summary = run(&plan, &fmus, out, &opts)?;
+    if let Some((t, file)) = &checkpoints.at {
+        let step = checkpoint_step(&plan, *t)
+            .map_err(|e| Error::Other(format!("--checkpoint-at: {e}")))?;
+        opts.checkpoint = Some(CheckpointRequest {
+            step,
+            file: file.clone(),
+        });
+    }
+    let mut summary = match &checkpoints.resume {
+        None => run(&plan, &fmus, out, &opts)?,
+        Some(file) => {
+            let cp = Checkpoint::read(file)?;
+            cp.check_plan(&plan, &fmus).map_err(|e| Error::Checkpoint {
+                file: file.clone(),
+                message: e.to_string(),
+            })?;
+            resume(&plan, &fmus, &cp, out, &opts)?
+        }
+    };
     summary.total_wall_time = begin.elapsed();
     if !quiet {
+        if let Some((t, file)) = &checkpoints.at {
+            eprintln!("checkpoint at t = {t} s written to {}", file.display());
+        }
         eprintln!("{summary}");
     }
     Ok(())

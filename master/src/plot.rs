@@ -99,7 +99,9 @@ impl Table {
     }
 }
 
-fn register_font() {
+/// Registers the embedded DejaVu Sans as plotters' "sans-serif" (once per process). Every PNG
+/// plot of the crate ([`plot_panels`], [`crate::campaign::plot`]) draws text with it.
+pub(crate) fn register_font() {
     static ONCE: Once = Once::new();
     ONCE.call_once(|| {
         // The embedded font is valid; if registration failed, text would simply not render.
@@ -111,7 +113,8 @@ fn register_font() {
     });
 }
 
-const COLORS: [RGBColor; 6] = [
+/// Series colours, in order: matplotlib's "tab10" blue, red, green, orange and purple, then grey.
+pub(crate) const COLORS: [RGBColor; 6] = [
     RGBColor(31, 119, 180),
     RGBColor(214, 39, 40),
     RGBColor(44, 160, 44),
@@ -124,16 +127,22 @@ fn draw_err<E: std::fmt::Debug>(path: &Path) -> impl Fn(E) -> Error + '_ {
     move |e| Error::Other(format!("drawing {}: {e:?}", path.display()))
 }
 
+/// Creates the folder that will hold `path` (and its parents) when it does not exist.
+pub(crate) fn create_parent_dir(path: &Path) -> Result<()> {
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir)
+            .map_err(|e| Error::io(format!("cannot create {}", dir.display()), e))?;
+    }
+    Ok(())
+}
+
 /// Draws the panels one above the other against time and writes a PNG.
 pub fn plot_panels(path: &Path, title: &str, panels: &[Panel]) -> Result<()> {
     if panels.is_empty() {
         return Err(Error::Other("nothing to plot".into()));
     }
     register_font();
-    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir)
-            .map_err(|e| Error::io(format!("cannot create {}", dir.display()), e))?;
-    }
+    create_parent_dir(path)?;
     let height = 60 + 260 * panels.len() as u32;
     let root = BitMapBackend::new(path, (1100, height)).into_drawing_area();
     let err = draw_err(path);

@@ -1,20 +1,27 @@
 //! Standard manoeuvres: rudder-command generators (step / turning circle, zig-zag a/b, pull-out)
-//! and the metrics computed from a recorded run (turning circle and zig-zag).
+//! and the metrics of a run (turning circle and zig-zag), from a recorded run ([`turning_circle`],
+//! [`zigzag`]) or on the fly, one sample at a time ([`TurningCircleTracker`], [`ZigZagTracker`]),
+//! and the IMO MSC.137(76) criteria on them ([`imo`]).
 //!
 //! # Source
 //! The MSS toolbox (`LIBRARY/maneuvering/turncircle.m`, `zigzag.m`,
-//! `mssExamples/exTurnCircle.m`, `exZigZag.m`), the ITTC/IMO definitions and IMO MSC.137(76).
+//! `mssExamples/exTurnCircle.m`, `exZigZag.m`), the ITTC/IMO definitions and IMO MSC.137(76)
+//! (the definitions in its Annex, sec. 4.2; the criteria in sec. 5.3).
 //!
 //! # Definitions and the readings taken
 //! Let t_e be the execute time, (x_e, y_e, ψ_e) the position and heading there. The *original
 //! course* is ψ_e; "along" and "perpendicular" are measured in that direction, the heading change
 //! is Δψ = ψ − ψ_e (the heading is continuous, not wrapped).
-//! * **Advance**: along-course distance from the execute point when |Δψ| = 90°.
-//! * **Transfer**: |perpendicular distance| at |Δψ| = 90°.
-//! * **Tactical diameter**: |perpendicular distance| at |Δψ| = 180°.
-//! * **Steady turning diameter** D_s = 2U_ss/|ψ̇_ss| with ψ̇ from the heading samples at the end of
-//!   the run (the true path radius of the steady turn). MSS reports U/|r| at the final time,
-//!   which is slightly smaller with roll (ψ̇ = r cos φ); it is given as `steady_diameter_mss`.
+//! * **Advance**: along-course distance from the execute point when |Δψ| = 90°
+//!   (MSC.137(76), Annex 4.2.3).
+//! * **Transfer**: |perpendicular distance| at |Δψ| = 90° (ITTC).
+//! * **Tactical diameter**: |perpendicular distance| at |Δψ| = 180° (MSC.137(76), Annex 4.2.4).
+//! * **Steady turning diameter** D_s = 2U_ss/|ψ̇_ss| with ψ̇ = Δψ/Δt over the final sample
+//!   interval and U_ss the mean speed of its two samples (the true path radius of the steady
+//!   turn). MSS reports U/|r| at the final time, which is slightly smaller with roll
+//!   (ψ̇ = r cos φ); it is given as `steady_diameter_mss`. (Until the streaming trackers, ψ̇ was
+//!   taken over the final 1 % of the samples, a look-back that grows with the run; on the
+//!   published runs the two readings agree within 2.4e-10 relative, see the tracker tests.)
 //! * **Steady speed loss**: (U_approach − U_ss)/U_approach, U_approach = U at execute.
 //! * **Steady heel** φ_ss and drift angle β_ss at the final sample; also the transient peak heel
 //!   (largest |φ| after execute) and the initial inward heel (extremum of the sign opposite to the
@@ -32,9 +39,12 @@
 //! Metrics (with s = sign(a), all angles as s·Δψ so that a port-first test reads like a
 //! starboard-first one):
 //! * **Second execute**: first time s·Δψ reaches +b (interpolated); **initial turning time** =
-//!   second execute − t_e.
-//! * **First overshoot angle**: max s·Δψ after the second execute, minus b; its time.
-//! * **Second overshoot angle**: |min s·Δψ after the third execute (s·Δψ reaching −b)| − b.
+//!   second execute − t_e (MSC.137(76), Annex 4.2.6); the track run until then (with a = b = 10°
+//!   the distance of the initial turning ability, sec. 5.3.2).
+//! * **First overshoot angle**: max s·Δψ after the second execute, minus b; its time
+//!   (MSC.137(76), Annex 4.2.7).
+//! * **Second overshoot angle**: |min s·Δψ after the third execute (s·Δψ reaching −b)| − b
+//!   (MSC.137(76), Annex 4.2.8).
 //! * **Period**: time between the first two upward crossings of +b.
 //!
 //! The times from each reversal (second, third execute) to the following overshoot peak
@@ -44,7 +54,13 @@ use serde::{Deserialize, Serialize};
 
 use crate::hull::container_ship::{ContainerShip, ContainerShipInputs};
 use crate::hull::mariner::{Mariner, MarinerInputs};
+#[cfg(test)]
 use crate::hull::DEG;
+
+pub mod imo;
+mod tracker;
+
+pub use tracker::{TurningCircleTracker, ZigZagTracker};
 
 /// Rudder-command generator of the standard tests (the model of the `Manoeuvre` FMU).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -208,6 +224,9 @@ pub struct ZigZagMetrics {
     pub second_time_to_check: f64,
     /// Time between the first two upward crossings of +b [s] (NaN if the run is too short).
     pub period: f64,
+    /// Track distance [m] run from the first to the second execute: with a = b = 10° the
+    /// distance of the IMO initial turning ability ([`imo::check_initial_turning`]).
+    pub track_to_second_execute: f64,
 }
 
 /// Errors of the metric computations.
@@ -234,10 +253,33 @@ fn lerp(a: f64, b: f64, f: f64) -> f64 {
     a + (b - a) * f
 }
 
+/// Whether a sample at time `t` is at or after the execute time `t_e` (within 1e-9 s: a time
+/// accumulated from k·h may fall a round-off short of t_e).
+fn is_executed(t: f64, t_e: f64) -> bool {
+    t >= t_e - 1e-9
+}
+
+/// Upward crossing of `level` between consecutive values `a` and `b` (a < level ≤ b): the
+/// fraction in [0, 1] of the interval at which it is reached, by linear interpolation.
+fn crossing_fraction(a: f64, b: f64, level: f64) -> Option<f64> {
+    (a < level && b >= level).then(|| (level - a) / (b - a))
+}
+
+/// Length of the straight track segment between two samples [m].
+fn segment(a: &Sample, b: &Sample) -> f64 {
+    ((b.x - a.x).powi(2) + (b.y - a.y).powi(2)).sqrt()
+}
+
+/// The part of a track segment of length `seg` run until `level` is reached, the value going
+/// from `a` to `b` along it (linear interpolation).
+fn segment_to(seg: f64, a: f64, b: f64, level: f64) -> f64 {
+    seg * (level - a) / (b - a)
+}
+
 /// Index of the execute sample: the first with t ≥ t_e (within 1e-9 s).
 fn execute_index(s: &[Sample], t_e: f64) -> Result<usize, MetricError> {
     s.iter()
-        .position(|p| p.t >= t_e - 1e-9)
+        .position(|p| is_executed(p.t, t_e))
         .ok_or(MetricError::NoExecute)
 }
 
@@ -249,101 +291,19 @@ fn crossing<F: Fn(&Sample) -> f64>(
     level: f64,
     g: F,
 ) -> Option<(usize, f64)> {
-    for k in (from + 1)..s.len() {
-        let (a, b) = (g(&s[k - 1]), g(&s[k]));
-        if a < level && b >= level {
-            return Some((k, (level - a) / (b - a)));
-        }
-    }
-    None
+    ((from + 1)..s.len())
+        .find_map(|k| crossing_fraction(g(&s[k - 1]), g(&s[k]), level).map(|f| (k, f)))
 }
 
-/// Turning-circle metrics from a recorded run with the rudder executed at `t_execute`.
+/// Turning-circle metrics from a recorded run with the rudder executed at `t_execute`: the
+/// samples fed one by one into a [`TurningCircleTracker`], which is the implementation.
 /// The run must be long enough for the 180° event and a steady turn at its end.
 pub fn turning_circle(s: &[Sample], t_execute: f64) -> Result<TurningCircleMetrics, MetricError> {
-    let ke = execute_index(s, t_execute)?;
-    let e = s[ke];
-    let (c0, s0) = (e.psi.cos(), e.psi.sin());
-    let along = |p: &Sample| (p.x - e.x) * c0 + (p.y - e.y) * s0;
-    let perp = |p: &Sample| -(p.x - e.x) * s0 + (p.y - e.y) * c0;
-    let last = *s.last().unwrap();
-    let turn_sign = if last.psi >= e.psi { 1.0 } else { -1.0 };
-    let dpsi = |p: &Sample| turn_sign * (p.psi - e.psi);
-
-    let at = |level: f64, name: &'static str| -> Result<(f64, f64, f64), MetricError> {
-        let (k, f) = crossing(s, ke, level, dpsi).ok_or(MetricError::EventNotReached(name))?;
-        let (a, b) = (&s[k - 1], &s[k]);
-        Ok((
-            lerp(along(a), along(b), f),
-            lerp(perp(a), perp(b), f).abs(),
-            lerp(a.t, b.t, f) - e.t,
-        ))
-    };
-    let (advance, transfer, t90) = at(90.0 * DEG, "90 deg heading change")?;
-    let (_, tactical, t180) = at(180.0 * DEG, "180 deg heading change")?;
-
-    // Track length to 10°.
-    let mut track = 0.0;
-    let mut track10 = f64::NAN;
-    for k in (ke + 1)..s.len() {
-        let seg = ((s[k].x - s[k - 1].x).powi(2) + (s[k].y - s[k - 1].y).powi(2)).sqrt();
-        let (a, b) = (dpsi(&s[k - 1]), dpsi(&s[k]));
-        if a < 10.0 * DEG && b >= 10.0 * DEG {
-            track10 = track + seg * (10.0 * DEG - a) / (b - a);
-            break;
-        }
-        track += seg;
+    let mut tracker = TurningCircleTracker::new(t_execute);
+    for p in s {
+        tracker.push(p);
     }
-
-    let mut max_adv = f64::NEG_INFINITY;
-    let mut max_tr: f64 = 0.0;
-    let mut peak = 0.0f64;
-    let mut peak_t = e.t;
-    for p in &s[ke..] {
-        max_adv = max_adv.max(along(p));
-        max_tr = max_tr.max(perp(p).abs());
-        if p.roll.abs() > peak.abs() {
-            peak = p.roll;
-            peak_t = p.t;
-        }
-    }
-    let steady_heel = last.roll;
-    let mut inward = 0.0f64;
-    for p in &s[ke..] {
-        if p.roll * steady_heel < 0.0 && p.roll.abs() > inward.abs() {
-            inward = p.roll;
-        }
-    }
-    // Heading rate over the last samples (central difference over the final 1 % of the run,
-    // at least one sample interval).
-    let n = s.len();
-    let back = ((n - ke) / 100).max(1);
-    let p0 = &s[n - 1 - back];
-    let psidot = (last.psi - p0.psi) / (last.t - p0.t);
-    let u_ss = 0.5 * (last.speed + p0.speed);
-    Ok(TurningCircleMetrics {
-        t_execute: e.t,
-        approach_speed: e.speed,
-        advance,
-        time_to_90: t90,
-        transfer,
-        tactical_diameter: tactical,
-        time_to_180: t180,
-        max_advance: max_adv,
-        max_transfer: max_tr,
-        steady_diameter: 2.0 * u_ss / psidot.abs(),
-        steady_diameter_mss: 2.0 * last.speed / last.r.abs(),
-        steady_speed: last.speed,
-        speed_loss: (e.speed - last.speed) / e.speed,
-        steady_yaw_rate: last.r,
-        steady_heading_rate: psidot,
-        steady_heel,
-        steady_drift: last.drift,
-        peak_heel: peak,
-        peak_heel_time: peak_t,
-        initial_inward_heel: inward,
-        track_to_10deg: track10,
-    })
+    tracker.finish()
 }
 
 /// Zig-zag metrics from a recorded run: first rudder `rudder_sign` (its sign only matters),
@@ -367,6 +327,9 @@ pub fn zigzag(
     let (k3, f3) =
         crossing(s, k2, check, nd).ok_or(MetricError::EventNotReached("third execute"))?;
     let t3 = time_at(k3, f3);
+    // Track run from the first to the second execute.
+    let track = (ke + 1..k2).fold(0.0, |sum, k| sum + segment(&s[k - 1], &s[k]));
+    let track2 = track + segment_to(segment(&s[k2 - 1], &s[k2]), d(&s[k2 - 1]), d(&s[k2]), check);
     // First overshoot: max d between the second and the third execute.
     let (mut m1, mut tm1) = (f64::NEG_INFINITY, t2);
     for p in &s[k2..k3] {
@@ -401,19 +364,14 @@ pub fn zigzag(
         second_overshoot_time: tm2,
         second_time_to_check: tm2 - t3,
         period,
+        track_to_second_execute: track2,
     })
 }
 
-/// IMO MSC.137(76) 10/10 first-overshoot limit [rad] for L/U [s].
+/// IMO MSC.137(76) 10/10 first-overshoot limit [rad] for L/U [s]: the same as
+/// [`imo::first_overshoot_limit_10_10`], kept under its first name.
 pub fn imo_10_10_first_overshoot_limit(l_over_u: f64) -> f64 {
-    let deg = if l_over_u < 10.0 {
-        10.0
-    } else if l_over_u >= 30.0 {
-        20.0
-    } else {
-        5.0 + 0.5 * l_over_u
-    };
-    deg * DEG
+    imo::first_overshoot_limit_10_10(l_over_u)
 }
 
 /// A ship that can be driven by a [`ManoeuvreGenerator`].
@@ -506,13 +464,11 @@ mod tests {
     use super::*;
     use std::f64::consts::PI;
 
-    /// A synthetic steady circle (constant speed U, rate ω, executed at t = 0 with no transient):
-    /// advance = transfer = R, tactical diameter = 2R, steady diameter = 2R.
-    #[test]
-    fn ideal_circle() {
-        let (u, w) = (5.0, 0.02);
+    /// A steady circle at speed `u` [m/s] and rate `w` [rad/s] from t = 0, sampled every 0.1 s
+    /// for 400 s.
+    pub(super) fn circle_run(u: f64, w: f64) -> Vec<Sample> {
         let r = u / w;
-        let s: Vec<Sample> = (0..=4000)
+        (0..=4000)
             .map(|i| {
                 let t = i as f64 * 0.1;
                 let psi = w * t;
@@ -526,7 +482,31 @@ mod tests {
                     ..Default::default()
                 }
             })
-            .collect();
+            .collect()
+    }
+
+    /// ψ = A sin(ωt), sampled every 0.05 s for 400 s.
+    pub(super) fn sine_zigzag_run(a: f64, w: f64) -> Vec<Sample> {
+        (0..=8000)
+            .map(|i| {
+                let t = i as f64 * 0.05;
+                Sample {
+                    t,
+                    psi: a * (w * t).sin(),
+                    r: a * w * (w * t).cos(),
+                    ..Default::default()
+                }
+            })
+            .collect()
+    }
+
+    /// A synthetic steady circle (constant speed U, rate ω, executed at t = 0 with no transient):
+    /// advance = transfer = R, tactical diameter = 2R, steady diameter = 2R.
+    #[test]
+    fn ideal_circle() {
+        let (u, w) = (5.0, 0.02);
+        let r = u / w;
+        let s = circle_run(u, w);
         let m = turning_circle(&s, 0.0).unwrap();
         assert!((m.advance - r).abs() < 1e-3 * r);
         assert!((m.transfer - r).abs() < 1e-3 * r);
@@ -542,17 +522,7 @@ mod tests {
     #[test]
     fn ideal_zigzag() {
         let (a, w, b) = (15.0 * DEG, 0.05, 10.0 * DEG);
-        let s: Vec<Sample> = (0..=8000)
-            .map(|i| {
-                let t = i as f64 * 0.05;
-                Sample {
-                    t,
-                    psi: a * (w * t).sin(),
-                    r: a * w * (w * t).cos(),
-                    ..Default::default()
-                }
-            })
-            .collect();
+        let s = sine_zigzag_run(a, w);
         let m = zigzag(&s, 0.0, 1.0, b).unwrap();
         assert!((m.second_execute - (b / a).asin() / w).abs() < 1e-3);
         assert!((m.first_overshoot - (a - b)).abs() < 1e-6);
@@ -597,13 +567,15 @@ mod tests {
     fn print_zz(name: &str, m: &ZigZagMetrics) {
         println!(
             "{name}: initial turning time {:.2} s, 1st overshoot {:.3} deg at {:.2} s, \
-             2nd overshoot {:.3} deg at {:.2} s, period {:.2} s",
+             2nd overshoot {:.3} deg at {:.2} s, period {:.2} s, track to the second execute \
+             {:.1} m",
             m.initial_turning_time,
             m.first_overshoot / DEG,
             m.first_overshoot_time,
             m.second_overshoot / DEG,
             m.second_overshoot_time,
-            m.period
+            m.period,
+            m.track_to_second_execute
         );
     }
 
@@ -646,12 +618,15 @@ mod tests {
     ///   (steady speed loss 20.5 %), steady heel −5.04° (outward), transient peak heel −6.72° at
     ///   t = 92.1 s, initial inward heel +0.36°, steady drift −6.93°, 90° after 171.4 s, 180° after
     ///   333.6 s, track to 10° heading change 274.9 m (1.57 L). The IMO turning criteria are not
-    ///   met, as expected with the 10° rudder limit of the model (IMO assumes 35°).
+    ///   met, as expected with the 10° rudder limit of the model (IMO assumes 35°); the initial
+    ///   turning (10° rudder, 2.5 L) is.
     /// * 10/10 zig-zag: initial turning time 33.04 s, first overshoot 3.78° (peak at 59.1 s),
-    ///   second overshoot 5.07° (peak at 144.2 s), period 167.8 s. IMO limits for L/U = 20.89 s:
-    ///   15.45° and 30.45°: met.
+    ///   second overshoot 5.07° (peak at 144.2 s), period 167.8 s, track to the second execute
+    ///   274.9 m (1.57 L, the same as in the turn). IMO limits for L/U = 20.89 s: 15.45° and
+    ///   33.17° (17.5 + 0.75 L/U; printed as 30.45° = first + 15° before the IMO API): met.
     /// * 20/20 zig-zag (10° effective rudder, 20° check): initial turning time 51.63 s, first
-    ///   overshoot 5.08° (82.5 s), second overshoot 5.36° (205.4 s), period 247.3 s.
+    ///   overshoot 5.08° (82.5 s), second overshoot 5.36° (205.4 s), period 247.3 s (IMO 20/20
+    ///   limit 25°: met).
     #[test]
     fn container_ship_manoeuvres() {
         let l = crate::hull::container_ship::L;
@@ -683,14 +658,11 @@ mod tests {
         assert!(m.initial_inward_heel > 0.0, "inverse initial roll");
         assert!(m.speed_loss > 0.0 && m.speed_loss < 0.5);
         assert!(m.steady_diameter_mss < m.steady_diameter);
-        println!(
-            "  IMO turning criteria (advance < 4.5 L, tactical diameter < 5 L): {}",
-            if m.advance < 4.5 * l && m.tactical_diameter < 5.0 * l {
-                "met"
-            } else {
-                "NOT met"
-            }
-        );
+        // IMO with the model's 10° rudder limit: turning not met, initial turning met.
+        let turning = imo::check_turning(&m, l).unwrap();
+        let initial = imo::check_initial_turning(m.track_to_10deg, l).unwrap();
+        println!("  IMO turning: {turning:?}; initial turning: {initial:?}");
+        assert!(!turning.advance_pass && !turning.tactical_diameter_pass && initial.pass);
 
         // Forward Euler, h = 0.01 s, written here (MSS's integrator), same rudder logic.
         let params = crate::hull::container_ship::ContainerShipParams::default();
@@ -736,7 +708,6 @@ mod tests {
             assert!((a - b).abs() < 5e-3 * b.abs(), "Euler {a} vs RK4 {b}");
         }
 
-        let lu = l / ContainerShip::straight_line_speed(80.0);
         for (a, b, name) in [
             (10.0, 10.0, "container 10/10 zig-zag"),
             (20.0, 20.0, "container 20/20 (10/20 sat.) zig-zag"),
@@ -765,14 +736,34 @@ mod tests {
             assert!((z.first_overshoot - res[1].first_overshoot).abs() < 0.05 * DEG);
             assert!((z.initial_turning_time - res[1].initial_turning_time).abs() < 0.02);
             assert!(z.first_overshoot > 0.0 && z.second_overshoot > 0.0);
-            if a == 10.0 {
-                let lim = imo_10_10_first_overshoot_limit(lu);
-                println!(
-                    "  IMO 10/10 limits (L/U = {lu:.2} s): 1st {:.2} deg, 2nd {:.2} deg",
-                    lim / DEG,
-                    lim / DEG + 15.0
-                );
-            }
+            imo_zigzag(&z, a, l, ContainerShip::straight_line_speed(80.0));
+        }
+    }
+
+    /// Prints the IMO checks of a zig-zag and asserts that they are met (the 10/10 one also for
+    /// the initial turning, from the track to the second execute).
+    fn imo_zigzag(z: &ZigZagMetrics, a: f64, l: f64, u: f64) {
+        if a == 10.0 {
+            let c = imo::check_zigzag_10_10(z, l, u).unwrap();
+            let initial = imo::check_initial_turning(z.track_to_second_execute, l).unwrap();
+            println!(
+                "  IMO 10/10 limits (L/U = {:.2} s): 1st {:.2} deg, 2nd {:.2} deg: {}; initial \
+                 turning {:.2} L (limit 2.5 L): {}",
+                c.l_over_u,
+                c.first_overshoot_limit / DEG,
+                c.second_overshoot_limit / DEG,
+                if c.pass { "met" } else { "NOT met" },
+                z.track_to_second_execute / l,
+                if initial.pass { "met" } else { "NOT met" },
+            );
+            assert!(c.pass && initial.pass);
+        } else {
+            let c = imo::check_zigzag_20_20(z);
+            println!(
+                "  IMO 20/20 limit 25 deg: {}",
+                if c.pass { "met" } else { "NOT met" }
+            );
+            assert!(c.pass);
         }
     }
 
@@ -788,7 +779,8 @@ mod tests {
     ///   after 258.5 s, track to 10° 146.1 m (0.91 L). IMO: advance met, tactical diameter
     ///   (< 5 L) not met.
     /// * 10/10 zig-zag: initial turning time 30.37 s, first overshoot 4.93° (60.1 s), second
-    ///   overshoot 4.47° (148.7 s), period 172.2 s (IMO limit 15.43° for L/U = 20.85 s: met).
+    ///   overshoot 4.47° (148.7 s), period 172.2 s, track to the second execute 233.7 m
+    ///   (1.45 L) (IMO limits 15.43° and 33.14° for L/U = 20.85 s, initial turning 2.5 L: met).
     /// * 20/20 zig-zag: initial turning time 34.48 s, first overshoot 7.80° (62.6 s), second
     ///   overshoot 6.35° (164.5 s), period 203.7 s (IMO 20/20 limit 25°: met).
     #[test]
@@ -812,16 +804,10 @@ mod tests {
             (m.steady_diameter - m.steady_diameter_mss).abs() < 1e-6 * dgeo,
             "no roll"
         );
-        println!(
-            "  IMO turning criteria (advance < 4.5 L, tactical diameter < 5 L): {}",
-            if m.advance < 4.5 * l && m.tactical_diameter < 5.0 * l {
-                "met"
-            } else {
-                "NOT met"
-            }
-        );
+        let turning = imo::check_turning(&m, l).unwrap();
+        println!("  IMO turning: {turning:?}");
+        assert!(turning.advance_pass && !turning.tactical_diameter_pass);
         assert!(m.speed_loss > 0.0);
-        let lu = l / u0;
         for (a, b, name) in [
             (10.0, 10.0, "Mariner 10/10 zig-zag"),
             (20.0, 20.0, "Mariner 20/20 zig-zag"),
@@ -839,13 +825,7 @@ mod tests {
             let z = zigzag(&s, 10.0, 1.0, b * DEG).unwrap();
             print_zz(name, &z);
             assert!(z.first_overshoot > 0.0 && z.second_overshoot > 0.0);
-            if a == 10.0 {
-                let lim = imo_10_10_first_overshoot_limit(lu);
-                println!(
-                    "  IMO 10/10 limit (L/U = {lu:.2} s): 1st {:.2} deg",
-                    lim / DEG
-                );
-            }
+            imo_zigzag(&z, a, l, u0);
         }
     }
 }

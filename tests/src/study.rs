@@ -9,11 +9,20 @@
 //!
 //! A study is `fn(&Env) -> Result<Report, String>`; register it in [`crate::studies::STUDIES`].
 
+use shipsim::campaign::table::Table as CampaignTable;
+use shipsim::campaign::{execute, Campaign, CampaignOptions, CampaignOutcome, CampaignSpec};
 use shipsim::plot::{plot_panels, Panel, Series, Table};
 use shipsim::run::{run_system, Output, RunOptions};
 use shipsim::system::System;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
+
+/// A campaign run by a study ([`Env::campaign`]).
+pub struct CampaignResult {
+    pub outcome: CampaignOutcome,
+    pub runs: CampaignTable,
+    pub derived: CampaignTable,
+}
 
 /// Where the FMUs, system files and outputs are.
 #[derive(Clone, Debug)]
@@ -65,6 +74,41 @@ impl Env {
         csv: &str,
         steps: Option<u64>,
     ) -> Result<Table, String> {
+        let mut system = self.system(file)?;
+        system.apply_overrides(sets).map_err(|e| e.to_string())?;
+        if let Some(n) = steps {
+            system.stop_time = Some(system.start_time + n as f64 * system.step_size);
+        }
+        std::fs::create_dir_all(&self.out_dir).map_err(|e| e.to_string())?;
+        let out = self.out_dir.join(csv);
+        run_system(&system, Output::File(out.clone()), &RunOptions::default())
+            .map_err(|e| format!("{file}: {e}"))?;
+        Table::read(&out).map_err(|e| e.to_string())
+    }
+
+    /// Runs `campaigns/<file>` on `systems/<system>` (FMUs from [`Env::fmu_dir`]) afresh into
+    /// `<out_dir>/campaign`; returns the outcome, the run table and the derived table.
+    pub fn campaign(&self, file: &str, system: &str) -> Result<CampaignResult, String> {
+        let spec = CampaignSpec::load(&self.root.join("campaigns").join(file))
+            .map_err(|e| e.to_string())?;
+        let campaign = Campaign::new(spec, self.system(system)?).map_err(|e| e.to_string())?;
+        let out = self.out_dir.join("campaign");
+        let _ = std::fs::remove_dir_all(&out);
+        let opts = CampaignOptions {
+            output: out.clone(),
+            ..Default::default()
+        };
+        let outcome = execute::run(&campaign, &opts).map_err(|e| e.to_string())?;
+        let read = |name: &str| CampaignTable::read(&out.join(name)).map_err(|e| e.to_string());
+        Ok(CampaignResult {
+            outcome,
+            runs: read("runs.parquet")?,
+            derived: read("derived.parquet")?,
+        })
+    }
+
+    /// `systems/<file>` with its FMU paths resolved by file name in [`Env::fmu_dir`].
+    pub fn system(&self, file: &str) -> Result<System, String> {
         let path = self.root.join("systems").join(file);
         let mut system = System::load(&path).map_err(|e| e.to_string())?;
         for inst in &mut system.instances {
@@ -83,15 +127,7 @@ impl Env {
             }
             inst.fmu = candidate;
         }
-        system.apply_overrides(sets).map_err(|e| e.to_string())?;
-        if let Some(n) = steps {
-            system.stop_time = Some(system.start_time + n as f64 * system.step_size);
-        }
-        std::fs::create_dir_all(&self.out_dir).map_err(|e| e.to_string())?;
-        let out = self.out_dir.join(csv);
-        run_system(&system, Output::File(out.clone()), &RunOptions::default())
-            .map_err(|e| format!("{file}: {e}"))?;
-        Table::read(&out).map_err(|e| e.to_string())
+        Ok(system)
     }
 
     /// Draws a figure into the output folder; returns its path.

@@ -36,7 +36,7 @@ fn main() {
                  demo         run the default coupled system\n  \
                  report [DIR] run every coupled system and write the validation report (target/report)\n  \
                  export-osp   every system of systems/ as target/osp/<name>/OspSystemStructure.xml for libcosim\n  \
-                 bench        master overhead per FMU-step: shipsim vs libcosim vs FMPy (master/bench)\n  \
+                 bench        master overhead vs libcosim and FMPy, campaign throughput (docs/bench.md)\n  \
                  artifacts DIR          FMU model descriptions, system CSVs and report into DIR\n  \
                  artifacts --compare A B  byte-compare two artifact folders (refactor check)"
             );
@@ -235,17 +235,40 @@ fn export_osp() -> Result<()> {
 }
 
 /// Runs master/bench/bench_master.py in the project venv (extra arguments are passed on).
+/// `cargo xtask bench`: master overhead against libcosim and FMPy, and campaign throughput,
+/// fixed cost and warm-up forks; printed, and written to docs/bench.md (committed).
 fn bench(extra: &[String]) -> Result<()> {
     let root = workspace_root();
+    fmu::build_fmus(&root)?;
     run(cargo()
         .current_dir(&root)
         .args(["build", "--release", "-p", "shipsim", "--bins"]))?;
     let python = ensure_venv(&root)?;
-    run(Command::new(python)
-        .current_dir(&root)
-        .arg("master/bench/bench_master.py")
-        .args(extra)
-        .env("SHIPSIM_BIN", root.join("target/release/shipsim")))
+    let script = |name: &str, args: &[String]| -> Result<String> {
+        let out = Command::new(&python)
+            .current_dir(&root)
+            .arg(format!("master/bench/{name}"))
+            .args(args)
+            .env("SHIPSIM_BIN", root.join("target/release/shipsim"))
+            .stderr(std::process::Stdio::inherit())
+            .output()?;
+        let text = String::from_utf8_lossy(&out.stdout).into_owned();
+        print!("{text}");
+        if !out.status.success() {
+            bail!("master/bench/{name} failed with {}", out.status);
+        }
+        Ok(text)
+    };
+    let master = script("bench_master.py", extra)?;
+    let campaigns = script("bench_campaign.py", &[])?;
+    let doc = format!(
+        "# Benchmarks\n\nWritten by `cargo xtask bench` (do not edit by hand). Ratios are \
+         measured in one run on one machine; absolute times depend on it.\n\n\
+         ## Master overhead per FMU-step (master/bench/bench_master.py)\n\n```text\n{master}```\n\n{campaigns}"
+    );
+    std::fs::write(root.join("docs/bench.md"), doc)?;
+    println!("wrote docs/bench.md");
+    Ok(())
 }
 
 /// The built-in default system: rudder roll stabilization (systems/rrs.toml) with RRS off and

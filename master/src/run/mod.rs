@@ -10,6 +10,10 @@
 //!    on the communication points of [`time_grid`], each instance a [`slot`];
 //! 5. termination of every instance (here), so that a failing fmi2Terminate is reported.
 //!
+//! A run can stop at a communication point and hand back a [`Checkpoint`]
+//! ([`run_to_checkpoint`]), write one on passing a step and go on ([`RunOptions::checkpoint`]),
+//! or start from one in fresh instances ([`resume_with`]); [`checkpoint`] says what it holds.
+//!
 //! Clean termination holds on every path: an instance dropped on an error or an interrupt is
 //! terminated and freed ([`crate::instance`]). The step loop allocates nothing.
 //!
@@ -24,12 +28,13 @@ use crate::model_description::ModelDescription;
 use crate::system::{Algorithm as AlgorithmChoice, Plan, System};
 use std::collections::HashMap;
 use std::io::Write;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 pub mod algorithm;
+pub mod checkpoint;
 pub mod exchange;
 pub mod initialize;
 pub mod progress;
@@ -39,6 +44,8 @@ pub mod stepping;
 pub mod time_grid;
 
 use algorithm::{Algorithm, GaussSeidel, Jacobi};
+use checkpoint::Fingerprint;
+pub use checkpoint::{checkpoint_step, Checkpoint};
 use exchange::Exchange;
 pub use recorder::{ColumnInfo, CsvRecorder, MemoryRecorder, Recorder, Row, Sample};
 use stepping::{Recording, Stepper};
@@ -54,6 +61,16 @@ pub struct RunOptions {
     /// Set to true (e.g. by Ctrl-C) to stop the run cleanly.
     pub interrupt: Option<Arc<AtomicBool>>,
     pub log_sink: Option<LogSink>,
+    /// Write a checkpoint on passing a base step and continue ([`run_with`], [`resume_with`]).
+    pub checkpoint: Option<CheckpointRequest>,
+}
+
+/// Where and when a run writes its checkpoint.
+#[derive(Clone, Debug)]
+pub struct CheckpointRequest {
+    /// The base step k: the checkpoint is the run at t_k ([`checkpoint_step`] finds k for a time).
+    pub step: u64,
+    pub file: PathBuf,
 }
 
 /// What a run did.
@@ -154,18 +171,32 @@ pub enum Output {
 /// Runs a validated plan with loaded FMUs (`fmus[i]` for `plan.instances[i]`), recording into
 /// a CSV file or writer.
 pub fn run(plan: &Plan, fmus: &[Arc<Fmu>], output: Output, opts: &RunOptions) -> Result<Summary> {
+    into_csv(output, |rec| run_with(plan, fmus, rec, opts))
+}
+
+/// [`resume_with`] recording into a CSV file or writer: the rows from the checkpoint's time on.
+pub fn resume(
+    plan: &Plan,
+    fmus: &[Arc<Fmu>],
+    cp: &Checkpoint,
+    output: Output,
+    opts: &RunOptions,
+) -> Result<Summary> {
+    into_csv(output, |rec| resume_with(plan, fmus, cp, rec, opts))
+}
+
+/// Runs `f` with a CSV recorder on `output` (or none); the summary names the file.
+fn into_csv(
+    output: Output,
+    f: impl FnOnce(Option<&mut dyn Recorder>) -> Result<Summary>,
+) -> Result<Summary> {
     let (writer, path): (Option<Box<dyn Write>>, Option<PathBuf>) = match output {
         Output::None => (None, None),
         Output::File(p) => (Some(create_output_file(&p)?), Some(p)),
         Output::Writer(w) => (Some(w), None),
     };
     let mut csv = writer.map(CsvRecorder::new);
-    let mut summary = run_with(
-        plan,
-        fmus,
-        csv.as_mut().map(|r| r as &mut dyn Recorder),
-        opts,
-    )?;
+    let mut summary = f(csv.as_mut().map(|r| r as &mut dyn Recorder))?;
     summary.output_file = path;
     Ok(summary)
 }
@@ -181,28 +212,174 @@ fn create_output_file(p: &std::path::Path) -> Result<Box<dyn Write>> {
     Ok(Box::new(std::io::BufWriter::with_capacity(1 << 16, f)))
 }
 
-/// Runs a validated plan with loaded FMUs, recording into any [`Recorder`] (or none).
+/// Runs a validated plan with loaded FMUs, recording into any [`Recorder`] (or none). With
+/// [`RunOptions::checkpoint`] it writes a checkpoint on passing that step and goes on.
 pub fn run_with(
     plan: &Plan,
     fmus: &[Arc<Fmu>],
     recorder: Option<&mut dyn Recorder>,
     opts: &RunOptions,
 ) -> Result<Summary> {
+    let course = Course {
+        resume: None,
+        checkpoint: write_request(opts),
+    };
+    Ok(dispatch(plan, fmus, recorder, opts, course)?.0)
+}
+
+/// Runs a plan from t_0 to t_`at_step` and returns the checkpoint there: the state at that
+/// communication point after its outputs are published, before the events of step `at_step`.
+/// The recorder gets the rows a full run records up to and including t_`at_step`. The
+/// instances are terminated and freed. [`RunOptions::checkpoint`] is not used.
+pub fn run_to_checkpoint(
+    plan: &Plan,
+    fmus: &[Arc<Fmu>],
+    at_step: u64,
+    recorder: Option<&mut dyn Recorder>,
+    opts: &RunOptions,
+) -> Result<Checkpoint> {
+    let course = Course {
+        resume: None,
+        checkpoint: Some((at_step, Then::Return)),
+    };
+    dispatch(plan, fmus, recorder, opts, course)?
+        .1
+        .ok_or_else(|| Error::Other(format!("no checkpoint taken at step {at_step}")))
+}
+
+/// Continues a run from a checkpoint of the same system (else an error naming what differs,
+/// [`Checkpoint::check`]): fresh instances are instantiated and initialized as in a normal run,
+/// then every instance's state and the exchange's values are restored, and the step loop goes
+/// on from step `cp.step` to the end, applying the plan's events at that step and later. The
+/// recorder gets the row at t_`cp.step` first, then the rows a full run records after it. The
+/// plan may differ from the checkpoint's in its start values and events (a fork).
+pub fn resume_with(
+    plan: &Plan,
+    fmus: &[Arc<Fmu>],
+    cp: &Checkpoint,
+    recorder: Option<&mut dyn Recorder>,
+    opts: &RunOptions,
+) -> Result<Summary> {
+    let course = Course {
+        resume: Some(cp),
+        checkpoint: write_request(opts),
+    };
+    Ok(dispatch(plan, fmus, recorder, opts, course)?.0)
+}
+
+/// Where a run starts and whether it takes a checkpoint.
+struct Course<'c> {
+    /// Start from this checkpoint instead of t_0.
+    resume: Option<&'c Checkpoint>,
+    /// Take a checkpoint on passing this step.
+    checkpoint: Option<(u64, Then<'c>)>,
+}
+
+/// What to do with a checkpoint taken.
+#[derive(Clone, Copy)]
+enum Then<'c> {
+    /// Stop the run and return it.
+    Return,
+    /// Write it and go on.
+    Write(&'c Path),
+}
+
+fn write_request(opts: &RunOptions) -> Option<(u64, Then<'_>)> {
+    opts.checkpoint
+        .as_ref()
+        .map(|c| (c.step, Then::Write(c.file.as_path())))
+}
+
+fn dispatch(
+    plan: &Plan,
+    fmus: &[Arc<Fmu>],
+    recorder: Option<&mut dyn Recorder>,
+    opts: &RunOptions,
+    course: Course,
+) -> Result<(Summary, Option<Checkpoint>)> {
     match plan.algorithm {
-        AlgorithmChoice::Jacobi => execute(&Jacobi, plan, fmus, recorder, opts),
+        AlgorithmChoice::Jacobi => execute(&Jacobi, plan, fmus, recorder, opts, course),
         AlgorithmChoice::GaussSeidel => {
             let gs = GaussSeidel { order: &plan.order };
-            execute(&gs, plan, fmus, recorder, opts)
+            execute(&gs, plan, fmus, recorder, opts, course)
         }
     }
 }
 
-/// The rows a run records if it runs to its end: t_0, every `decimation` steps, and t_n.
-fn expected_rows(plan: &Plan) -> u64 {
+/// The rows a run records from t_`from` to t_`to`: the first, every `decimation` steps, and
+/// t_n.
+fn expected_rows(plan: &Plan, from: u64, to: u64) -> u64 {
     let dec = plan.decimation as u64;
-    (plan.n_steps / dec)
+    (to / dec - from / dec)
         .saturating_add(1)
-        .saturating_add(u64::from(plan.n_steps % dec != 0))
+        .saturating_add(u64::from(to == plan.n_steps && plan.n_steps % dec != 0))
+}
+
+/// The recording of a run from step `from` to `to`, its recorder started.
+fn start_recording<'r>(
+    plan: &Plan,
+    recorder: &'r mut dyn Recorder,
+    columns: &'r [exchange::Column],
+    from: u64,
+    to: u64,
+) -> Result<Recording<'r>> {
+    let infos: Vec<ColumnInfo> = plan
+        .outputs
+        .iter()
+        .map(|o| ColumnInfo {
+            name: o.header.clone(),
+            var_type: o.var_type,
+        })
+        .collect();
+    recorder.start(&infos, expected_rows(plan, from, to))?;
+    Ok(Recording {
+        recorder,
+        columns,
+        decimation: plan.decimation as u64,
+        rows: 0,
+    })
+}
+
+/// The first step of a run on `course` and the step where it stops, checked before the run:
+/// the FMUs can save their states, the checkpoint's fingerprint matches, the requested step
+/// lies in the run.
+fn course_steps(
+    plan: &Plan,
+    fmus: &[Arc<Fmu>],
+    fp: Option<&Fingerprint>,
+    course: &Course,
+) -> Result<(u64, u64)> {
+    if fp.is_some() {
+        for (pi, fmu) in plan.instances.iter().zip(fmus) {
+            fmu.require_state_support(&pi.name)?;
+        }
+    }
+    let first = match (course.resume, fp) {
+        (Some(cp), Some(fp)) => {
+            cp.check(fp)?;
+            cp.step
+        }
+        _ => 0,
+    };
+    let stop = match course.checkpoint {
+        Some((at, then)) => {
+            if at < first || at >= plan.n_steps {
+                let grid = TimeGrid::new(plan.start_time, plan.step_size, plan.n_steps);
+                return Err(Error::Other(format!(
+                    "checkpoint at step {at}: it must lie in the run, from step {first} (t = {} s) to before the end at step {} (t = {} s)",
+                    grid.at(first),
+                    plan.n_steps,
+                    grid.at(plan.n_steps)
+                )));
+            }
+            match then {
+                Then::Return => at,
+                Then::Write(_) => plan.n_steps,
+            }
+        }
+        None => plan.n_steps,
+    };
+    Ok((first, stop))
 }
 
 fn execute<A: Algorithm>(
@@ -211,38 +388,33 @@ fn execute<A: Algorithm>(
     fmus: &[Arc<Fmu>],
     recorder: Option<&mut dyn Recorder>,
     opts: &RunOptions,
-) -> Result<Summary> {
+    course: Course,
+) -> Result<(Summary, Option<Checkpoint>)> {
     let begin = Instant::now();
+    let fingerprint = (course.resume.is_some() || course.checkpoint.is_some())
+        .then(|| Fingerprint::of(plan, fmus));
+    let (first, stop) = course_steps(plan, fmus, fingerprint.as_ref(), &course)?;
     let Exchange {
         ports,
         mut values,
         columns,
     } = Exchange::build(plan);
     let mut recording = match recorder {
+        Some(r) => Some(start_recording(plan, r, &columns, first, stop)?),
         None => None,
-        Some(recorder) => {
-            let infos: Vec<ColumnInfo> = plan
-                .outputs
-                .iter()
-                .map(|o| ColumnInfo {
-                    name: o.header.clone(),
-                    var_type: o.var_type,
-                })
-                .collect();
-            recorder.start(&infos, expected_rows(plan))?;
-            Some(Recording {
-                recorder,
-                columns: &columns,
-                decimation: plan.decimation as u64,
-                rows: 0,
-            })
-        }
     };
-    let slots = initialize::initialize(algorithm, plan, fmus, ports, &mut values, opts)?;
-    if let Some(r) = recording.as_mut() {
-        r.row(plan.start_time, &values)?;
+    let mut slots = initialize::initialize(algorithm, plan, fmus, ports, &mut values, opts)?;
+    if let Some(cp) = course.resume {
+        cp.restore(&mut slots, &mut values)?;
     }
     let grid = TimeGrid::new(plan.start_time, plan.step_size, plan.n_steps);
+    let start_time = match first {
+        0 => plan.start_time,
+        k => grid.at(k),
+    };
+    if let Some(r) = recording.as_mut() {
+        r.row(start_time, &values)?;
+    }
     let mut stepper = Stepper {
         grid,
         events: &plan.events,
@@ -251,24 +423,46 @@ fn execute<A: Algorithm>(
         recording,
         progress: progress::Progress::new(opts.progress, plan.n_steps),
         interrupt: opts.interrupt.as_deref(),
+        k: first,
+        count: Default::default(),
+        wall: Duration::ZERO,
     };
-    let end = stepper.run(algorithm)?;
+    let mut taken = None;
+    if let (Some((at, then)), Some(fp)) = (course.checkpoint, fingerprint) {
+        stepper.advance(algorithm, at)?;
+        if stepper.ended() {
+            let end = stepper.finish()?;
+            return Err(Error::Other(format!(
+                "no checkpoint at t = {} s: {}",
+                grid.at(at),
+                end.count.terminated_by.unwrap_or_default()
+            )));
+        }
+        let cp = Checkpoint::capture(fp, at, &mut stepper.slots, &stepper.values)?;
+        match then {
+            Then::Return => taken = Some(cp),
+            Then::Write(path) => cp.write(path)?,
+        }
+    }
+    stepper.advance(algorithm, stop)?;
+    let end = stepper.finish()?;
     let rows = stepper.recording.as_ref().map(|r| r.rows).unwrap_or(0);
     // Terminate explicitly so that a failing fmi2Terminate is reported.
     for s in stepper.slots {
         s.inst.terminate()?;
     }
-    Ok(Summary {
-        macro_steps: end.steps,
+    let summary = Summary {
+        macro_steps: end.steps - first,
         fmu_steps: end.count.fmu_steps,
-        start_time: plan.start_time,
+        start_time,
         end_time: grid.at(end.steps),
         wall_time: end.wall,
         total_wall_time: begin.elapsed(),
         rows,
         terminated_by: end.count.terminated_by,
         output_file: None,
-    })
+    };
+    Ok((summary, taken))
 }
 
 /// Loads a system's FMUs and validates it against their model descriptions. The plan's

@@ -1,5 +1,7 @@
-//! The step loop: macro steps from t_0 to t_n with an [`Algorithm`], recording, progress and
-//! interruption. Nothing in it allocates on the success path.
+//! The step loop: macro steps from t_k (t_0, or a checkpoint's) to t_n with an [`Algorithm`],
+//! recording, progress and interruption. A run may stop at a communication point between two
+//! calls of [`Stepper::advance`] (to take a checkpoint) and go on. Nothing in it allocates on
+//! the success path.
 
 use super::algorithm::{Algorithm, MacroStep};
 use super::exchange::{Column, Values};
@@ -30,7 +32,8 @@ impl Recording<'_> {
     }
 }
 
-/// A run at its first communication point, ready to step.
+/// A run at communication point t_k, ready to step: at its first point, or at a checkpoint's
+/// ([`super::checkpoint`]).
 pub struct Stepper<'a> {
     pub grid: TimeGrid,
     pub events: &'a [PlanEvent],
@@ -39,11 +42,16 @@ pub struct Stepper<'a> {
     pub recording: Option<Recording<'a>>,
     pub progress: Option<Progress>,
     pub interrupt: Option<&'a AtomicBool>,
+    /// The next base step: the run is at t_k.
+    pub k: u64,
+    pub count: StepCount,
+    /// Wall time spent stepping so far.
+    pub wall: Duration,
 }
 
 /// How the step loop ended.
 pub struct LoopEnd {
-    /// Base steps taken.
+    /// The base step the run ended at (t_n, or earlier if an instance ended it).
     pub steps: u64,
     pub count: StepCount,
     /// Wall time of the loop.
@@ -51,16 +59,18 @@ pub struct LoopEnd {
 }
 
 impl Stepper<'_> {
-    /// Steps to the end of the run, or until an instance ends it or the interrupt flag is set
-    /// (then the recorder is finished and the error is [`Error::Interrupted`]).
-    pub fn run<A: Algorithm>(&mut self, algorithm: &A) -> Result<LoopEnd> {
+    /// Steps until t_`until` (at most the end of the run), or until an instance ends the run or
+    /// the interrupt flag is set (then the recorder is finished and the error is
+    /// [`Error::Interrupted`]). The events of step k are applied at k, from any starting k.
+    pub fn advance<A: Algorithm>(&mut self, algorithm: &A, until: u64) -> Result<()> {
         let start = Instant::now();
         let grid = self.grid;
         let n_steps = grid.n_steps();
-        let mut count = StepCount::default();
-        let mut next_event = 0usize;
-        let mut k = 0u64;
-        while k < n_steps {
+        let until = until.min(n_steps);
+        let mut count = std::mem::take(&mut self.count);
+        let mut k = self.k;
+        let mut next_event = self.events.partition_point(|e| e.step < k);
+        while k < until && count.terminated_by.is_none() {
             let t = grid.at(k);
             if self.interrupted() {
                 return Err(self.interrupt_at(t));
@@ -85,11 +95,20 @@ impl Stepper<'_> {
             if let Some(p) = &self.progress {
                 p.update(k, &grid);
             }
-            if ended {
-                break;
-            }
         }
-        let wall = start.elapsed();
+        self.k = k;
+        self.count = count;
+        self.wall += start.elapsed();
+        Ok(())
+    }
+
+    /// An instance ended the run early (fmi2Discard + fmi2Terminated).
+    pub fn ended(&self) -> bool {
+        self.count.terminated_by.is_some()
+    }
+
+    /// Ends stepping: the progress bar and the recorder are finished.
+    pub fn finish(&mut self) -> Result<LoopEnd> {
         if let Some(p) = &self.progress {
             p.finish();
         }
@@ -97,9 +116,9 @@ impl Stepper<'_> {
             r.recorder.finish()?;
         }
         Ok(LoopEnd {
-            steps: k,
-            count,
-            wall,
+            steps: self.k,
+            count: std::mem::take(&mut self.count),
+            wall: self.wall,
         })
     }
 

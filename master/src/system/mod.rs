@@ -179,31 +179,38 @@ impl System {
     /// Applies `--set inst.var=value` overrides (they replace values from the file).
     pub fn apply_overrides(&mut self, sets: &[String]) -> Result<()> {
         for s in sets {
-            let Some((lhs, rhs)) = s.split_once('=') else {
+            let parsed = s
+                .split_once('=')
+                .and_then(|(l, r)| Some((VarRef::parse(l)?, r)));
+            let Some((r, rhs)) = parsed else {
                 return Err(Error::Other(format!(
                     "--set {s}: expected instance.variable=value"
                 )));
             };
-            let Some(r) = VarRef::parse(lhs) else {
-                return Err(Error::Other(format!(
-                    "--set {s}: expected instance.variable=value"
-                )));
-            };
-            let names: Vec<String> = self.instances.iter().map(|i| i.name.clone()).collect();
-            let Some(inst) = self.instances.iter_mut().find(|i| i.name == r.instance) else {
-                return Err(Error::Other(format!(
-                    "--set {s}: no instance '{}'{}",
-                    r.instance,
-                    did_you_mean(&r.instance, names.iter().map(|s| s.as_str()))
-                )));
-            };
-            inst.values.retain(|v| v.variable != r.variable);
-            inst.values.push(ValueSpec {
-                variable: r.variable,
-                value: Value::Text(rhs.trim().to_string()),
-                line: None,
-            });
+            self.set_value(r, Value::Text(rhs.trim().to_string()))
+                .map_err(|e| Error::Other(format!("--set {s}: {e}")))?;
         }
+        Ok(())
+    }
+
+    /// Sets a start value of an instance's variable, replacing one from the file (the value
+    /// is checked against the variable when the system is validated).
+    pub fn set_value(&mut self, r: VarRef, value: Value) -> Result<()> {
+        let Some(i) = self.instances.iter().position(|i| i.name == r.instance) else {
+            let names = self.instances.iter().map(|i| i.name.as_str());
+            return Err(Error::Other(format!(
+                "no instance '{}'{}",
+                r.instance,
+                did_you_mean(&r.instance, names)
+            )));
+        };
+        let inst = &mut self.instances[i];
+        inst.values.retain(|v| v.variable != r.variable);
+        inst.values.push(ValueSpec {
+            variable: r.variable,
+            value,
+            line: None,
+        });
         Ok(())
     }
 }

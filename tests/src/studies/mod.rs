@@ -7,12 +7,14 @@
 use crate::study::{Env, Report};
 
 pub mod autopilot;
+pub mod autopilot_robustness;
 pub mod dgps_trial;
 pub mod dp_observer;
 mod path_common;
 pub mod path_control;
 pub mod path_estimation;
 pub mod rrs;
+pub mod rrs_polar;
 pub mod steering_gear;
 
 /// A study: id (also its output folder under `target/studies/`), function.
@@ -28,10 +30,18 @@ pub const STUDIES: &[Study] = &[
     ("path_estimation", path_estimation::run),
 ];
 
+/// Studies in the report only (`cargo xtask report`): campaigns too long for the test suite,
+/// which runs reduced versions of them.
+pub const REPORT_ONLY: &[Study] = &[
+    ("rrs_polar", rrs_polar::run),
+    ("autopilot_robustness", autopilot_robustness::run),
+];
+
 /// Runs the study `id` in `target/studies/<id>/`.
 pub fn run(id: &str) -> Result<Report, String> {
     let (_, f) = STUDIES
         .iter()
+        .chain(REPORT_ONLY)
         .find(|s| s.0 == id)
         .ok_or_else(|| format!("no study {id:?}"))?;
     let env = Env::new(&format!("studies/{id}"))?;

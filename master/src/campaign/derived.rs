@@ -1,0 +1,122 @@
+//! Derived KPIs across arms, computed after the runs: one row per design point and
+//! replication, e.g. `roll_reduction = 100 * (1 - roll_var[on] / roll_var[off])`.
+//!
+//! An expression is arithmetic (`+ - * / ^`, parentheses, `sqrt`, `abs`, `exp`, `log`, `sin`,
+//! `cos`, ...; evaluated in f64 by the `exmex` crate) over KPI names. `kpi[arm]` is the KPI of
+//! the run of that arm; a bare `kpi` is allowed when the campaign has no arms. A row whose
+//! runs are not all done, or failed, gets NaN and says why in its status.
+
+use super::spec::CampaignSpec;
+use crate::error::{Error, Result};
+use exmex::{Express, FlatEx};
+
+/// One compiled derived KPI.
+pub struct DerivedKpi {
+    pub name: String,
+    expr: FlatEx<f64>,
+    /// Per variable of the expression (in exmex's order): (KPI column index, arm index).
+    inputs: Vec<(usize, usize)>,
+}
+
+/// `kpi[arm]` → `{kpi[arm]}` (exmex reads any text in braces as one variable name).
+fn braced(expr: &str) -> String {
+    let mut out = String::with_capacity(expr.len() + 8);
+    let chars: Vec<char> = expr.chars().collect();
+    let mut i = 0;
+    while i < chars.len() {
+        let c = chars[i];
+        if c.is_ascii_alphabetic() || c == '_' {
+            let start = i;
+            while i < chars.len() && (chars[i].is_ascii_alphanumeric() || chars[i] == '_') {
+                i += 1;
+            }
+            let word: String = chars[start..i].iter().collect();
+            if i < chars.len() && chars[i] == '[' {
+                if let Some(close) = chars[i..].iter().position(|c| *c == ']') {
+                    let arm: String = chars[i + 1..i + close].iter().collect();
+                    out.push_str(&format!("{{{word}[{}]}}", arm.trim()));
+                    i += close + 1;
+                    continue;
+                }
+            }
+            out.push_str(&word);
+            continue;
+        }
+        out.push(c);
+        i += 1;
+    }
+    out
+}
+
+impl DerivedKpi {
+    /// Compiles the campaign's derived KPIs against its KPI columns and arms.
+    pub fn compile(spec: &CampaignSpec, kpi_columns: &[String]) -> Result<Vec<DerivedKpi>> {
+        let arms: Vec<&str> = spec.arms.iter().map(|a| a.name.as_str()).collect();
+        spec.derived
+            .iter()
+            .map(|d| {
+                let err = |m: String| {
+                    Error::Other(format!(
+                        "campaign {}: derived kpi '{}' = \"{}\": {m}",
+                        spec.source.display(),
+                        d.name,
+                        d.expr
+                    ))
+                };
+                let text = braced(&d.expr);
+                let expr = FlatEx::<f64>::parse(&text).map_err(|e| err(e.to_string()))?;
+                let mut inputs = Vec::new();
+                for v in expr.var_names() {
+                    let (kpi, arm) = match v.split_once('[') {
+                        Some((k, a)) => (k, Some(a.trim_end_matches(']'))),
+                        None => (v.as_str(), None),
+                    };
+                    let col = kpi_columns.iter().position(|c| c == kpi).ok_or_else(|| {
+                        err(format!(
+                            "no KPI '{kpi}'{}",
+                            crate::error::did_you_mean(kpi, kpi_columns.iter().map(|s| s.as_str()))
+                        ))
+                    })?;
+                    let arm = match (arm, arms.is_empty()) {
+                        (None, true) => 0,
+                        (None, false) => {
+                            return Err(err(format!(
+                                "write {kpi}[arm] with one of the arms {arms:?}"
+                            )))
+                        }
+                        (Some(a), _) => arms
+                            .iter()
+                            .position(|x| *x == a)
+                            .ok_or_else(|| err(format!("no arm '{a}' (arms: {arms:?})")))?,
+                    };
+                    inputs.push((col, arm));
+                }
+                Ok(DerivedKpi {
+                    name: d.name.clone(),
+                    expr,
+                    inputs,
+                })
+            })
+            .collect()
+    }
+
+    /// The value from the KPIs of one design point and replication: `kpis[arm][column]`.
+    pub fn eval(&self, kpis: &[Vec<f64>]) -> f64 {
+        let vars: Vec<f64> = self.inputs.iter().map(|&(c, a)| kpis[a][c]).collect();
+        self.expr.eval(&vars).unwrap_or(f64::NAN)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn arm_references_become_single_variables() {
+        assert_eq!(
+            braced("100 * (1 - roll_var[on] / roll_var[ off ])"),
+            "100 * (1 - {roll_var[on]} / {roll_var[off]})"
+        );
+        assert_eq!(braced("sqrt(a_1) + b"), "sqrt(a_1) + b");
+    }
+}

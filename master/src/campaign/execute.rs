@@ -1,0 +1,566 @@
+//! Running a campaign: a work-stealing pool (rayon) over the runs still to do, each run with
+//! its own instances of FMUs loaded once per process; each finished run appended to the
+//! journal at once.
+//!
+//! A run fails alone: an FMU error, a NaN in a recorded variable or a panic is recorded in its
+//! row (status and message) and the campaign goes on. An interrupt (Ctrl-C) stops the runs in
+//! flight cleanly; they are not recorded, and the next start runs them again. A thread stuck
+//! inside an FMU cannot be stopped from outside, so a wall-time limit per run needs the
+//! out-of-process mode of the hardening issue; it is not offered here.
+//!
+//! With `fork_at = T`, the runs are grouped by their values of everything that cannot change
+//! during a run (fixed and structural parameters, seeds, start values of states). Each group
+//! runs its warm-up to T once; at T every FMU's state is serialized into a master checkpoint,
+//! and each run of the group continues from it in fresh instances, with its own inputs and
+//! tunable parameters set by events at T. A forked run is bit-identical to the cold run that
+//! sets them by events at T ([`super::Campaign::fork_systems_for`]).
+
+use super::design::Run;
+use super::journal::{Journal, JsonKpi, RunRecord, Status};
+use super::kpi::{missing_values, KpiRecorder, KpiValue};
+use super::output;
+use super::Campaign;
+use crate::error::{Error, Result};
+use crate::fmu::Fmu;
+use crate::instance::LogSink;
+use crate::model_description::ModelDescription;
+use crate::run::{self, ColumnInfo, CsvRecorder, Recorder, Row, RunOptions};
+use crate::system::{Plan, System};
+use rayon::prelude::*;
+use std::panic::{catch_unwind, AssertUnwindSafe};
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+
+/// How to run a campaign.
+#[derive(Clone, Default)]
+pub struct CampaignOptions {
+    /// Worker threads (default: every core).
+    pub jobs: Option<usize>,
+    /// Run only shard i of n (0-based): runs (or, with forks, warm-up groups) whose index is
+    /// i modulo n.
+    pub shard: Option<(usize, usize)>,
+    /// The output folder (journal, tables, provenance, series).
+    pub output: PathBuf,
+    /// Show a progress bar.
+    pub progress: bool,
+    /// Run again the runs that failed before (default: a failed run counts as done).
+    pub retry_failed: bool,
+    pub interrupt: Option<Arc<AtomicBool>>,
+    pub log_sink: Option<LogSink>,
+    /// Told of every run as it starts and ends (progress in embedding applications).
+    pub observer: Option<Arc<dyn Observer>>,
+}
+
+/// An observer of a campaign's runs, called from the worker threads.
+pub trait Observer: Send + Sync {
+    /// A run starts. Called inside the run's panic guard: a panic here fails that run only.
+    fn started(&self, _run: &Run) {}
+    /// A run finished and is in the journal.
+    fn finished(&self, _run: &Run, _record: &RunRecord) {}
+}
+
+/// What a campaign run did.
+#[derive(Debug, Clone, Default)]
+pub struct CampaignOutcome {
+    /// Runs in the campaign (all shards).
+    pub total: usize,
+    /// Runs of this shard.
+    pub selected: usize,
+    /// Runs of this shard found done in the journal and skipped.
+    pub skipped: usize,
+    /// Runs executed now, and how many of them failed.
+    pub ran: usize,
+    pub failed: usize,
+    pub interrupted: bool,
+    pub jobs: usize,
+    /// Why the jobs were limited, if they were.
+    pub jobs_note: Option<String>,
+    pub wall: Duration,
+    /// The slowest run executed now: (index, wall time [s]).
+    pub slowest: Option<(usize, f64)>,
+    /// With forks: the runs per warm-up group (of this shard).
+    pub groups: Option<Vec<usize>>,
+    pub files: Vec<PathBuf>,
+    pub warnings: Vec<String>,
+}
+
+impl CampaignOutcome {
+    pub fn runs_per_second(&self) -> f64 {
+        self.ran as f64 / self.wall.as_secs_f64().max(1e-9)
+    }
+}
+
+impl std::fmt::Display for CampaignOutcome {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{} of {} runs in this shard ran ({} failed), {} were done before; {:.1} s, {:.2} runs/s on {} job(s)",
+            self.ran,
+            self.selected,
+            self.failed,
+            self.skipped,
+            self.wall.as_secs_f64(),
+            self.runs_per_second(),
+            self.jobs
+        )?;
+        if let Some(note) = &self.jobs_note {
+            write!(f, " ({note})")?;
+        }
+        if let Some((i, t)) = self.slowest {
+            write!(f, "\nslowest run: {i} ({t:.3} s)")?;
+        }
+        if let Some(g) = &self.groups {
+            let (lo, hi) = (g.iter().min().unwrap_or(&0), g.iter().max().unwrap_or(&0));
+            write!(f, "\nwarm-up groups: {} ({lo}..={hi} runs each)", g.len())?;
+        }
+        if self.interrupted {
+            write!(
+                f,
+                "\ninterrupted: the runs in flight were not recorded and will run again"
+            )?;
+        }
+        for p in &self.files {
+            write!(f, "\nwrote {}", p.display())?;
+        }
+        Ok(())
+    }
+}
+
+/// The shared state of the workers.
+struct Context<'a> {
+    campaign: &'a Campaign,
+    fmus: Vec<Arc<Fmu>>,
+    run_opts: RunOptions,
+    journal: Mutex<Journal>,
+    progress: Option<indicatif::ProgressBar>,
+    failed: AtomicUsize,
+    /// Runs finished (recorded) by this call.
+    done: AtomicUsize,
+    slowest: Mutex<Option<(usize, f64)>>,
+    interrupted: AtomicBool,
+    series_dir: PathBuf,
+    observer: Option<Arc<dyn Observer>>,
+}
+
+impl Context<'_> {
+    fn mds(&self) -> Vec<&ModelDescription> {
+        self.fmus.iter().map(|f| &f.model_description).collect()
+    }
+
+    fn stop(&self) -> bool {
+        self.run_opts
+            .interrupt
+            .as_ref()
+            .is_some_and(|f| f.load(Ordering::Relaxed))
+    }
+
+    /// Records a finished run (journal, progress, slowest); an interrupted one is not.
+    fn finish(&self, run: &Run, result: Outcome) -> Result<()> {
+        let (status, message, kpis, wall) = match result {
+            Outcome::Interrupted => {
+                self.interrupted.store(true, Ordering::Relaxed);
+                return Ok(());
+            }
+            Outcome::Done {
+                status,
+                message,
+                kpis,
+                wall,
+            } => (status, message, kpis, wall),
+        };
+        self.done.fetch_add(1, Ordering::Relaxed);
+        if status.failed() {
+            self.failed.fetch_add(1, Ordering::Relaxed);
+        }
+        {
+            let mut s = self.slowest.lock().unwrap_or_else(|e| e.into_inner());
+            if s.is_none_or(|(_, t)| wall > t) {
+                *s = Some((run.index, wall));
+            }
+        }
+        let record = RunRecord {
+            index: run.index,
+            key: run.key.clone(),
+            status,
+            message,
+            kpis: kpis.iter().map(JsonKpi::from).collect(),
+            wall_time: wall,
+        };
+        if let Some(o) = &self.observer {
+            o.finished(run, &record);
+        }
+        self.journal
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .append(record)?;
+        if let Some(p) = &self.progress {
+            p.inc(1);
+            p.set_message(format!("{} failed", self.failed.load(Ordering::Relaxed)));
+        }
+        Ok(())
+    }
+}
+
+/// How one run ended.
+enum Outcome {
+    Done {
+        status: Status,
+        message: String,
+        kpis: Vec<KpiValue>,
+        /// Wall time of the run [s].
+        wall: f64,
+    },
+    Interrupted,
+}
+
+/// Records the KPIs and, for the runs that asked for it, the decimated series.
+struct RunRecorders<'a> {
+    kpis: KpiRecorder<'a>,
+    series: Option<(CsvRecorder, u64, u64)>,
+}
+
+impl Recorder for RunRecorders<'_> {
+    fn start(&mut self, columns: &[ColumnInfo], expected_rows: u64) -> Result<()> {
+        self.kpis.start(columns, expected_rows)?;
+        if let Some((csv, _, _)) = &mut self.series {
+            csv.start(columns, expected_rows)?;
+        }
+        Ok(())
+    }
+
+    fn record(&mut self, time: f64, row: &Row<'_>) -> Result<()> {
+        self.kpis.record(time, row)?;
+        if let Some((csv, every, n)) = &mut self.series {
+            if *n % *every == 0 {
+                csv.record(time, row)?;
+            }
+            *n += 1;
+        }
+        Ok(())
+    }
+
+    fn finish(&mut self) -> Result<()> {
+        self.kpis.finish()?;
+        if let Some((csv, _, _)) = &mut self.series {
+            csv.finish()?;
+        }
+        Ok(())
+    }
+}
+
+/// How a run's execution ends: the master's result and the recorders.
+fn classify(
+    result: std::thread::Result<Result<run::Summary>>,
+    recorders: &RunRecorders<'_>,
+    specs: &[super::kpi::KpiSpec],
+    wall: f64,
+) -> Outcome {
+    let failed = |status, message: String| Outcome::Done {
+        status,
+        message,
+        kpis: missing_values(specs),
+        wall,
+    };
+    match result {
+        Ok(Ok(summary)) => {
+            let (status, message) = match summary.terminated_by {
+                Some(m) => (Status::Terminated, m),
+                None => (Status::Ok, String::new()),
+            };
+            Outcome::Done {
+                status,
+                message,
+                kpis: recorders.kpis.values(),
+                wall,
+            }
+        }
+        Ok(Err(Error::Interrupted { .. })) => Outcome::Interrupted,
+        Ok(Err(e)) if recorders.kpis.nan().is_some() => failed(Status::Nan, e.to_string()),
+        Ok(Err(e)) => failed(Status::Error, e.to_string()),
+        Err(panic) => {
+            let m = panic
+                .downcast_ref::<String>()
+                .cloned()
+                .or_else(|| panic.downcast_ref::<&str>().map(|s| s.to_string()))
+                .unwrap_or_else(|| "a panic without a message".into());
+            failed(Status::Panic, format!("panic: {m}"))
+        }
+    }
+}
+
+impl Context<'_> {
+    fn recorders(&self, run: &Run) -> Result<RunRecorders<'_>> {
+        let series = match &self.campaign.spec.series {
+            Some(s) if s.runs.contains(&(run.index as u64)) => {
+                let path = self.series_dir.join(format!("run-{:06}.csv", run.index));
+                std::fs::create_dir_all(&self.series_dir).map_err(|e| {
+                    Error::io(format!("cannot create {}", self.series_dir.display()), e)
+                })?;
+                let f = std::fs::File::create(&path)
+                    .map_err(|e| Error::io(format!("cannot create {}", path.display()), e))?;
+                let w = Box::new(std::io::BufWriter::new(f));
+                Some((CsvRecorder::new(w), s.decimation as u64, 0))
+            }
+            _ => None,
+        };
+        Ok(RunRecorders {
+            kpis: KpiRecorder::new(&self.campaign.spec.kpis),
+            series,
+        })
+    }
+
+    /// A cold run: validate the run's system and run it.
+    fn cold(&self, run: &Run) -> Outcome {
+        self.execute(run, |rec| {
+            let system = self.campaign.system_for(run)?;
+            let plan = system.validate(&self.mds())?;
+            run::run_with(&plan, &self.fmus, Some(rec), &self.run_opts)
+        })
+    }
+
+    /// A run's execution with a panic caught and the outcome classified.
+    fn execute(
+        &self,
+        run: &Run,
+        body: impl FnOnce(&mut dyn Recorder) -> Result<run::Summary>,
+    ) -> Outcome {
+        let begin = Instant::now();
+        let mut recorders = match self.recorders(run) {
+            Ok(r) => r,
+            Err(e) => {
+                return Outcome::Done {
+                    status: Status::Error,
+                    message: e.to_string(),
+                    kpis: missing_values(&self.campaign.spec.kpis),
+                    wall: 0.0,
+                }
+            }
+        };
+        let result = catch_unwind(AssertUnwindSafe(|| {
+            if let Some(o) = &self.observer {
+                o.started(run);
+            }
+            body(&mut recorders)
+        }));
+        let wall = begin.elapsed().as_secs_f64();
+        classify(result, &recorders, &self.campaign.spec.kpis, wall)
+    }
+}
+
+/// Runs the campaign's runs of this shard that are not done yet. See the module documentation.
+pub fn run(campaign: &Campaign, opts: &CampaignOptions) -> Result<CampaignOutcome> {
+    let begin = Instant::now();
+    let dir = &opts.output;
+    std::fs::create_dir_all(dir)
+        .map_err(|e| Error::io(format!("cannot create output folder {}", dir.display()), e))?;
+    output::check_or_write_provenance(campaign, dir, opts.shard)?;
+    let journal = Journal::open(dir)?;
+    let fmus = run::load_fmus(&campaign.system)?;
+    let mut outcome = CampaignOutcome {
+        total: campaign.runs.len(),
+        ..Default::default()
+    };
+    let mut jobs = opts.jobs.unwrap_or_else(rayon::current_num_threads).max(1);
+    if let Some(f) = fmus
+        .iter()
+        .find(|f| f.co_simulation().can_be_instantiated_only_once_per_process)
+    {
+        if jobs > 1 {
+            outcome.jobs_note = Some(format!(
+                "{} declares canBeInstantiatedOnlyOncePerProcess: one job, until the out-of-process mode exists",
+                f.path.display()
+            ));
+        }
+        jobs = 1;
+    }
+    outcome.jobs = jobs;
+    let mds: Vec<&ModelDescription> = fmus.iter().map(|f| &f.model_description).collect();
+    let fork = fork_plan(campaign, &mds)?;
+    let selected = select(campaign, fork.as_ref(), opts.shard);
+    outcome.selected = selected.len();
+    let todo: Vec<&Run> = selected
+        .iter()
+        .map(|&i| &campaign.runs[i])
+        .filter(|r| match journal.done(&r.key) {
+            Some(rec) => opts.retry_failed && rec.status.failed(),
+            None => true,
+        })
+        .collect();
+    outcome.skipped = outcome.selected - todo.len();
+    let ctx = Context {
+        campaign,
+        fmus: fmus.clone(),
+        run_opts: RunOptions {
+            interrupt: opts.interrupt.clone(),
+            log_sink: opts.log_sink.clone(),
+            ..Default::default()
+        },
+        journal: Mutex::new(journal),
+        progress: opts.progress.then(|| progress_bar(todo.len())),
+        failed: Default::default(),
+        done: Default::default(),
+        slowest: Mutex::new(None),
+        interrupted: AtomicBool::new(false),
+        series_dir: dir.join("series"),
+        observer: opts.observer.clone(),
+    };
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(jobs)
+        .build()
+        .map_err(|e| Error::Other(format!("cannot start {jobs} worker threads: {e}")))?;
+    let errors: Mutex<Vec<Error>> = Mutex::new(Vec::new());
+    let keep = |r: Result<()>| {
+        if let Err(e) = r {
+            errors.lock().unwrap_or_else(|e| e.into_inner()).push(e);
+        }
+    };
+    pool.install(|| match &fork {
+        None => todo.par_iter().for_each(|r| {
+            if !ctx.stop() {
+                keep(ctx.finish(r, ctx.cold(r)));
+            }
+        }),
+        Some(fork) => {
+            let groups = fork.groups_of(&todo);
+            outcome.groups = Some(groups.iter().map(Vec::len).collect());
+            groups
+                .par_iter()
+                .for_each(|g| keep(fork.run_group(&ctx, g)));
+        }
+    });
+    if let Some(p) = &ctx.progress {
+        p.finish();
+    }
+    if let Some(e) = errors.into_inner().unwrap_or_else(|e| e.into_inner()).pop() {
+        return Err(e);
+    }
+    outcome.ran = ctx.done.load(Ordering::Relaxed);
+    outcome.interrupted = ctx.interrupted.load(Ordering::Relaxed) || ctx.stop();
+    outcome.failed = ctx.failed.load(Ordering::Relaxed);
+    outcome.slowest = *ctx.slowest.lock().unwrap_or_else(|e| e.into_inner());
+    let journal = ctx.journal.into_inner().unwrap_or_else(|e| e.into_inner());
+    outcome.files = output::write_tables(&campaign.spec, &campaign.runs, &journal, dir)?;
+    outcome.wall = begin.elapsed();
+    Ok(outcome)
+}
+
+fn progress_bar(n: usize) -> indicatif::ProgressBar {
+    let bar = indicatif::ProgressBar::new(n as u64);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(
+            "{bar:40} {pos}/{len} runs, {msg}, {per_sec}, ETA {eta}",
+        )
+        .expect("valid template"),
+    );
+    bar.set_message("0 failed");
+    bar
+}
+
+/// The runs of shard i of n: by run index, or with forks by warm-up group (so a group's
+/// warm-up runs once, in one shard).
+fn select(campaign: &Campaign, fork: Option<&Fork>, shard: Option<(usize, usize)>) -> Vec<usize> {
+    let all = 0..campaign.runs.len();
+    match (shard, fork) {
+        (None, _) => all.collect(),
+        (Some((i, n)), None) => all.filter(|r| r % n == i).collect(),
+        (Some((i, n)), Some(f)) => all.filter(|r| f.group[*r] % n == i).collect(),
+    }
+}
+
+/// The warm-up groups of a forked campaign.
+struct Fork {
+    at: f64,
+    /// `group[run]`: the run's warm-up group, numbered in order of first appearance.
+    group: Vec<usize>,
+    /// Per run: (warm-up system, the run's system).
+    systems: Vec<(System, System)>,
+}
+
+/// Groups the runs when the campaign forks, after checking every FMU can save its state.
+fn fork_plan(campaign: &Campaign, mds: &[&ModelDescription]) -> Result<Option<Fork>> {
+    let Some(at) = campaign.spec.fork_at else {
+        return Ok(None);
+    };
+    for (inst, md) in campaign.system.instances.iter().zip(mds) {
+        let cs = md.co_simulation.as_ref();
+        if !cs.is_some_and(|c| c.can_get_and_set_fmu_state && c.can_serialize_fmu_state) {
+            return Err(Error::fmu(
+                &inst.fmu,
+                format!(
+                    "instance '{}': fork_at needs canGetAndSetFMUstate and canSerializeFMUstate, which this FMU does not declare",
+                    inst.name
+                ),
+            ));
+        }
+    }
+    let changeable = |r: &crate::system::VarRef| super::changeable_in(&campaign.system, mds, r);
+    let mut keys: std::collections::HashMap<String, usize> = Default::default();
+    let mut group = Vec::with_capacity(campaign.runs.len());
+    let mut systems = Vec::with_capacity(campaign.runs.len());
+    for r in &campaign.runs {
+        let n = keys.len();
+        group.push(*keys.entry(campaign.group_key(r, &changeable)).or_insert(n));
+        systems.push(campaign.fork_systems_for(r, at, &changeable)?);
+    }
+    Ok(Some(Fork { at, group, systems }))
+}
+
+impl Fork {
+    /// The runs to do, by warm-up group.
+    fn groups_of<'r>(&self, todo: &[&'r Run]) -> Vec<Vec<&'r Run>> {
+        let mut by: std::collections::BTreeMap<usize, Vec<&Run>> = Default::default();
+        for r in todo {
+            by.entry(self.group[r.index]).or_default().push(r);
+        }
+        by.into_values().collect()
+    }
+
+    /// One group: its warm-up to T, then every run from the checkpoint.
+    fn run_group(&self, ctx: &Context, runs: &[&Run]) -> Result<()> {
+        if ctx.stop() {
+            return Ok(());
+        }
+        let warm_up = |system: &System| -> Result<(Plan, run::Checkpoint)> {
+            let plan = system.validate(&ctx.mds())?;
+            let k = run::checkpoint_step(&plan, self.at)
+                .map_err(|e| Error::Other(format!("fork_at: {e}")))?;
+            let cp = run::run_to_checkpoint(&plan, &ctx.fmus, k, None, &ctx.run_opts)?;
+            Ok((plan, cp))
+        };
+        let first = runs[0];
+        let shared = catch_unwind(AssertUnwindSafe(|| warm_up(&self.systems[first.index].0)));
+        let cp = match shared {
+            Ok(Ok((_, cp))) => Arc::new(cp),
+            Ok(Err(Error::Interrupted { .. })) => return Ok(()),
+            failed => {
+                // The warm-up failed: every run of the group fails with its message.
+                let message = match failed {
+                    Ok(Err(e)) => format!("warm-up: {e}"),
+                    _ => "warm-up: panic".into(),
+                };
+                for r in runs {
+                    let done = Outcome::Done {
+                        status: Status::Error,
+                        message: message.clone(),
+                        kpis: missing_values(&ctx.campaign.spec.kpis),
+                        wall: 0.0,
+                    };
+                    ctx.finish(r, done)?;
+                }
+                return Ok(());
+            }
+        };
+        runs.par_iter().try_for_each(|r| {
+            if ctx.stop() {
+                return Ok(());
+            }
+            let outcome = ctx.execute(r, |rec| {
+                let plan = self.systems[r.index].1.validate(&ctx.mds())?;
+                run::resume_with(&plan, &ctx.fmus, &cp, Some(rec), &ctx.run_opts)
+            });
+            ctx.finish(r, outcome)
+        })
+    }
+}

@@ -1,0 +1,135 @@
+//! Manoeuvring KPIs of a run: the streaming trackers of `models::manoeuvre` fed from the
+//! recorded columns, judged against the IMO MSC.137(76) criteria.
+
+use super::kpi::{KpiSpec, KpiValue, Manoeuvre};
+use crate::run::Row;
+use models::hull::DEG;
+use models::manoeuvre::{imo, Sample, TurningCircleTracker, ZigZagMetrics, ZigZagTracker};
+
+// Both trackers are a few hundred bytes; the KPI is boxed as a whole (kpi.rs).
+#[allow(clippy::large_enum_variant)]
+enum Tracker {
+    Turning(TurningCircleTracker),
+    ZigZag(ZigZagTracker),
+}
+
+/// One manoeuvring KPI bound to its recorded columns.
+pub struct ManoeuvreKpi {
+    tracker: Tracker,
+    /// Columns of x, y, heading (turning circle) or heading (zig-zag).
+    columns: Vec<usize>,
+    length: f64,
+    speed: f64,
+    check_angle: f64,
+}
+
+impl ManoeuvreKpi {
+    /// `columns` are the recorded columns of [`KpiSpec::variables`].
+    pub fn new(spec: &KpiSpec, columns: &[usize]) -> ManoeuvreKpi {
+        let KpiSpec::Manoeuvre {
+            manoeuvre,
+            execute_time,
+            length,
+            ..
+        } = spec
+        else {
+            unreachable!("a manoeuvre KPI")
+        };
+        let (tracker, speed, check_angle) = match manoeuvre {
+            Manoeuvre::TurningCircle { .. } => (
+                Tracker::Turning(TurningCircleTracker::new(*execute_time)),
+                f64::NAN,
+                f64::NAN,
+            ),
+            Manoeuvre::ZigZag {
+                check_angle,
+                rudder_sign,
+                speed,
+                ..
+            } => (
+                Tracker::ZigZag(ZigZagTracker::new(
+                    *execute_time,
+                    *rudder_sign,
+                    *check_angle,
+                )),
+                *speed,
+                *check_angle,
+            ),
+        };
+        ManoeuvreKpi {
+            tracker,
+            columns: columns.to_vec(),
+            length: *length,
+            speed,
+            check_angle,
+        }
+    }
+
+    #[inline]
+    pub fn push(&mut self, t: f64, row: &Row<'_>) {
+        let v = |j: usize| row.get(self.columns[j]).as_f64();
+        match &mut self.tracker {
+            Tracker::Turning(tr) => tr.push(&Sample {
+                t,
+                x: v(0),
+                y: v(1),
+                psi: v(2),
+                ..Sample::default()
+            }),
+            Tracker::ZigZag(tr) => tr.push(&Sample {
+                t,
+                psi: v(0),
+                ..Sample::default()
+            }),
+        }
+    }
+
+    /// The KPI values in the order of [`KpiSpec::columns`]; NaN and "" where the run did not
+    /// reach the event a metric needs.
+    pub fn values(&self, out: &mut Vec<KpiValue>) {
+        let n = |x: f64| KpiValue::Number(x);
+        let verdict = |pass: Option<bool>| {
+            KpiValue::Verdict(match pass {
+                Some(true) => "pass",
+                Some(false) => "fail",
+                None => "",
+            })
+        };
+        match &self.tracker {
+            Tracker::Turning(tr) => match tr.finish() {
+                Ok(m) => {
+                    let pass = imo::check_turning(&m, self.length).ok().map(|c| c.pass);
+                    out.extend([
+                        n(m.advance),
+                        n(m.transfer),
+                        n(m.tactical_diameter),
+                        verdict(pass),
+                    ]);
+                }
+                Err(_) => out.extend([n(f64::NAN), n(f64::NAN), n(f64::NAN), verdict(None)]),
+            },
+            Tracker::ZigZag(tr) => match tr.finish() {
+                Ok(m) => {
+                    let pass = self.zigzag_pass(&m);
+                    out.extend([n(m.first_overshoot), n(m.second_overshoot), verdict(pass)]);
+                }
+                Err(_) => out.extend([n(f64::NAN), n(f64::NAN), verdict(None)]),
+            },
+        }
+    }
+
+    /// The IMO yaw-checking verdict: the 10°/10° limits (by L/U) for a 10° check angle, the
+    /// 20°/20° limit for 20°, none for other tests.
+    fn zigzag_pass(&self, m: &ZigZagMetrics) -> Option<bool> {
+        let is = |deg: f64| (self.check_angle - deg * DEG).abs() < 1e-9;
+        if is(10.0) {
+            imo::check_zigzag_10_10(m, self.length, self.speed)
+                .ok()
+                .map(|c| c.pass)
+        } else if is(20.0) {
+            Some(imo::check_zigzag_20_20(m).pass)
+        } else {
+            None
+        }
+    }
+}

@@ -1,0 +1,131 @@
+//! `shipsim campaign merge`: the output folders of a campaign's shards (or of interrupted
+//! attempts) combined into one folder, with the tables and the derived KPIs recomputed, and a
+//! report of the runs that are missing.
+
+use super::journal::{Journal, RunRecord};
+use super::output::{self, write_atomic, Provenance};
+use super::{design, CampaignSpec};
+use crate::error::{Error, Result};
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+
+/// What a merge found.
+#[derive(Debug, Clone)]
+pub struct MergeReport {
+    /// Runs in the campaign.
+    pub total: usize,
+    /// Finished runs found.
+    pub found: usize,
+    /// Runs found in more than one input folder (kept once: a successful record first).
+    pub duplicates: usize,
+    /// Indices of the runs no input has.
+    pub missing: Vec<usize>,
+    pub files: Vec<PathBuf>,
+}
+
+impl std::fmt::Display for MergeReport {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{} of {} runs found ({} in several inputs)",
+            self.found, self.total, self.duplicates
+        )?;
+        if !self.missing.is_empty() {
+            let shown: Vec<String> = self
+                .missing
+                .iter()
+                .take(20)
+                .map(|i| i.to_string())
+                .collect();
+            write!(
+                f,
+                "\nmissing {} run(s): {}{}",
+                self.missing.len(),
+                shown.join(", "),
+                if self.missing.len() > 20 { ", ..." } else { "" }
+            )?;
+        }
+        for p in &self.files {
+            write!(f, "\nwrote {}", p.display())?;
+        }
+        Ok(())
+    }
+}
+
+/// Merges the output folders `inputs` of one campaign into `out`.
+pub fn merge(inputs: &[PathBuf], out: &Path) -> Result<MergeReport> {
+    let Some(first) = inputs.first() else {
+        return Err(Error::Other(
+            "campaign merge: give the output folders to merge".into(),
+        ));
+    };
+    let prov = Provenance::read(first)?;
+    let mut records: HashMap<String, RunRecord> = HashMap::new();
+    let mut duplicates = 0;
+    for dir in inputs {
+        let p = Provenance::read(dir)?;
+        if (p.base_hash.as_str(), p.kpi_hash.as_str())
+            != (prov.base_hash.as_str(), prov.kpi_hash.as_str())
+        {
+            return Err(Error::Other(format!(
+                "campaign merge: {} is from another campaign than {} (other base system, FMUs or KPIs)",
+                dir.display(),
+                first.display()
+            )));
+        }
+        if !dir.join("runs.jsonl").exists() {
+            continue;
+        }
+        for r in Journal::open(dir)?.records() {
+            match records.get(&r.key) {
+                Some(old) => {
+                    duplicates += 1;
+                    if old.status.failed() && !r.status.failed() {
+                        records.insert(r.key.clone(), r.clone());
+                    }
+                }
+                None => {
+                    records.insert(r.key.clone(), r.clone());
+                }
+            }
+        }
+    }
+    // The campaign as the newest input describes it (its runs, keyed like the journals).
+    let newest = inputs
+        .iter()
+        .map(|d| Provenance::read(d))
+        .collect::<Result<Vec<_>>>()?
+        .into_iter()
+        .max_by_key(|p| p.runs)
+        .expect("one input");
+    let spec = CampaignSpec::parse(&newest.campaign_file, &newest.campaign_text)?;
+    let runs = design::runs(&spec, &newest.base_hash)?;
+    std::fs::create_dir_all(out)
+        .map_err(|e| Error::io(format!("cannot create {}", out.display()), e))?;
+    let mut merged_prov = newest.clone();
+    merged_prov.shard = None;
+    let text = serde_json::to_string_pretty(&merged_prov).expect("serializable");
+    write_atomic(&out.join("campaign.json"), text.as_bytes())?;
+    let mut journal = Journal::open(out)?;
+    let mut found = 0;
+    let mut missing = Vec::new();
+    for run in &runs {
+        match records.get(&run.key) {
+            Some(r) => {
+                found += 1;
+                if journal.done(&run.key) != Some(r) {
+                    journal.append(r.clone())?;
+                }
+            }
+            None => missing.push(run.index),
+        }
+    }
+    let files = output::write_tables(&spec, &runs, &journal, out)?;
+    Ok(MergeReport {
+        total: runs.len(),
+        found,
+        duplicates,
+        missing,
+        files,
+    })
+}

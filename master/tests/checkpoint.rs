@@ -1,0 +1,520 @@
+//! Master-level checkpoints on our FMUs ($SHIPSIM_FMU_DIR): a run continued from a checkpoint
+//! gives, bit for bit, the rows of the uninterrupted run; a fork (warm-up without an event,
+//! then the event from the checkpoint) gives, bit for bit, the cold run with the event; the
+//! CLI's --checkpoint-at/--resume give the tail of the full CSV byte for byte; truncated,
+//! hostile and foreign checkpoints and times off the grid are clear errors.
+//!
+//! Tolerance: none. Every comparison of results is of the f64 bit patterns.
+mod common;
+use common::*;
+use shipsim::fmu::Fmu;
+use shipsim::run::{
+    checkpoint_step, load_fmus, resume_with, run_to_checkpoint, run_with, Checkpoint,
+    CheckpointRequest, MemoryRecorder, RunOptions,
+};
+use shipsim::system::{Algorithm, EventSpec, Plan, System, Value, VarRef};
+use shipsim::Error;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::sync::Arc;
+
+/// `systems/<name>` with our FMUs from $SHIPSIM_FMU_DIR, stopping at `stop_time`, no output
+/// file.
+fn system(name: &str, stop_time: f64, algorithm: Algorithm) -> System {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../systems")
+        .join(name);
+    let mut sys = System::load(&path).unwrap();
+    for inst in &mut sys.instances {
+        let stem = inst.fmu.file_stem().unwrap().to_string_lossy().into_owned();
+        inst.fmu = our_fmu(&stem);
+    }
+    sys.stop_time = Some(stop_time);
+    sys.algorithm = algorithm;
+    sys.output.file = None;
+    sys
+}
+
+fn plan(sys: &System, fmus: &[Arc<Fmu>]) -> Plan {
+    let mds: Vec<_> = fmus.iter().map(|f| &f.model_description).collect();
+    sys.validate(&mds).unwrap()
+}
+
+/// `sys` with one more event: `target` set to `value` at `time`.
+fn with_event(sys: &System, time: f64, target: &str, value: Value) -> System {
+    let mut s = sys.clone();
+    s.events.push(EventSpec {
+        time,
+        target: VarRef::parse(target).unwrap(),
+        value,
+        line: None,
+    });
+    s
+}
+
+/// Every recorded row as bit patterns: [time, column...].
+fn rows(m: &MemoryRecorder) -> Vec<Vec<u64>> {
+    (0..m.time.len())
+        .map(|i| {
+            std::iter::once(m.time[i].to_bits())
+                .chain(m.data.iter().map(|c| c[i].to_bits()))
+                .collect()
+        })
+        .collect()
+}
+
+fn full_run(plan: &Plan, fmus: &[Arc<Fmu>], opts: &RunOptions) -> Vec<Vec<u64>> {
+    let mut m = MemoryRecorder::new();
+    run_with(plan, fmus, Some(&mut m), opts).unwrap();
+    rows(&m)
+}
+
+/// The rows of a run continued from `cp` with `plan`.
+fn resumed(plan: &Plan, fmus: &[Arc<Fmu>], cp: &Checkpoint) -> Vec<Vec<u64>> {
+    let mut m = MemoryRecorder::new();
+    let s = resume_with(plan, fmus, cp, Some(&mut m), &RunOptions::default()).unwrap();
+    assert_eq!(s.macro_steps, plan.n_steps - cp.step);
+    assert_eq!(s.start_time, cp.time);
+    assert_eq!(s.rows as usize, m.time.len());
+    rows(&m)
+}
+
+/// The index of the row at time `t` (bit-equal).
+fn row_at(rows: &[Vec<u64>], t: f64) -> usize {
+    rows.iter()
+        .position(|r| r[0] == t.to_bits())
+        .unwrap_or_else(|| panic!("no row at t = {t}"))
+}
+
+/// Checkpoint, resume and compare with the uninterrupted run, at base step `k`.
+fn check_resume(plan: &Plan, fmus: &[Arc<Fmu>], k: u64, label: &str) {
+    let full = full_run(plan, fmus, &RunOptions::default());
+    let mut warm = MemoryRecorder::new();
+    let cp = run_to_checkpoint(plan, fmus, k, Some(&mut warm), &RunOptions::default()).unwrap();
+    assert_eq!(cp.step, k);
+    let i = row_at(&full, cp.time);
+    assert_eq!(i as u64, k, "{label}: decimation 1, row k is t_k");
+    // The warm-up recorded what the full run records up to t_k.
+    assert_eq!(rows(&warm), full[..=i], "{label}: warm-up rows");
+    // Through a file and back: the same checkpoint.
+    let d = tempfile::tempdir().unwrap();
+    let file = d.path().join("cp.bin");
+    cp.write(&file).unwrap();
+    let back = Checkpoint::read(&file).unwrap();
+    assert_eq!(back.encode().unwrap(), cp.encode().unwrap(), "{label}");
+    assert_eq!(back.states, cp.states, "{label}");
+    let tail = resumed(plan, fmus, &back);
+    assert_eq!(tail.len(), full.len() - i, "{label}: row count");
+    assert!(
+        tail == full[i..],
+        "{label}: resumed rows differ from the full run"
+    );
+}
+
+#[test]
+fn resume_gives_the_uninterrupted_run_bit_for_bit() {
+    // RRS (Jacobi, sensors/filter/autopilot at step multiple 2): at an even and an odd step,
+    // where the slow instances are mid-step and their published outputs are older than
+    // their states.
+    let sys = system("rrs.toml", 60.0, Algorithm::Jacobi);
+    let fmus = load_fmus(&sys).unwrap();
+    let p = plan(&sys, &fmus);
+    assert_eq!(p.n_steps, 1200);
+    check_resume(&p, &fmus, 400, "rrs jacobi k=400");
+    check_resume(&p, &fmus, 401, "rrs jacobi k=401");
+    // Gauss-Seidel: the path-keeping system and RRS.
+    let sys = system("path_control_current.toml", 120.0, Algorithm::GaussSeidel);
+    let fmus = load_fmus(&sys).unwrap();
+    let p = plan(&sys, &fmus);
+    check_resume(&p, &fmus, 250, "path control gauss-seidel");
+    let sys = system("rrs.toml", 60.0, Algorithm::GaussSeidel);
+    let fmus = load_fmus(&sys).unwrap();
+    check_resume(&plan(&sys, &fmus), &fmus, 333, "rrs gauss-seidel k=333");
+}
+
+#[test]
+fn resume_keeps_the_decimation_phase() {
+    let mut sys = system("rrs.toml", 30.0, Algorithm::Jacobi);
+    let fmus = load_fmus(&sys).unwrap();
+    let every = full_run(&plan(&sys, &fmus), &fmus, &RunOptions::default());
+    sys.output.decimation = 7;
+    let p = plan(&sys, &fmus);
+    let full = full_run(&p, &fmus, &RunOptions::default());
+    assert_eq!(full.len(), 600 / 7 + 2, "t0, every 7th step, t_n");
+    let cp = run_to_checkpoint(&p, &fmus, 100, None, &RunOptions::default()).unwrap();
+    let tail = resumed(&p, &fmus, &cp);
+    // First the row at t_100 (not a multiple of 7), then the full run's rows after it.
+    assert_eq!(tail[0], every[100]);
+    let after = full
+        .iter()
+        .position(|r| f64::from_bits(r[0]) > cp.time)
+        .unwrap();
+    assert_eq!(after, 100 / 7 + 1);
+    assert!(tail[1..] == full[after..]);
+}
+
+/// Options that write a checkpoint at base step `step` to `file`.
+fn writing(step: u64, file: &Path) -> RunOptions {
+    RunOptions {
+        checkpoint: Some(CheckpointRequest {
+            step,
+            file: file.to_path_buf(),
+        }),
+        ..Default::default()
+    }
+}
+
+#[test]
+fn writing_a_checkpoint_during_a_run_changes_nothing() {
+    let sys = system("rrs.toml", 40.0, Algorithm::Jacobi);
+    let fmus = load_fmus(&sys).unwrap();
+    let p = plan(&sys, &fmus);
+    let d = tempfile::tempdir().unwrap();
+    let file = d.path().join("sub/dir/cp.bin");
+    let with = full_run(&p, &fmus, &writing(321, &file));
+    let without = full_run(&p, &fmus, &RunOptions::default());
+    assert!(with == without, "taking a checkpoint changed the run");
+    let written = std::fs::read(&file).unwrap();
+    let returned = run_to_checkpoint(&p, &fmus, 321, None, &RunOptions::default()).unwrap();
+    assert_eq!(written, returned.encode().unwrap());
+    // A resumed run may write a later checkpoint: resuming from that one gives the same tail.
+    let later = d.path().join("later.bin");
+    let mut m = MemoryRecorder::new();
+    resume_with(&p, &fmus, &returned, Some(&mut m), &writing(700, &later)).unwrap();
+    assert!(rows(&m) == without[321..]);
+    let tail = resumed(&p, &fmus, &Checkpoint::read(&later).unwrap());
+    assert!(tail == without[700..]);
+}
+
+/// Cold run A: `sys` with the event `target = value` at t_k. Fork B: warm-up of `sys` without
+/// it to t_k, then the plan with the event from the checkpoint. A and B agree bit for bit from
+/// t_k on, and the event changes the run (else the test could not fail).
+fn check_fork(sys: &System, k: u64, target: &str, values: &[Value], label: &str) {
+    let fmus = load_fmus(sys).unwrap();
+    let base = plan(sys, &fmus);
+    let t = base.start_time + k as f64 * base.step_size;
+    assert_eq!(checkpoint_step(&base, t).unwrap(), k);
+    let warm = run_to_checkpoint(&base, &fmus, k, None, &RunOptions::default()).unwrap();
+    let unchanged = full_run(&base, &fmus, &RunOptions::default());
+    let i = row_at(&unchanged, warm.time);
+    for value in values {
+        let forked = with_event(sys, t, target, value.clone());
+        let p = plan(&forked, &fmus);
+        assert_eq!(p.events.last().unwrap().step, k);
+        let cold = full_run(&p, &fmus, &RunOptions::default());
+        let fork = resumed(&p, &fmus, &warm);
+        assert!(
+            fork == cold[i..],
+            "{label}: fork {target} = {value} differs from the cold run"
+        );
+        assert!(cold[..=i] == unchanged[..=i], "{label}: before the event");
+        let changed = cold[i + 1..]
+            .iter()
+            .zip(&unchanged[i + 1..])
+            .filter(|(a, b)| a != b)
+            .count();
+        assert!(
+            changed > (cold.len() - i) / 2,
+            "{label}: {target} = {value} changed only {changed} rows"
+        );
+    }
+}
+
+#[test]
+fn a_fork_from_a_warm_up_equals_the_cold_run_with_the_event() {
+    let rrs = system("rrs.toml", 90.0, Algorithm::Jacobi);
+    check_fork(
+        &rrs,
+        601,
+        "autopilot.roll_mode",
+        &[Value::Integer(0)],
+        "rrs jacobi",
+    );
+    check_fork(
+        &rrs,
+        600,
+        "waves.wave_direction",
+        &[Value::Real(0.5), Value::Real(2.5)],
+        "rrs jacobi",
+    );
+    let rrs_gs = system("rrs.toml", 90.0, Algorithm::GaussSeidel);
+    check_fork(
+        &rrs_gs,
+        600,
+        "autopilot.roll_mode",
+        &[Value::Integer(0)],
+        "rrs gauss-seidel",
+    );
+    let path = system("path_control_current.toml", 150.0, Algorithm::GaussSeidel);
+    check_fork(
+        &path,
+        300,
+        "sensors.noise_scale",
+        &[Value::Real(3.0), Value::Real(0.0)],
+        "path control gauss-seidel",
+    );
+}
+
+/// A checkpoint is refused by another system, naming the difference.
+#[test]
+fn a_checkpoint_from_another_system_is_refused() {
+    let sys = system("rrs.toml", 30.0, Algorithm::Jacobi);
+    let fmus = load_fmus(&sys).unwrap();
+    let p = plan(&sys, &fmus);
+    let cp = run_to_checkpoint(&p, &fmus, 200, None, &RunOptions::default()).unwrap();
+    let refused = |sys: &System| -> String {
+        let fmus = load_fmus(sys).unwrap();
+        let p = plan(sys, &fmus);
+        let e = resume_with(&p, &fmus, &cp, None, &RunOptions::default()).unwrap_err();
+        e.to_string()
+    };
+    let e = refused(&system("rrs.toml", 40.0, Algorithm::Jacobi));
+    assert!(
+        e.contains("different system") && e.contains("600 base steps"),
+        "{e}"
+    );
+    let e = refused(&system("rrs.toml", 30.0, Algorithm::GaussSeidel));
+    assert!(e.contains("algorithm Jacobi in the checkpoint"), "{e}");
+    let e = refused(&system(
+        "path_control_current.toml",
+        30.0,
+        Algorithm::Jacobi,
+    ));
+    assert!(e.contains("7 instances (ship, gear, waves"), "{e}");
+    let mut other = sys.clone();
+    other.instances[4].step_multiple = 1;
+    let e = refused(&other);
+    assert!(e.contains("instance 'sensors': step_multiple 2"), "{e}");
+    let mut other = sys.clone();
+    other.output.variables = Some(vec!["ship.heading".into()]);
+    let e = refused(&other);
+    assert!(
+        e.contains("connection or recorded output 23 is 'ship.roll' in the checkpoint, 'ship.heading' in this system"),
+        "{e}"
+    );
+    other.output.variables = Some(vec!["ship.roll".into()]);
+    let e = refused(&other);
+    assert!(
+        e.contains("36 connections and recorded outputs in the checkpoint, 23 in this system"),
+        "{e}"
+    );
+    // Another FMU under the same instance name: the GUID differs.
+    let mut other = sys.clone();
+    other.instances[3].fmu = our_fmu("Waves");
+    other.instances[3].values.clear();
+    other
+        .connections
+        .retain(|c| c.from.instance != "wind" && c.to.instance != "wind");
+    other.output.variables = Some(vec!["ship.roll".into()]);
+    let e = refused(&other);
+    assert!(
+        e.contains("instance 'wind': FMU GUID") && e.contains("a different FMU"),
+        "{e}"
+    );
+    // A different start value is no difference: the restored states replace it.
+    let mut other = sys.clone();
+    other
+        .apply_overrides(&["gear.time_constant=0.5".into()])
+        .unwrap();
+    let fmus2 = load_fmus(&other).unwrap();
+    let tail = resumed(&plan(&other, &fmus2), &fmus2, &cp);
+    let full = full_run(&p, &fmus, &RunOptions::default());
+    assert!(tail == full[200..]);
+}
+
+#[test]
+fn truncated_corrupt_and_hostile_files_are_clear_errors() {
+    let sys = system("rrs.toml", 10.0, Algorithm::Jacobi);
+    let fmus = load_fmus(&sys).unwrap();
+    let p = plan(&sys, &fmus);
+    let cp = run_to_checkpoint(&p, &fmus, 100, None, &RunOptions::default()).unwrap();
+    let bytes = cp.encode().unwrap();
+    let file = Path::new("/some/where/cp.bin");
+    let decode_err = |b: &[u8]| match Checkpoint::decode(b, file) {
+        Ok(_) => panic!("decoded {} bytes", b.len()),
+        Err(e @ Error::Checkpoint { .. }) => e.to_string(),
+        Err(e) => panic!("{e}"),
+    };
+    assert!(Checkpoint::decode(&bytes, file).is_ok());
+    for n in 0..bytes.len() {
+        let e = decode_err(&bytes[..n]);
+        assert!(e.starts_with("checkpoint file /some/where/cp.bin: "), "{e}");
+        assert!(
+            e.contains("truncated") || (n < 8 && e.contains("magic")),
+            "{n}: {e}"
+        );
+    }
+    // Every byte changed: an error, never a panic, an allocation or a wrong checkpoint.
+    for i in 0..bytes.len() {
+        let mut b = bytes.clone();
+        b[i] ^= 0x5a;
+        decode_err(&b);
+    }
+    // A count of 2^32 - 1 instances is checked against the bytes left before any allocation.
+    let mut b = bytes.clone();
+    b[53..57].copy_from_slice(&u32::MAX.to_le_bytes());
+    let e = decode_err(&b);
+    assert!(
+        e.contains("4294967295 instances") && e.contains("truncated or corrupt"),
+        "{e}"
+    );
+    let mut b = bytes.clone();
+    b[8..12].copy_from_slice(&2u32.to_le_bytes());
+    assert!(decode_err(&b).contains("format version 2"));
+    let mut b = bytes.clone();
+    b.push(0);
+    assert!(decode_err(&b).contains("checksum"));
+    // A foreign file, and a missing one.
+    let e = Checkpoint::read(
+        Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("Cargo.toml")
+            .as_path(),
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("Cargo.toml: not a shipsim checkpoint"), "{e}");
+    let e = Checkpoint::read(Path::new("/no/such/cp.bin")).unwrap_err();
+    assert!(e.to_string().contains("/no/such/cp.bin"), "{e}");
+}
+
+#[test]
+fn checkpoint_times_must_be_inside_the_grid() {
+    let sys = system("rrs.toml", 10.0, Algorithm::Jacobi);
+    let fmus = load_fmus(&sys).unwrap();
+    let p = plan(&sys, &fmus);
+    assert_eq!(checkpoint_step(&p, 5.0).unwrap(), 100);
+    assert_eq!(checkpoint_step(&p, 0.05).unwrap(), 1);
+    for t in [5.01, 0.0, 10.0, 12.0, -1.0, f64::NAN] {
+        let e = checkpoint_step(&p, t).unwrap_err().to_string();
+        assert!(e.contains("base-step point"), "{t}: {e}");
+    }
+    let e = run_to_checkpoint(&p, &fmus, 200, None, &RunOptions::default()).unwrap_err();
+    assert!(e.to_string().contains("before the end at step 200"), "{e}");
+}
+
+#[test]
+fn an_fmu_without_state_functions_is_refused_before_the_run() {
+    let d = tempfile::tempdir().unwrap();
+    let fmu = test_fmu(d.path());
+    let p = write_system(
+        d.path(),
+        "a.toml",
+        "[simulation]\nstop_time = 1.0\nstep_size = 0.1\n[[instances]]\nname = \"a\"\nfmu = \"testfmu.fmu\"\n",
+    );
+    let sys = System::load(&p).unwrap();
+    let fmus = load_fmus(&sys).unwrap();
+    let plan = plan(&sys, &fmus);
+    let mut m = MemoryRecorder::new();
+    let e = run_to_checkpoint(&plan, &fmus, 5, Some(&mut m), &RunOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains(&format!("FMU '{}'", fmu.display()))
+            && e.contains("instance 'a'")
+            && e.contains("canGetAndSetFMUstate"),
+        "{e}"
+    );
+    assert!(m.time.is_empty(), "refused before the first row");
+}
+
+// ---- the command line ----
+
+/// systems/rrs.toml pointing at $SHIPSIM_FMU_DIR, in `dir`.
+fn rrs_file(dir: &Path) -> PathBuf {
+    let text =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("../systems/rrs.toml"))
+            .unwrap();
+    let fmu_dir = our_fmu("RrsShip").parent().unwrap().to_path_buf();
+    let text = text.replace("../target/fmu/", &format!("{}/", fmu_dir.display()));
+    write_system(dir, "rrs.toml", &text)
+}
+
+/// `shipsim run SYSTEM --stop-time 30 -q ARGS`: (success, stderr).
+fn shipsim_run(system: &Path, args: &[&str]) -> (bool, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_shipsim"))
+        .arg("run")
+        .arg(system)
+        .args(["--stop-time", "30", "-q"])
+        .args(args)
+        .output()
+        .unwrap();
+    (
+        out.status.success(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+#[test]
+fn cli_checkpoint_then_resume_gives_the_tail_of_the_full_csv() {
+    let d = tempfile::tempdir().unwrap();
+    let sys = rrs_file(d.path());
+    let path = |n: &str| d.path().join(n).display().to_string();
+    let (ok, err) = shipsim_run(&sys, &["-o", &path("plain.csv")]);
+    assert!(ok, "{err}");
+    let (ok, err) = shipsim_run(
+        &sys,
+        &[
+            "-o",
+            &path("full.csv"),
+            "--checkpoint-at",
+            "12.35",
+            &path("cp.bin"),
+        ],
+    );
+    assert!(ok, "{err}");
+    let (ok, err) = shipsim_run(
+        &sys,
+        &["-o", &path("tail.csv"), "--resume", &path("cp.bin")],
+    );
+    assert!(ok, "{err}");
+    let read = |n: &str| std::fs::read_to_string(d.path().join(n)).unwrap();
+    let (plain, full, tail) = (read("plain.csv"), read("full.csv"), read("tail.csv"));
+    assert_eq!(plain, full, "--checkpoint-at changed the output");
+    let full: Vec<&str> = full.lines().collect();
+    let tail: Vec<&str> = tail.lines().collect();
+    assert_eq!(full.len(), 1 + 601);
+    assert!(full[1 + 247].starts_with("12.35,"), "{}", full[1 + 247]);
+    assert_eq!(tail[0], full[0], "header");
+    assert_eq!(tail[1..], full[1 + 247..]);
+
+    // Resuming under another --stop-time is refused, naming the file and the difference.
+    let out = Command::new(env!("CARGO_BIN_EXE_shipsim"))
+        .arg("run")
+        .arg(&sys)
+        .args(["--stop-time", "31", "-q", "--resume", &path("cp.bin")])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(
+        err.contains(&format!("checkpoint file {}", path("cp.bin")))
+            && err.contains("different system")
+            && err.contains("620 (t = 31 s) in this system"),
+        "{err}"
+    );
+}
+
+#[test]
+fn cli_refuses_times_off_the_grid_and_truncated_files() {
+    let d = tempfile::tempdir().unwrap();
+    let sys = rrs_file(d.path());
+    let cp = d.path().join("cp.bin").display().to_string();
+    for t in ["12.34", "0", "30", "45", "soon"] {
+        let (ok, err) = shipsim_run(&sys, &["--checkpoint-at", t, &cp]);
+        assert!(!ok && err.contains("--checkpoint-at"), "{t}: {err}");
+        assert!(
+            err.contains("base-step point") || err.contains("a time in seconds"),
+            "{t}: {err}"
+        );
+    }
+    assert!(!Path::new(&cp).exists());
+    let (ok, err) = shipsim_run(&sys, &["--checkpoint-at", "10", &cp]);
+    assert!(ok, "{err}");
+    let bytes = std::fs::read(&cp).unwrap();
+    std::fs::write(&cp, &bytes[..bytes.len() / 2]).unwrap();
+    let (ok, err) = shipsim_run(&sys, &["--resume", &cp]);
+    assert!(
+        !ok && err.contains(&format!("checkpoint file {cp}: truncated")),
+        "{err}"
+    );
+}
