@@ -882,3 +882,112 @@ fn ctrl_c_stops_a_campaign_cleanly_and_the_same_command_finishes_it() {
     let unique: HashSet<_> = after.iter().collect();
     assert_eq!((after.len(), unique.len()), (200, 200));
 }
+
+#[test]
+fn campaign_plot_draws_every_kind_from_an_output_folder() {
+    let dir = tempfile::tempdir().unwrap();
+    test_system(dir.path(), 0.05);
+    let text = format!("{MANY}[[arms]]\nname = \"lo\"\nset = {{ \"m.u\" = 1.0 }}\n[[arms]]\nname = \"hi\"\nset = {{ \"m.u\" = 2.0 }}\n{KPIS}[[derived]]\nname = \"ratio\"\nexpr = \"y_final[hi] / y_final[lo]\"\n");
+    let c = Campaign::from_spec(spec(dir.path(), "c.toml", &text)).unwrap();
+    let out = dir.path().join("out");
+    execute::run(&c, &opts(&out, 2)).unwrap();
+    let plot = |args: &[&str]| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_shipsim"))
+            .args(["campaign", "plot"])
+            .args(args)
+            .output()
+            .unwrap()
+    };
+    let png = |name: &str| dir.path().join(name).display().to_string();
+    let runs = out.join("runs.parquet").display().to_string();
+    let folder = out.display().to_string();
+    for (args, file) in [
+        (
+            vec![
+                folder.as_str(),
+                "--x",
+                "k",
+                "--y",
+                "ratio",
+                "--x-label",
+                "k [-]",
+            ],
+            "line.png",
+        ),
+        (
+            vec![
+                runs.as_str(),
+                "--kind",
+                "heatmap",
+                "--x",
+                "k",
+                "--y",
+                "m.fail_at_step",
+                "--z",
+                "y_final",
+            ],
+            "heat.png",
+        ),
+        (
+            vec![
+                runs.as_str(),
+                "--kind",
+                "polar",
+                "--x",
+                "k",
+                "--y",
+                "y_final",
+                "--group",
+                "arm",
+            ],
+            "polar.png",
+        ),
+        (
+            vec![
+                runs.as_str(),
+                "--kind",
+                "histogram",
+                "--x",
+                "y_mean",
+                "--group",
+                "arm",
+            ],
+            "hist.png",
+        ),
+    ] {
+        let p = png(file);
+        let o = plot(&[args, vec!["-o", p.as_str()]].concat());
+        assert!(
+            o.status.success(),
+            "{file}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        let bytes = std::fs::read(&p).unwrap();
+        assert_eq!(&bytes[1..4], b"PNG", "{file}");
+    }
+    let o = plot(&[
+        runs.as_str(),
+        "--kind",
+        "pie",
+        "--x",
+        "k",
+        "-o",
+        &png("x.png"),
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success() && err.contains("use line, polar, heatmap or histogram"),
+        "{err}"
+    );
+    let o = plot(&[
+        runs.as_str(),
+        "--x",
+        "kk",
+        "--y",
+        "y_final",
+        "-o",
+        &png("x.png"),
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success() && err.contains("kk"), "{err}");
+}

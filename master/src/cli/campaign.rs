@@ -68,6 +68,15 @@ pub enum CampaignCommand {
         group: Option<String>,
         #[arg(long)]
         title: Option<String>,
+        /// Axis label of --x (default: the column name), e.g. "wave direction [deg]".
+        #[arg(long)]
+        x_label: Option<String>,
+        /// Axis label of --y (polar: the radius), e.g. "roll reduction [%]".
+        #[arg(long)]
+        y_label: Option<String>,
+        /// Legend name of --group, e.g. "H_s [m]".
+        #[arg(long)]
+        group_label: Option<String>,
         /// PNG output file.
         #[arg(long, short)]
         output: PathBuf,
@@ -142,6 +151,9 @@ pub fn dispatch(
             z,
             group,
             title,
+            x_label,
+            y_label,
+            group_label,
             output,
         } => {
             let req = PlotRequest {
@@ -151,7 +163,12 @@ pub fn dispatch(
                 z: z.as_deref(),
                 group: group.as_deref(),
             };
-            plot(&table, &req, title, &output)
+            let mut opts = campaign::plot::PlotOptions::new(&output);
+            opts.title = title;
+            opts.x_label = x_label;
+            opts.y_label = y_label;
+            opts.group_label = group_label;
+            plot(&table, &req, &opts)
         }
     }
 }
@@ -226,8 +243,7 @@ pub struct PlotRequest<'a> {
 fn plot<'r>(
     table: &Path,
     req: &PlotRequest<'r>,
-    title: Option<String>,
-    output: &Path,
+    opts: &campaign::plot::PlotOptions,
 ) -> shipsim::Result<()> {
     use campaign::plot;
     let file = if table.is_dir() {
@@ -241,22 +257,20 @@ fn plot<'r>(
         table.to_path_buf()
     };
     let t = campaign::table::Table::read(&file)?;
-    let mut opts = plot::PlotOptions::new(output);
-    opts.title = title;
     let need = |v: Option<&'r str>, what: &str| -> shipsim::Result<&'r str> {
         v.ok_or_else(|| Error::Other(format!("campaign plot --kind {}: give {what}", req.kind)))
     };
     let summary = match req.kind {
-        "line" => plot::line_band(&t, req.x, need(req.y, "--y (the KPI)")?, req.group, &opts)?,
-        "polar" => plot::polar(&t, req.x, need(req.y, "--y (the KPI)")?, req.group, &opts)?,
+        "line" => plot::line_band(&t, req.x, need(req.y, "--y (the KPI)")?, req.group, opts)?,
+        "polar" => plot::polar(&t, req.x, need(req.y, "--y (the KPI)")?, req.group, opts)?,
         "heatmap" => plot::heatmap(
             &t,
             req.x,
             need(req.y, "--y (the second factor)")?,
             need(req.z, "--z (the KPI)")?,
-            &opts,
+            opts,
         )?,
-        "histogram" => plot::histogram(&t, req.x, req.group, &opts)?,
+        "histogram" => plot::histogram(&t, req.x, req.group, opts)?,
         k => {
             return Err(Error::Other(format!(
                 "campaign plot --kind {k}: use line, polar, heatmap or histogram"
@@ -265,7 +279,7 @@ fn plot<'r>(
     };
     println!(
         "wrote {} ({} rows of {}{})",
-        output.display(),
+        opts.path.display(),
         summary.rows_used,
         file.display(),
         if summary.rows_skipped > 0 {
