@@ -33,6 +33,10 @@ use crate::error::{Error, Result};
 use crate::system::Value;
 use sha2::{Digest, Sha256};
 
+/// The most runs (and design points) a campaign file may expand to: every run is held in
+/// memory with the values it sets (about a kilobyte each).
+pub const MAX_RUNS: usize = 1_000_000;
+
 /// One run of the campaign.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Run {
@@ -166,10 +170,10 @@ pub fn design_points(spec: &CampaignSpec) -> Result<Vec<Vec<f64>>> {
     let total = dims
         .iter()
         .try_fold(1usize, |n, d| n.checked_mul(d.levels.len()))
-        .filter(|n| *n <= 100_000_000)
+        .filter(|n| *n <= MAX_RUNS)
         .ok_or_else(|| {
             Error::Other(format!(
-                "campaign {}: more than 10^8 design points",
+                "campaign {}: more than {MAX_RUNS} design points",
                 spec.source.display()
             ))
         })?;
@@ -189,13 +193,13 @@ pub fn design_points(spec: &CampaignSpec) -> Result<Vec<Vec<f64>>> {
     Ok(points)
 }
 
-/// A factor value as the text `--set` takes: whole numbers without a fraction (so that
-/// Integer, Enumeration and Boolean variables take them), others in shortest round-trip form.
-fn set_value(x: f64) -> Value {
+/// A number as the text `--set` takes: whole numbers without a fraction (so that Integer,
+/// Enumeration and Boolean variables take them), others in shortest round-trip form.
+fn number_text(x: f64) -> String {
     if x.fract() == 0.0 && x.abs() < 2f64.powi(53) {
-        Value::Text(format!("{}", x as i64))
+        format!("{}", x as i64)
     } else {
-        Value::Text(format!("{x:?}"))
+        format!("{x:?}")
     }
 }
 
@@ -228,7 +232,7 @@ pub fn runs(spec: &CampaignSpec, base_hash: &str) -> Result<Vec<Run>> {
             for arm in 0..arms {
                 let mut sets = spec.set.clone();
                 for (f, x) in spec.factors.iter().zip(values) {
-                    sets.push((f.variable.clone(), set_value(x * f.scale)));
+                    sets.push((f.variable.clone(), Value::Text(number_text(x * f.scale))));
                 }
                 for (p, s) in spec.replications.seeds.iter().zip(&seeds) {
                     sets.push((p.clone(), Value::Integer(*s)));
@@ -285,15 +289,8 @@ fn run_key(spec: &CampaignSpec, base_hash: &str, sets: &[(String, Value)]) -> St
 
 /// A value's text for hashing: the same value always hashes the same, whatever its spelling.
 fn canonical(v: &Value) -> String {
-    let number = |x: f64| {
-        if x.fract() == 0.0 && x.abs() < 2f64.powi(53) {
-            format!("{}", x as i64)
-        } else {
-            format!("{x:?}")
-        }
-    };
     match v {
-        Value::Real(x) => number(*x),
+        Value::Real(x) => number_text(*x),
         Value::Integer(i) => format!("{i}"),
         Value::Boolean(b) => format!("{}", *b as i32),
         Value::String(s) => format!("{s:?}"),
@@ -302,7 +299,7 @@ fn canonical(v: &Value) -> String {
             "false" => "0".into(),
             t => t
                 .parse::<f64>()
-                .map(number)
+                .map(number_text)
                 .unwrap_or_else(|_| format!("{t:?}")),
         },
     }

@@ -25,7 +25,7 @@ use crate::fmu::Fmu;
 use crate::instance::LogSink;
 use crate::model_description::ModelDescription;
 use crate::run::{self, ColumnInfo, CsvRecorder, Recorder, Row, RunOptions};
-use crate::system::{Plan, System};
+use crate::system::System;
 use rayon::prelude::*;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::PathBuf;
@@ -474,8 +474,9 @@ struct Fork {
     at: f64,
     /// `group[run]`: the run's warm-up group, numbered in order of first appearance.
     group: Vec<usize>,
-    /// Per run: (warm-up system, the run's system).
-    systems: Vec<(System, System)>,
+    /// The set variables (`instance.variable`) that can change during a run (inputs and
+    /// tunable parameters): set by events at the fork, the others before the warm-up.
+    changeable: std::collections::HashSet<String>,
 }
 
 /// Groups the runs when the campaign forks, after checking every FMU can save its state.
@@ -495,19 +496,45 @@ fn fork_plan(campaign: &Campaign, mds: &[&ModelDescription]) -> Result<Option<Fo
             ));
         }
     }
-    let changeable = |r: &crate::system::VarRef| super::changeable_in(&campaign.system, mds, r);
+    let changeable: std::collections::HashSet<String> = campaign
+        .runs
+        .iter()
+        .flat_map(|r| r.sets.iter().map(|(v, _)| v))
+        .filter(|v| {
+            crate::system::VarRef::parse(v)
+                .is_some_and(|r| super::changeable_in(&campaign.system, mds, &r))
+        })
+        .cloned()
+        .collect();
+    let fork = Fork {
+        at,
+        group: Vec::new(),
+        changeable,
+    };
     let mut keys: std::collections::HashMap<String, usize> = Default::default();
-    let mut group = Vec::with_capacity(campaign.runs.len());
-    let mut systems = Vec::with_capacity(campaign.runs.len());
-    for r in &campaign.runs {
-        let n = keys.len();
-        group.push(*keys.entry(campaign.group_key(r, &changeable)).or_insert(n));
-        systems.push(campaign.fork_systems_for(r, at, &changeable)?);
-    }
-    Ok(Some(Fork { at, group, systems }))
+    let group = campaign
+        .runs
+        .iter()
+        .map(|r| {
+            let n = keys.len();
+            *keys
+                .entry(campaign.group_key(r, &|v| fork.is_changeable(v)))
+                .or_insert(n)
+        })
+        .collect();
+    Ok(Some(Fork { group, ..fork }))
 }
 
 impl Fork {
+    fn is_changeable(&self, r: &crate::system::VarRef) -> bool {
+        self.changeable.contains(&r.to_string())
+    }
+
+    /// (The warm-up system of the run's group, the run's own system.)
+    fn systems(&self, campaign: &Campaign, run: &Run) -> Result<(System, System)> {
+        campaign.fork_systems_for(run, self.at, &|v| self.is_changeable(v))
+    }
+
     /// The runs to do, by warm-up group.
     fn groups_of<'r>(&self, todo: &[&'r Run]) -> Vec<Vec<&'r Run>> {
         let mut by: std::collections::BTreeMap<usize, Vec<&Run>> = Default::default();
@@ -522,17 +549,15 @@ impl Fork {
         if ctx.stop() {
             return Ok(());
         }
-        let warm_up = |system: &System| -> Result<(Plan, run::Checkpoint)> {
+        let warm_up = || -> Result<run::Checkpoint> {
+            let (system, _) = self.systems(ctx.campaign, runs[0])?;
             let plan = system.validate(&ctx.mds())?;
             let k = run::checkpoint_step(&plan, self.at)
                 .map_err(|e| Error::Other(format!("fork_at: {e}")))?;
-            let cp = run::run_to_checkpoint(&plan, &ctx.fmus, k, None, &ctx.run_opts)?;
-            Ok((plan, cp))
+            run::run_to_checkpoint(&plan, &ctx.fmus, k, None, &ctx.run_opts)
         };
-        let first = runs[0];
-        let shared = catch_unwind(AssertUnwindSafe(|| warm_up(&self.systems[first.index].0)));
-        let cp = match shared {
-            Ok(Ok((_, cp))) => Arc::new(cp),
+        let cp = match catch_unwind(AssertUnwindSafe(warm_up)) {
+            Ok(Ok(cp)) => Arc::new(cp),
             Ok(Err(Error::Interrupted { .. })) => return Ok(()),
             failed => {
                 // The warm-up failed: every run of the group fails with its message.
@@ -557,7 +582,7 @@ impl Fork {
                 return Ok(());
             }
             let outcome = ctx.execute(r, |rec| {
-                let plan = self.systems[r.index].1.validate(&ctx.mds())?;
+                let plan = self.systems(ctx.campaign, r)?.1.validate(&ctx.mds())?;
                 run::resume_with(&plan, &ctx.fmus, &cp, Some(rec), &ctx.run_opts)
             });
             ctx.finish(r, outcome)

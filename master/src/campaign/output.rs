@@ -108,11 +108,14 @@ pub fn check_or_write_provenance(
     write_atomic(&path, text.as_bytes())
 }
 
+/// Writes `bytes` to `path` atomically ([`super::table::write_atomic`]).
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    let tmp = path.with_extension("tmp");
-    std::fs::write(&tmp, bytes)
-        .and_then(|_| std::fs::rename(&tmp, path))
-        .map_err(|e| Error::io(format!("cannot write {}", path.display()), e))
+    super::table::write_atomic(path, |mut file| {
+        use std::io::Write;
+        file.write_all(bytes)
+            .map_err(|e| Error::io(format!("writing {}", path.display()), e))?;
+        Ok(file)
+    })
 }
 
 /// The KPI column names of the campaign, in row order.

@@ -170,7 +170,7 @@ struct Raw {
     #[serde(default)]
     kpis: Vec<Spanned<RawKpi>>,
     #[serde(default)]
-    derived: Vec<Spanned<Derived2>>,
+    derived: Vec<Spanned<RawDerived>>,
     series: Option<RawSeries>,
 }
 
@@ -217,7 +217,7 @@ struct RawArm {
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
-struct Derived2 {
+struct RawDerived {
     name: String,
     expr: String,
 }
@@ -546,10 +546,14 @@ impl Reader<'_> {
                 "[sampling] is given but no factor is uniform or normal".into(),
             );
         }
-        if s.samples == 0 || s.samples > 10_000_000 {
+        if s.samples == 0 || s.samples > super::design::MAX_RUNS {
             self.error(
                 None,
-                format!("sampling: samples = {} must be 1 ..= 10^7", s.samples),
+                format!(
+                    "sampling: samples = {} must be 1 ..= {}",
+                    s.samples,
+                    super::design::MAX_RUNS
+                ),
             );
         }
         Sampling {

@@ -169,7 +169,7 @@ fn tmp_path(path: &Path) -> PathBuf {
 /// Writes `path` atomically: `write` fills `<path>.tmp` and returns the file, which is synced
 /// to disk and renamed over `path` (a rename within a directory is atomic on POSIX file
 /// systems). On any error the temporary file is removed and `path` is left as it was.
-fn write_atomic(path: &Path, write: impl FnOnce(File) -> Result<File>) -> Result<()> {
+pub(crate) fn write_atomic(path: &Path, write: impl FnOnce(File) -> Result<File>) -> Result<()> {
     let tmp = tmp_path(path);
     let result = File::create(&tmp)
         .map_err(|e| Error::io(format!("creating {}", tmp.display()), e))
