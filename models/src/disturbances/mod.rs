@@ -4,6 +4,7 @@
 
 pub mod current;
 pub mod shaping;
+pub mod sinusoids;
 pub mod spectral;
 pub mod waves;
 pub mod wind;
