@@ -52,7 +52,7 @@ enum Command {
         #[arg(long, conflicts_with = "output")]
         no_output: bool,
         /// Time the step loop per instance (fmi2DoStep, get/set) and the master's own work, on
-        /// 1 in 61 macro steps; print a table after the summary (stderr), or with
+        /// 1 in 127 macro steps; print a table after the summary (stderr), or with
         /// --profile=json one JSON line of the summary and profile on stdout.
         #[arg(long, value_enum, num_args = 0..=1, require_equals = true, default_missing_value = "table", value_name = "FORMAT")]
         profile: Option<ProfileFormat>,

@@ -142,8 +142,8 @@ fn profile_counts_every_call_and_the_busy_instance_leads() {
         assert_eq!(calls, [12000, 4000, 6000], "{algorithm}");
         assert_eq!(calls.iter().sum::<u64>(), summary.fmu_steps);
         assert_eq!(prof.macro_steps, 12000);
-        // Steps k < 12000 with k % 61 == 30: 30, 91, ..., 30 + 196 * 61 = 11986.
-        assert_eq!((prof.stride, prof.sampled_steps), (61, 197), "{algorithm}");
+        // Steps k < 12000 with k % 127 == 63: 63, 190, ..., 63 + 93 * 127 = 11874.
+        assert_eq!((prof.stride, prof.sampled_steps), (127, 94), "{algorithm}");
 
         // Shares of the sampled total: instances and master sum to 100 % (f64 rounding).
         let shares: f64 = prof
@@ -232,7 +232,7 @@ fn profile_changes_no_output_byte_and_prints_table_or_json() {
 
     let err = String::from_utf8(table.stderr).unwrap();
     let summary_at = err.find("macro steps, ").expect("the summary");
-    let profile_at = err.find("profile (sampled: 197 of 12000").expect(&err);
+    let profile_at = err.find("profile (sampled: 94 of 12000").expect(&err);
     assert!(
         summary_at < profile_at,
         "the table follows the summary:\n{err}"

@@ -2,19 +2,28 @@
 //! (`fmi2SetXxx`/`fmi2GetXxx` with the gather of inputs, and the events' `fmi2SetXxx`), and in
 //! the master's own work (recording, scheduling, progress, interruption checks).
 //!
-//! **Method: deterministic sampling.** Reading the clock around every FMI call (about 20 ns per
-//! `Instant::now` here, 20 or more reads per macro step) would cost more than the 1 % allowed
-//! when a whole macro step costs a few µs. So only the macro steps k with
-//! `k % STRIDE == PHASE` (every 61st) are timed, in full: one clock read at the start of the
+//! **Method: deterministic sampling.** Reading the clock around every FMI call (about 25 ns per
+//! `Instant::now` here, about 3 reads per instance and macro step) would cost more than the
+//! 1 % allowed when a whole macro step costs a few µs. So only the macro steps k with
+//! `k % STRIDE == PHASE` (1 in 127) are timed, in full: one clock read at the start of the
 //! step and one after each FMI call or batch (a lap, [`Probe::lap`]), the time since the
 //! previous read going to that call's instance and kind, and the rest (everything between the
 //! calls and after them: event lookup, recording, progress) to the master. The other steps run
-//! the same code with a probe that does nothing ([`Off`]), monomorphized away. The stride is a
-//! prime, co-prime with every step multiple below it, so an instance stepping every m-th macro
-//! step (k % m == 0) is timed in the same proportion of the sampled steps as of all steps
-//! (k ≡ PHASE mod 61 visits every residue mod m equally, by the Chinese remainder theorem): the
-//! per-macro-step means are unbiased for multi-rate systems. PHASE = 30 keeps the cold first
-//! step out of the sample.
+//! the same code with a probe that does nothing ([`Off`]), monomorphized away; the loop
+//! compares k with the next sampled step once per step. The stride is a prime, co-prime with
+//! every step multiple below it, so an instance stepping every m-th macro step (k % m == 0) is
+//! timed in the same proportion of the sampled steps as of all steps (k ≡ PHASE mod STRIDE
+//! visits every residue mod m equally, by the Chinese remainder theorem): the per-macro-step
+//! means are unbiased for multi-rate systems. PHASE = 63 keeps the cold first step out of the
+//! sample.
+//!
+//! Why 127 and not 61: a clock read also waits for the instructions before it (the vDSO reads
+//! the TSC ordered), so in a step of real FMUs a read costs up to about twice its back-to-back
+//! cost. Measured on `systems/dgps_trial.toml` (6 FMUs, 1.6 µs per macro step, 13 reads per
+//! timed step), 1 in 61 cost 0.7-1.4 % of the step loop (the fastest and the median of 60
+//! alternating runs each); 1 in 127 halves that, which keeps a 7-FMU system at 3 µs per macro
+//! step below 1 %.
+//! Runs of a few thousand steps get a few dozen timed steps.
 //!
 //! Each lap's interval also holds about one clock read; the cost of a read is measured before
 //! the loop (the fastest of 20 runs of 50 back-to-back reads) and subtracted once per lap
@@ -28,9 +37,9 @@
 use std::time::{Duration, Instant};
 
 /// Every `STRIDE`-th macro step is timed (a prime).
-pub const STRIDE: u64 = 61;
+pub const STRIDE: u64 = 127;
 /// The sampled steps are k with `k % STRIDE == PHASE`.
-pub const PHASE: u64 = 30;
+pub const PHASE: u64 = 63;
 
 /// Whether macro step k is timed.
 pub fn sampled(k: u64) -> bool {
@@ -358,7 +367,7 @@ mod tests {
             let expected = (k..).find(|&j| sampled(j)).unwrap();
             assert_eq!(next_sampled(k), expected, "k = {k}");
         }
-        assert_eq!(next_sampled(0), 30);
-        assert_eq!(next_sampled(31), 91);
+        assert_eq!(next_sampled(0), 63);
+        assert_eq!(next_sampled(64), 190);
     }
 }
