@@ -6,6 +6,7 @@ use shipsim::error::Error;
 use shipsim::fmu::UnpackedFmu;
 use shipsim::run::{
     checkpoint_step, prepare, resume, run, Checkpoint, CheckpointRequest, Output, RunOptions,
+    Sampling,
 };
 use shipsim::system::{Algorithm, System};
 use std::io::IsTerminal;
@@ -56,6 +57,10 @@ enum Command {
         /// --profile=json one JSON line of the summary and profile on stdout.
         #[arg(long, value_enum, num_args = 0..=1, require_equals = true, default_missing_value = "table", value_name = "FORMAT")]
         profile: Option<ProfileFormat>,
+        /// With --profile: time 1 in N macro steps instead of 1 in 127 (1 = every step, which
+        /// catches work done on few steps at about 10 % overhead; else choose a prime).
+        #[arg(long, value_name = "N", requires = "profile", value_parser = clap::value_parser!(u64).range(1..))]
+        profile_every: Option<u64>,
         /// Set a parameter or start value: --set instance.variable=value (repeatable).
         #[arg(long = "set", value_name = "INST.VAR=VALUE")]
         set: Vec<String>,
@@ -160,6 +165,7 @@ fn dispatch(cmd: Command) -> shipsim::Result<()> {
             output,
             no_output,
             profile,
+            profile_every,
             set,
             algorithm,
             verbose,
@@ -182,7 +188,7 @@ fn dispatch(cmd: Command) -> shipsim::Result<()> {
             let flags = RunFlags {
                 output,
                 no_output,
-                profile,
+                profile: profile.map(|f| (f, profile_every)),
                 verbose,
                 quiet,
             };
@@ -306,7 +312,8 @@ fn parse_checkpoint_at(v: Vec<String>) -> shipsim::Result<(f64, PathBuf)> {
 struct RunFlags {
     output: Option<PathBuf>,
     no_output: bool,
-    profile: Option<ProfileFormat>,
+    /// The format, and 1 in how many macro steps to time (default [`Sampling::default`]).
+    profile: Option<(ProfileFormat, Option<u64>)>,
     verbose: bool,
     quiet: bool,
 }
@@ -341,7 +348,10 @@ fn run_cli(sys: &System, flags: &RunFlags, checkpoints: Checkpoints) -> shipsim:
         interrupt: Some(flag),
         log_sink: None,
         checkpoint: None,
-        profile: flags.profile.is_some(),
+        profile: flags.profile.map(|(_, every)| match every {
+            Some(every) => Sampling { every },
+            None => Sampling::default(),
+        }),
     };
     let (plan, fmus) = prepare(sys)?;
     print_warnings(&plan.warnings);
@@ -372,8 +382,8 @@ fn run_cli(sys: &System, flags: &RunFlags, checkpoints: Checkpoints) -> shipsim:
         eprintln!("{summary}");
     }
     match (flags.profile, &summary.profile) {
-        (Some(ProfileFormat::Table), Some(p)) => eprintln!("{p}"),
-        (Some(ProfileFormat::Json), Some(p)) => println!("{}", run_json(sys, &summary, p)),
+        (Some((ProfileFormat::Table, _)), Some(p)) => eprintln!("{p}"),
+        (Some((ProfileFormat::Json, _)), Some(p)) => println!("{}", run_json(sys, &summary, p)),
         _ => {}
     }
     Ok(())

@@ -6,7 +6,7 @@
 //! Also `--no-output`: no CSV even when the system names one.
 mod common;
 use common::*;
-use shipsim::run::{load_fmus, run_system, run_with, MemoryRecorder, Output, RunOptions};
+use shipsim::run::{load_fmus, run_system, run_with, MemoryRecorder, Output, RunOptions, Sampling};
 use shipsim::system::System;
 use std::alloc::{GlobalAlloc, Layout, System as SysAlloc};
 use std::cell::Cell;
@@ -38,11 +38,12 @@ fn allocs() -> usize {
     ALLOCS.with(Cell::get)
 }
 
-/// The test FMU with about 20,000 volatile additions (tens of µs) before every fmi2DoStep: the
-/// C source includes testfmu.c with its fmi2DoStep renamed and wraps it.
-fn busy_fmu(dir: &Path) -> PathBuf {
+/// The test FMU `dir/<name>.fmu` that does `iterations` volatile additions (about 1.5 ns each)
+/// before every `nth` fmi2DoStep (counted from its first): the C source includes testfmu.c with
+/// its fmi2DoStep renamed and wraps it.
+fn busy_fmu(dir: &Path, name: &str, iterations: u32, nth: u32) -> PathBuf {
     let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/c/testfmu.c");
-    let wrapper = dir.join("busy.c");
+    let wrapper = dir.join(format!("{name}.c"));
     std::fs::write(
         &wrapper,
         format!(
@@ -50,8 +51,10 @@ fn busy_fmu(dir: &Path) -> PathBuf {
 #include "{}"
 #undef fmi2DoStep
 EXPORT fmi2Status fmi2DoStep(fmi2Component c, fmi2Real t, fmi2Real h, fmi2Boolean noprior) {{
-    volatile double acc = 0.0;
-    for (int j = 0; j < 20000; j++) acc += 0.5;
+    if (((Inst *)c)->n % {nth} == 0) {{
+        volatile double acc = 0.0;
+        for (int j = 0; j < {iterations}; j++) acc += 0.5;
+    }}
     return testfmu_do_step(c, t, h, noprior);
 }}
 "#,
@@ -59,7 +62,7 @@ EXPORT fmi2Status fmi2DoStep(fmi2Component c, fmi2Real t, fmi2Real h, fmi2Boolea
         ),
     )
     .unwrap();
-    let so = dir.join("busy.so");
+    let so = dir.join(format!("{name}.so"));
     let st = Command::new("gcc")
         .args(["-shared", "-fPIC", "-O2", "-fvisibility=hidden", "-o"])
         .arg(&so)
@@ -67,8 +70,8 @@ EXPORT fmi2Status fmi2DoStep(fmi2Component c, fmi2Real t, fmi2Real h, fmi2Boolea
         .arg("-lm")
         .status()
         .expect("gcc must be installed to build the test FMU");
-    assert!(st.success(), "gcc failed for the busy FMU");
-    let fmu = dir.join("busy.fmu");
+    assert!(st.success(), "gcc failed for {name}");
+    let fmu = dir.join(format!("{name}.fmu"));
     zip_files(
         &fmu,
         &[
@@ -119,7 +122,8 @@ decimation = 7
 fn setup(algorithm: &str) -> (tempfile::TempDir, PathBuf) {
     let d = tempfile::tempdir().unwrap();
     test_fmu(d.path());
-    busy_fmu(d.path());
+    // Tens of µs in every doStep.
+    busy_fmu(d.path(), "busy", 20_000, 1);
     let p = write_system(d.path(), "s.toml", &system(algorithm));
     (d, p)
 }
@@ -130,7 +134,7 @@ fn profile_counts_every_call_and_the_busy_instance_leads() {
         let (_d, p) = setup(algorithm);
         let sys = System::load(&p).unwrap();
         let opts = RunOptions {
-            profile: true,
+            profile: Some(Sampling::default()),
             ..Default::default()
         };
         let (_, summary) = run_system(&sys, Output::None, &opts).unwrap();
@@ -182,7 +186,7 @@ fn profile_counts_are_the_fmus_own_step_counts() {
     let plan = sys.validate(&mds).unwrap();
     let mut memory = MemoryRecorder::new();
     let opts = RunOptions {
-        profile: true,
+        profile: Some(Sampling::default()),
         ..Default::default()
     };
     let s = run_with(&plan, &fmus, Some(&mut memory), &opts).unwrap();
@@ -307,7 +311,7 @@ fn profiled_step_loop_allocates_nothing() {
         sys.stop_time = Some(stop);
         let plan = sys.validate(&mds).unwrap();
         let opts = RunOptions {
-            profile: true,
+            profile: Some(Sampling::default()),
             ..Default::default()
         };
         let mut memory = MemoryRecorder::new();
@@ -320,4 +324,77 @@ fn profiled_step_loop_allocates_nothing() {
         counts[0], counts[1],
         "allocations, 7e3 vs 7e4 steps: {counts:?}"
     );
+}
+
+/// `Sampling { every: 1 }` times every step, and so catches work done on few steps: an instance
+/// busy on every 127th of its steps only (a period the default sample, k % 127 == 63, never
+/// meets for an instance stepping every base step at k % 127 == 0) has the largest share.
+#[test]
+fn profile_every_step_catches_rare_costly_steps() {
+    let d = tempfile::tempdir().unwrap();
+    test_fmu(d.path());
+    // About 0.3 ms on steps 0, 127, 254, ...: 95 of 12,000 steps, about 30 ms in all.
+    busy_fmu(d.path(), "rare", 200_000, 127);
+    let text = system("jacobi")
+        .replace("busy.fmu", "rare.fmu")
+        .replace("step_multiple = 2\n", "");
+    let p = write_system(d.path(), "s.toml", &text);
+    let sys = System::load(&p).unwrap();
+    let opts = RunOptions {
+        profile: Some(Sampling { every: 1 }),
+        ..Default::default()
+    };
+    let (_, summary) = run_system(&sys, Output::None, &opts).unwrap();
+    let prof = summary.profile.unwrap();
+    assert_eq!((prof.stride, prof.sampled_steps), (1, 12000));
+    let calls: Vec<u64> = prof.instances.iter().map(|i| i.do_step_calls).collect();
+    assert_eq!(calls, [12000, 4000, 12000]);
+    // 30 ms of busy work against 16,000 cheap doStep calls and exchanges of well under 1 µs.
+    let rare = &prof.instances[2];
+    assert_eq!(prof.most_expensive().unwrap().name, "slow");
+    for other in &prof.instances[..2] {
+        assert!(
+            rare.do_step > 5 * (other.do_step + other.exchange),
+            "{prof:?}"
+        );
+    }
+}
+
+#[test]
+fn profile_every_on_the_command_line() {
+    let (d, p) = setup("jacobi");
+    let sys = p.to_str().unwrap();
+    let args = [
+        "run",
+        "-q",
+        sys,
+        "--no-output",
+        "--profile=json",
+        "--profile-every",
+    ];
+    let out = shipsim(&[&args[..], &["1"]].concat(), d.path());
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["profile"]["stride"], 1);
+    assert_eq!(v["profile"]["sampled_steps"], 12000);
+    let out = shipsim(&[&args[..], &["61"]].concat(), d.path());
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    // Steps k < 12000 with k % 61 == 30: 30, 91, ..., 30 + 196 * 61 = 11986.
+    assert_eq!(
+        (
+            v["profile"]["stride"].as_u64(),
+            v["profile"]["sampled_steps"].as_u64()
+        ),
+        (Some(61), Some(197))
+    );
+    for bad in [
+        &[&args[..], &["0"]].concat()[..],
+        &["run", "-q", sys, "--no-output", "--profile-every", "5"][..],
+    ] {
+        let r = Command::new(env!("CARGO_BIN_EXE_shipsim"))
+            .current_dir(d.path())
+            .args(bad)
+            .output()
+            .unwrap();
+        assert!(!r.status.success(), "{bad:?} must be refused");
+    }
 }

@@ -48,7 +48,7 @@ use algorithm::{Algorithm, GaussSeidel, Jacobi};
 use checkpoint::Fingerprint;
 pub use checkpoint::{checkpoint_step, Checkpoint};
 use exchange::Exchange;
-pub use profile::Profile;
+pub use profile::{Profile, Sampling};
 pub use recorder::{ColumnInfo, CsvRecorder, MemoryRecorder, Recorder, Row, Sample};
 use stepping::{Recording, Stepper};
 pub use time_grid::TimeGrid;
@@ -65,8 +65,9 @@ pub struct RunOptions {
     pub log_sink: Option<LogSink>,
     /// Write a checkpoint on passing a base step and continue ([`run_with`], [`resume_with`]).
     pub checkpoint: Option<CheckpointRequest>,
-    /// Time where the step loop goes per instance ([`Summary::profile`]; sampled, [`profile`]).
-    pub profile: bool,
+    /// Time where the step loop goes per instance, on these steps ([`Summary::profile`],
+    /// [`profile`]).
+    pub profile: Option<Sampling>,
 }
 
 /// Where and when a run writes its checkpoint.
@@ -434,7 +435,7 @@ fn execute<A: Algorithm>(
         wall: Duration::ZERO,
         profile: opts
             .profile
-            .then(|| profile::Accumulator::new(plan.instances.len())),
+            .map(|s| profile::Accumulator::new(plan.instances.len(), s)),
     };
     let mut taken = None;
     if let (Some((at, then)), Some(fp)) = (course.checkpoint, fingerprint) {

@@ -1,11 +1,11 @@
 //! The step loop: macro steps from t_k (t_0, or a checkpoint's) to t_n with an [`Algorithm`],
 //! recording, progress and interruption. A run may stop at a communication point between two
 //! calls of [`Stepper::advance`] (to take a checkpoint) and go on. Nothing in it allocates on
-//! the success path. A profiled run times 1 in [`super::profile::STRIDE`] macro steps.
+//! the success path. A profiled run times a sample of the macro steps ([`super::profile`]).
 
 use super::algorithm::{Algorithm, MacroStep};
 use super::exchange::{Column, Values};
-use super::profile::{next_sampled, Accumulator, Lap, Off, Probe, STRIDE};
+use super::profile::{Accumulator, Lap, Off, Probe};
 use super::progress::Progress;
 use super::recorder::{Recorder, Row};
 use super::slot::{Slot, StepCount};
@@ -75,7 +75,7 @@ impl Stepper<'_> {
         let mut k = self.k;
         let mut next_event = self.events.partition_point(|e| e.step < k);
         // The next sampled step (none without a profile): one comparison per step.
-        let mut next_sample = profile.as_ref().map_or(u64::MAX, |_| next_sampled(k));
+        let mut next_sample = profile.as_ref().map_or(u64::MAX, |a| a.sampling.next(k));
         while k < until && count.terminated_by.is_none() {
             let (next_event, count) = (&mut next_event, &mut count);
             match profile.as_mut().filter(|_| k == next_sample) {
@@ -83,7 +83,7 @@ impl Stepper<'_> {
                     let mut timer = acc.start();
                     self.macro_step(algorithm, k, &grid, next_event, count, &mut timer)?;
                     timer.lap(Lap::Master);
-                    next_sample += STRIDE;
+                    next_sample += acc.sampling.every.max(1);
                 }
                 None => self.macro_step(algorithm, k, &grid, next_event, count, &mut Off)?,
             }
