@@ -1,21 +1,26 @@
 """Every system of systems/: speed and where its time goes, from `shipsim run --profile=json`.
 
 Each system runs --repeat times (default 5) without CSV output (`--no-output`), pinned to one
-core (`taskset -c 1`; without taskset, or on one core, unpinned and the table says so). Every
-figure is the median over the runs:
+core (`taskset -c 1`; without taskset, or on one core, unpinned and the table says so), twice
+over; every figure is the median over the runs of its set:
 
-- real-time factor and µs per macro step: simulated time and the step loop's wall time, as the
-  run's summary reports them (all steps, measured);
-- the most expensive instance and its share, and the master's share of the step loop: from the
-  run's profile (1 in 127 macro steps timed in full, see master/src/run/profile.rs). The most
+- with the default profile (1 in 127 macro steps timed, under 1 % overhead): the real-time
+  factor and µs per macro step (simulated time and the step loop's wall time over all steps, as
+  the run's summary reports them), the profile's own cost, and how much of the measured step
+  loop the sample accounts for (well below 100 % when an FMU does costly work on few steps,
+  which a sample of 1 in 127 catches by chance);
+- with every macro step timed (`--profile-every 1`, about 10 % slower, shares corrected for the
+  clock reads): the most expensive instance and its share, and the master's share. The most
   expensive instance is the one with the largest median share.
+
+See master/src/run/profile.rs for the method.
 
 The pure-Rust model loop of the RRS system (the `rrs-model-loop` binary of system-tests, if it
 is built: --model-loop, $SHIPSIM_MODEL_LOOP_BIN or target/release/rrs-model-loop) runs
 --repeat times as well, pinned alike; it prints one JSON line
 {"stop_time": ..., "macro_steps": ..., "wall_s": ...} for its step loop. The section gives
-the ratio of the FMU system's step-loop time to the model loop's, per macro step (the median
-of each).
+the ratio of the FMU system's step-loop time (default profile runs) to the model loop's, per
+macro step (the median of each).
 
 Prints a Markdown section on stdout (cargo xtask bench writes it into docs/bench.md).
 
@@ -43,19 +48,22 @@ def pinning():
     return ["taskset", "-c", str(CORE)], f"pinned to core {CORE} (`taskset -c {CORE}`)"
 
 
-def run_system(exe, pin, system):
+def run_system(exe, pin, system, every=None):
     cmd = pin + [exe, "run", str(system), "--no-output", "--profile=json", "-q"]
+    if every is not None:
+        cmd += ["--profile-every", str(every)]
     r = subprocess.run(cmd, capture_output=True, text=True, cwd=ROOT)
     if r.returncode != 0:
         raise SystemExit(f"{' '.join(cmd)} failed:\n{r.stderr}")
     return json.loads(r.stdout.strip().splitlines()[-1])
 
 
-def summarize(runs):
-    """The medians of one system's runs."""
+def summarize(runs, every_step):
+    """The medians of one system's runs: speed from `runs`, shares from `every_step`."""
     med = statistics.median
-    names = [i["name"] for i in runs[0]["profile"]["instances"]]
-    shares = {n: med(r["profile"]["instances"][j]["share"] for r in runs) for j, n in enumerate(names)}
+    names = [i["name"] for i in every_step[0]["profile"]["instances"]]
+    shares = {n: med(r["profile"]["instances"][j]["share"] for r in every_step)
+              for j, n in enumerate(names)}
     top = max(names, key=lambda n: shares[n])
     return {
         "instances": len(names),
@@ -64,8 +72,10 @@ def summarize(runs):
         "us": med(r["us_per_macro_step"] for r in runs),
         "top": top,
         "top_share": shares[top],
-        "master_share": med(r["profile"]["master_share"] for r in runs),
+        "master_share": med(r["profile"]["master_share"] for r in every_step),
         "overhead": med(r["profile"]["overhead_share"] for r in runs),
+        "covered": med(100 * r["profile"]["sampled_us_per_step"] / r["profile"]["loop_us_per_step"]
+                       for r in runs),
         "end_time": runs[0]["end_time"] - runs[0]["start_time"],
     }
 
@@ -130,20 +140,26 @@ def main():
         systems = [s for s in systems if s.stem in a.only]
     rows = {}
     for s in systems:
-        rows[s.stem] = summarize([run_system(a.shipsim, pin, s) for _ in range(a.repeat)])
+        runs = [run_system(a.shipsim, pin, s) for _ in range(a.repeat)]
+        every_step = [run_system(a.shipsim, pin, s, every=1) for _ in range(a.repeat)]
+        rows[s.stem] = summarize(runs, every_step)
     print(f"## Systems (master/bench/bench_systems.py)\n")
     print(f"Every system of systems/ without CSV output (`shipsim run --no-output --profile=json`), "
           f"{pin_note}; each figure is the median of {a.repeat} runs. Real-time factor and µs per "
-          "macro step: the step loop's wall time over all steps. Shares: the run's profile, "
-          "sampled (1 in 127 macro steps timed in full; master/src/run/profile.rs); an instance's "
-          "share is its fmi2DoStep and get/set, the master's is everything else in the step loop "
-          "(recording is off here).\n")
+          "macro step: the step loop's wall time over all steps, with the default profile (1 in "
+          "127 macro steps timed); its cost is the next column, and the share of the measured "
+          "step loop that its sample accounts for the one after (far below 100 % where an FMU "
+          "does costly work on few steps). Shares: from separate runs that time every macro step "
+          "(`--profile-every 1`, corrected for the clock reads); an instance's share is its "
+          "fmi2DoStep and get/set, the master's is everything else in the step loop (recording "
+          "is off here). Method: master/src/run/profile.rs.\n")
     print("| system | instances | macro steps | real-time factor | µs / macro step "
-          "| most expensive instance | its share | master's share | profile cost |")
-    print("|---|---|---|---|---|---|---|---|---|")
+          "| profile cost | sample / measured | most expensive instance | its share | master's share |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
     for name, r in rows.items():
         print(f"| {name} | {r['instances']} | {r['macro_steps']} | {r['rtf']:,.0f} | {r['us']:.3f} "
-              f"| {r['top']} | {r['top_share']:.1f} % | {r['master_share']:.1f} % | {r['overhead']:.2f} % |")
+              f"| {r['overhead']:.2f} % | {r['covered']:.0f} % | {r['top']} | {r['top_share']:.1f} % "
+              f"| {r['master_share']:.1f} % |")
     print("\nProfile cost: the profile's own clock reads (their number times the measured cost of "
           "one) as a share of the step loop.")
     exe = model_loop_bin(a.model_loop)
