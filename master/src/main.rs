@@ -6,6 +6,7 @@ use shipsim::error::Error;
 use shipsim::fmu::UnpackedFmu;
 use shipsim::run::{
     checkpoint_step, prepare, resume, run, Checkpoint, CheckpointRequest, Output, RunOptions,
+    Sampling,
 };
 use shipsim::system::{Algorithm, System};
 use std::io::IsTerminal;
@@ -26,6 +27,15 @@ struct Cli {
     command: Command,
 }
 
+/// How `shipsim run --profile` prints the profile.
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum ProfileFormat {
+    /// A table on stderr after the summary.
+    Table,
+    /// One JSON line on stdout: the summary's figures and the profile.
+    Json,
+}
+
 #[derive(Subcommand)]
 enum Command {
     /// Run a system (native .toml or OSP OspSystemStructure.xml).
@@ -38,6 +48,19 @@ enum Command {
         /// CSV output file (overrides the system's output.file).
         #[arg(long, short)]
         output: Option<PathBuf>,
+        /// Record nothing and write no CSV, even if the system has an [output] section (to
+        /// measure speed without the CSV's cost).
+        #[arg(long, conflicts_with = "output")]
+        no_output: bool,
+        /// Time the step loop per instance (fmi2DoStep, get/set) and the master's own work, on
+        /// 1 in 127 macro steps; print a table after the summary (stderr), or with
+        /// --profile=json one JSON line of the summary and profile on stdout.
+        #[arg(long, value_enum, num_args = 0..=1, require_equals = true, default_missing_value = "table", value_name = "FORMAT")]
+        profile: Option<ProfileFormat>,
+        /// With --profile: time 1 in N macro steps instead of 1 in 127 (1 = every step, which
+        /// catches work done on few steps at about 10 % overhead; else choose a prime).
+        #[arg(long, value_name = "N", requires = "profile", value_parser = clap::value_parser!(u64).range(1..))]
+        profile_every: Option<u64>,
         /// Set a parameter or start value: --set instance.variable=value (repeatable).
         #[arg(long = "set", value_name = "INST.VAR=VALUE")]
         set: Vec<String>,
@@ -140,6 +163,9 @@ fn dispatch(cmd: Command) -> shipsim::Result<()> {
             system,
             stop_time,
             output,
+            no_output,
+            profile,
+            profile_every,
             set,
             algorithm,
             verbose,
@@ -159,7 +185,14 @@ fn dispatch(cmd: Command) -> shipsim::Result<()> {
             if let Some(a) = algorithm {
                 sys.algorithm = parse_algorithm(&a)?;
             }
-            run_cli(&sys, output, verbose, quiet, checkpoints)
+            let flags = RunFlags {
+                output,
+                no_output,
+                profile: profile.map(|f| (f, profile_every)),
+                verbose,
+                quiet,
+            };
+            run_cli(&sys, &flags, checkpoints)
         }
         Command::ExportOsp { system, output } => export_osp(&system, output),
         Command::Campaign { command } => cli::campaign::dispatch(command, ctrl_c_flag),
@@ -275,17 +308,26 @@ fn parse_checkpoint_at(v: Vec<String>) -> shipsim::Result<(f64, PathBuf)> {
     Ok((time, PathBuf::from(file)))
 }
 
-/// `shipsim run`: Ctrl-C stops the run cleanly (a second one exits at once); warnings, then
-/// the run, then its summary on stderr.
-fn run_cli(
-    sys: &System,
+/// The flags of `shipsim run` that shape the run and what it prints.
+struct RunFlags {
     output: Option<PathBuf>,
+    no_output: bool,
+    /// The format, and 1 in how many macro steps to time (default [`Sampling::default`]).
+    profile: Option<(ProfileFormat, Option<u64>)>,
     verbose: bool,
     quiet: bool,
-    checkpoints: Checkpoints,
-) -> shipsim::Result<()> {
+}
+
+/// `shipsim run`: Ctrl-C stops the run cleanly (a second one exits at once); warnings, then
+/// the run, then its summary on stderr (and the profile, if asked for: a table on stderr or
+/// JSON on stdout).
+fn run_cli(sys: &System, flags: &RunFlags, checkpoints: Checkpoints) -> shipsim::Result<()> {
     let begin = Instant::now();
-    let out_file = output.or_else(|| sys.output.file.clone());
+    let (verbose, quiet) = (flags.verbose, flags.quiet);
+    let out_file = match flags.no_output {
+        true => None,
+        false => flags.output.clone().or_else(|| sys.output.file.clone()),
+    };
     let out = match &out_file {
         Some(p) => Output::File(p.clone()),
         None => Output::None,
@@ -306,6 +348,10 @@ fn run_cli(
         interrupt: Some(flag),
         log_sink: None,
         checkpoint: None,
+        profile: flags.profile.map(|(_, every)| match every {
+            Some(every) => Sampling { every },
+            None => Sampling::default(),
+        }),
     };
     let (plan, fmus) = prepare(sys)?;
     print_warnings(&plan.warnings);
@@ -335,7 +381,34 @@ fn run_cli(
         }
         eprintln!("{summary}");
     }
+    match (flags.profile, &summary.profile) {
+        (Some((ProfileFormat::Table, _)), Some(p)) => eprintln!("{p}"),
+        (Some((ProfileFormat::Json, _)), Some(p)) => println!("{}", run_json(sys, &summary, p)),
+        _ => {}
+    }
     Ok(())
+}
+
+/// `--profile=json`: the summary's figures and the profile, one line.
+fn run_json(
+    sys: &System,
+    s: &shipsim::run::Summary,
+    p: &shipsim::run::Profile,
+) -> serde_json::Value {
+    serde_json::json!({
+        "system": sys.source.display().to_string(),
+        "start_time": s.start_time,
+        "end_time": s.end_time,
+        "macro_steps": s.macro_steps,
+        "fmu_steps": s.fmu_steps,
+        "wall_s": s.wall_time.as_secs_f64(),
+        "total_wall_s": s.total_wall_time.as_secs_f64(),
+        "real_time_factor": s.real_time_factor(),
+        "us_per_macro_step": s.wall_time.as_secs_f64() * 1e6 / s.macro_steps.max(1) as f64,
+        "rows": s.rows,
+        "terminated_by": s.terminated_by,
+        "profile": p.to_json(),
+    })
 }
 
 /// `shipsim export-osp`: OspSystemStructure.xml (and scenario.json for events).

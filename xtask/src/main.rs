@@ -36,7 +36,7 @@ fn main() {
                  demo         run the default coupled system\n  \
                  report [DIR] run every coupled system and write the validation report (target/report)\n  \
                  export-osp   every system of systems/ as target/osp/<name>/OspSystemStructure.xml for libcosim\n  \
-                 bench        master overhead vs libcosim and FMPy, campaign throughput (docs/bench.md)\n  \
+                 bench        master overhead vs libcosim and FMPy, every system's speed and profile, campaigns (docs/bench.md)\n  \
                  artifacts DIR          FMU model descriptions, system CSVs and report into DIR\n  \
                  artifacts --compare A B  byte-compare two artifact folders (refactor check)"
             );
@@ -234,24 +234,30 @@ fn export_osp() -> Result<()> {
     Ok(())
 }
 
-/// Runs master/bench/bench_master.py in the project venv (extra arguments are passed on).
-/// `cargo xtask bench`: master overhead against libcosim and FMPy, and campaign throughput,
-/// fixed cost and warm-up forks; printed, and written to docs/bench.md (committed).
+/// `cargo xtask bench`: master overhead against libcosim and FMPy (bench_master.py, extra
+/// arguments are passed on to it), every system's speed and per-instance profile with the
+/// pure-Rust RRS model loop when it exists (bench_systems.py), and campaign throughput, fixed
+/// cost and warm-up forks (bench_campaign.py); printed, and written to docs/bench.md
+/// (committed).
 fn bench(extra: &[String]) -> Result<()> {
     let root = workspace_root();
     fmu::build_fmus(&root)?;
     run(cargo()
         .current_dir(&root)
         .args(["build", "--release", "-p", "shipsim", "--bins"]))?;
+    let model_loop = build_model_loop(&root)?;
     let python = ensure_venv(&root)?;
     let script = |name: &str, args: &[String]| -> Result<String> {
-        let out = Command::new(&python)
-            .current_dir(&root)
+        let mut cmd = Command::new(&python);
+        cmd.current_dir(&root)
             .arg(format!("master/bench/{name}"))
             .args(args)
             .env("SHIPSIM_BIN", root.join("target/release/shipsim"))
-            .stderr(std::process::Stdio::inherit())
-            .output()?;
+            .stderr(std::process::Stdio::inherit());
+        if let Some(bin) = &model_loop {
+            cmd.env("SHIPSIM_MODEL_LOOP_BIN", bin);
+        }
+        let out = cmd.output()?;
         let text = String::from_utf8_lossy(&out.stdout).into_owned();
         print!("{text}");
         if !out.status.success() {
@@ -260,15 +266,40 @@ fn bench(extra: &[String]) -> Result<()> {
         Ok(text)
     };
     let master = script("bench_master.py", extra)?;
+    let systems = script("bench_systems.py", &[])?;
     let campaigns = script("bench_campaign.py", &[])?;
     let doc = format!(
         "# Benchmarks\n\nWritten by `cargo xtask bench` (do not edit by hand). Ratios are \
          measured in one run on one machine; absolute times depend on it.\n\n\
-         ## Master overhead per FMU-step (master/bench/bench_master.py)\n\n```text\n{master}```\n\n{campaigns}"
+         ## Master overhead per FMU-step (master/bench/bench_master.py)\n\n```text\n{master}```\n\n\
+         {systems}\n{campaigns}"
     );
     std::fs::write(root.join("docs/bench.md"), doc)?;
     println!("wrote docs/bench.md");
     Ok(())
+}
+
+/// Builds the pure-Rust RRS model loop of system-tests (tests/src/bin/rrs_model_loop.rs) when
+/// it exists, and returns its path; `None` when there is none (the bench says so).
+fn build_model_loop(root: &Path) -> Result<Option<PathBuf>> {
+    if !root.join("tests/src/bin/rrs_model_loop.rs").is_file() {
+        return Ok(None);
+    }
+    let manifest = std::fs::read_to_string(root.join("tests/Cargo.toml"))?;
+    let name = if manifest.contains("\"rrs-model-loop\"") {
+        "rrs-model-loop"
+    } else {
+        "rrs_model_loop"
+    };
+    run(cargo().current_dir(root).args([
+        "build",
+        "--release",
+        "-p",
+        "system-tests",
+        "--bin",
+        name,
+    ]))?;
+    Ok(Some(root.join("target/release").join(name)))
 }
 
 /// The built-in default system: rudder roll stabilization (systems/rrs.toml) with RRS off and

@@ -12,10 +12,15 @@
 //! - [`GaussSeidel`]: instances step one after another in connection order, each reading the
 //!   newest outputs (already at t_(k+1) for those stepped earlier in the same macro step).
 //!
+//! A macro step takes a [`Probe`]: a profiled run times its sampled steps through it
+//! ([`super::profile`]), lapping after each FMI call or batch; every other step passes
+//! [`super::profile::Off`], which compiles to nothing.
+//!
 //! To add one, implement the trait here, add a variant to [`crate::system::Algorithm`] (and
 //! its name to the readers), and dispatch to it in [`super::run_with`].
 
 use super::exchange::Values;
+use super::profile::{Lap, Probe};
 use super::slot::{Slot, StepCount};
 use super::time_grid::TimeGrid;
 use crate::error::Result;
@@ -39,14 +44,16 @@ pub trait Algorithm {
     ) -> Result<()>;
 
     /// Sets inputs, applies the step's events, steps the instances due at k, and publishes
-    /// their outputs into `values`.
-    fn step(
+    /// their outputs into `values`. `probe` laps after each FMI call or batch, attributing the
+    /// time since the last lap ([`Lap`]), and at the start (the master's work before).
+    fn step<P: Probe>(
         &self,
         step: &MacroStep,
         grid: &TimeGrid,
         slots: &mut [Slot<Stepping>],
         values: &mut Values,
         count: &mut StepCount,
+        probe: &mut P,
     ) -> Result<()>;
 }
 
@@ -69,31 +76,37 @@ impl Algorithm for Jacobi {
     }
 
     #[inline]
-    fn step(
+    fn step<P: Probe>(
         &self,
         step: &MacroStep,
         grid: &TimeGrid,
         slots: &mut [Slot<Stepping>],
         values: &mut Values,
         count: &mut StepCount,
+        probe: &mut P,
     ) -> Result<()> {
         let k = step.k;
-        for s in slots.iter_mut() {
+        probe.lap(Lap::Master);
+        for (i, s) in slots.iter_mut().enumerate() {
             if s.steps_at(k) {
                 s.set_inputs(values)?;
+                probe.lap(Lap::Exchange(i));
             }
         }
         for e in step.events {
             slots[e.instance].apply(e, step.t)?;
+            probe.lap(Lap::Exchange(e.instance));
         }
-        for s in slots.iter_mut() {
+        for (i, s) in slots.iter_mut().enumerate() {
             if s.steps_at(k) {
                 s.do_step(k, step.t, grid, count)?;
+                probe.lap(Lap::DoStep(i));
             }
         }
-        for s in slots.iter_mut() {
+        for (i, s) in slots.iter_mut().enumerate() {
             if s.steps_at(k + 1) || k + 1 == grid.n_steps() {
                 s.get_outputs(values)?;
+                probe.lap(Lap::Exchange(i));
             }
         }
         Ok(())
@@ -119,26 +132,32 @@ impl Algorithm for GaussSeidel<'_> {
     }
 
     #[inline]
-    fn step(
+    fn step<P: Probe>(
         &self,
         step: &MacroStep,
         grid: &TimeGrid,
         slots: &mut [Slot<Stepping>],
         values: &mut Values,
         count: &mut StepCount,
+        probe: &mut P,
     ) -> Result<()> {
         let k = step.k;
+        probe.lap(Lap::Master);
         for &i in self.order {
             let s = &mut slots[i];
             if s.steps_at(k) {
                 s.set_inputs(values)?;
+                probe.lap(Lap::Exchange(i));
             }
             for e in step.events.iter().filter(|e| e.instance == i) {
                 s.apply(e, step.t)?;
+                probe.lap(Lap::Exchange(i));
             }
             if s.steps_at(k) {
                 s.do_step(k, step.t, grid, count)?;
+                probe.lap(Lap::DoStep(i));
                 s.get_outputs(values)?;
+                probe.lap(Lap::Exchange(i));
             }
         }
         Ok(())

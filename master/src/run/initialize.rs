@@ -42,6 +42,7 @@ pub fn initialize<A: Algorithm>(
             var_step: fmu
                 .co_simulation()
                 .can_handle_variable_communication_step_size,
+            do_steps: 0,
         });
     }
     let mut initializing = Vec::with_capacity(instantiated.len());

@@ -37,6 +37,7 @@ pub mod algorithm;
 pub mod checkpoint;
 pub mod exchange;
 pub mod initialize;
+pub mod profile;
 pub mod progress;
 pub mod recorder;
 pub mod slot;
@@ -47,6 +48,7 @@ use algorithm::{Algorithm, GaussSeidel, Jacobi};
 use checkpoint::Fingerprint;
 pub use checkpoint::{checkpoint_step, Checkpoint};
 use exchange::Exchange;
+pub use profile::{Profile, Sampling};
 pub use recorder::{ColumnInfo, CsvRecorder, MemoryRecorder, Recorder, Row, Sample};
 use stepping::{Recording, Stepper};
 pub use time_grid::TimeGrid;
@@ -63,6 +65,9 @@ pub struct RunOptions {
     pub log_sink: Option<LogSink>,
     /// Write a checkpoint on passing a base step and continue ([`run_with`], [`resume_with`]).
     pub checkpoint: Option<CheckpointRequest>,
+    /// Time where the step loop goes per instance, on these steps ([`Summary::profile`],
+    /// [`profile`]).
+    pub profile: Option<Sampling>,
 }
 
 /// Where and when a run writes its checkpoint.
@@ -89,6 +94,8 @@ pub struct Summary {
     /// Set when an FMU ended the simulation early (fmi2Discard + fmi2Terminated).
     pub terminated_by: Option<String>,
     pub output_file: Option<PathBuf>,
+    /// With [`RunOptions::profile`]: where the step loop's time went (not part of `Display`).
+    pub profile: Option<Profile>,
 }
 
 impl Summary {
@@ -426,6 +433,9 @@ fn execute<A: Algorithm>(
         k: first,
         count: Default::default(),
         wall: Duration::ZERO,
+        profile: opts
+            .profile
+            .map(|s| profile::Accumulator::new(plan.instances.len(), s)),
     };
     let mut taken = None;
     if let (Some((at, then)), Some(fp)) = (course.checkpoint, fingerprint) {
@@ -447,11 +457,17 @@ fn execute<A: Algorithm>(
     stepper.advance(algorithm, stop)?;
     let end = stepper.finish()?;
     let rows = stepper.recording.as_ref().map(|r| r.rows).unwrap_or(0);
+    let profile = stepper.profile.as_ref().map(|acc| {
+        let names = plan.instances.iter().map(|pi| pi.name.clone());
+        let calls = stepper.slots.iter().map(|s| s.do_steps);
+        Profile::new(acc, names.zip(calls), end.steps - first, end.wall)
+    });
     // Terminate explicitly so that a failing fmi2Terminate is reported.
     for s in stepper.slots {
         s.inst.terminate()?;
     }
     let summary = Summary {
+        profile,
         macro_steps: end.steps - first,
         fmu_steps: end.count.fmu_steps,
         start_time,

@@ -16,6 +16,9 @@ pub struct Slot<S> {
     pub step_multiple: u64,
     /// The FMU can take a shorter last step (canHandleVariableCommunicationStepSize).
     pub var_step: bool,
+    /// fmi2DoStep calls of this instance so far in this run (from a resumed checkpoint: since
+    /// the resume).
+    pub do_steps: u64,
 }
 
 impl<S> Slot<S> {
@@ -55,6 +58,7 @@ impl Slot<Instantiated> {
             ports: self.ports,
             step_multiple: self.step_multiple,
             var_step: self.var_step,
+            do_steps: self.do_steps,
         })
     }
 }
@@ -67,6 +71,7 @@ impl Slot<Initializing> {
             ports: self.ports,
             step_multiple: self.step_multiple,
             var_step: self.var_step,
+            do_steps: self.do_steps,
         })
     }
 }
@@ -95,6 +100,7 @@ impl Slot<Stepping> {
             return Ok(());
         };
         count.fmu_steps += 1;
+        self.do_steps += 1;
         if let StepOutcome::Terminated {
             last_successful_time,
         } = self.inst.do_step(t, h)?

@@ -1,10 +1,11 @@
 //! The step loop: macro steps from t_k (t_0, or a checkpoint's) to t_n with an [`Algorithm`],
 //! recording, progress and interruption. A run may stop at a communication point between two
 //! calls of [`Stepper::advance`] (to take a checkpoint) and go on. Nothing in it allocates on
-//! the success path.
+//! the success path. A profiled run times a sample of the macro steps ([`super::profile`]).
 
 use super::algorithm::{Algorithm, MacroStep};
 use super::exchange::{Column, Values};
+use super::profile::{Accumulator, Lap, Off, Probe};
 use super::progress::Progress;
 use super::recorder::{Recorder, Row};
 use super::slot::{Slot, StepCount};
@@ -47,6 +48,8 @@ pub struct Stepper<'a> {
     pub count: StepCount,
     /// Wall time spent stepping so far.
     pub wall: Duration,
+    /// The sums of a profiled run ([`super::RunOptions::profile`]).
+    pub profile: Option<Accumulator>,
 }
 
 /// How the step loop ended.
@@ -62,43 +65,74 @@ impl Stepper<'_> {
     /// Steps until t_`until` (at most the end of the run), or until an instance ends the run or
     /// the interrupt flag is set (then the recorder is finished and the error is
     /// [`Error::Interrupted`]). The events of step k are applied at k, from any starting k.
+    /// With a profile, the sampled steps are timed ([`super::profile`]).
     pub fn advance<A: Algorithm>(&mut self, algorithm: &A, until: u64) -> Result<()> {
         let start = Instant::now();
         let grid = self.grid;
-        let n_steps = grid.n_steps();
-        let until = until.min(n_steps);
+        let until = until.min(grid.n_steps());
         let mut count = std::mem::take(&mut self.count);
+        let mut profile = self.profile.take();
         let mut k = self.k;
         let mut next_event = self.events.partition_point(|e| e.step < k);
+        // The next sampled step (none without a profile): one comparison per step.
+        let mut next_sample = profile.as_ref().map_or(u64::MAX, |a| a.sampling.next(k));
         while k < until && count.terminated_by.is_none() {
-            let t = grid.at(k);
-            if self.interrupted() {
-                return Err(self.interrupt_at(t));
-            }
-            let first = next_event;
-            while next_event < self.events.len() && self.events[next_event].step == k {
-                next_event += 1;
-            }
-            let step = MacroStep {
-                k,
-                t,
-                events: &self.events[first..next_event],
-            };
-            algorithm.step(&step, &grid, &mut self.slots, &mut self.values, &mut count)?;
-            k += 1;
-            let ended = count.terminated_by.is_some();
-            if let Some(r) = self.recording.as_mut() {
-                if k % r.decimation == 0 || k == n_steps || ended {
-                    r.row(grid.at(k), &self.values)?;
+            let (next_event, count) = (&mut next_event, &mut count);
+            match profile.as_mut().filter(|_| k == next_sample) {
+                Some(acc) => {
+                    let mut timer = acc.start();
+                    self.macro_step(algorithm, k, &grid, next_event, count, &mut timer)?;
+                    timer.lap(Lap::Master);
+                    next_sample += acc.sampling.every.max(1);
                 }
+                None => self.macro_step(algorithm, k, &grid, next_event, count, &mut Off)?,
             }
-            if let Some(p) = &self.progress {
-                p.update(k, &grid);
-            }
+            k += 1;
         }
         self.k = k;
         self.count = count;
+        self.profile = profile;
         self.wall += start.elapsed();
+        Ok(())
+    }
+
+    /// Macro step k (with the next event's index and the count): the interruption check, the
+    /// step's events, the algorithm's step, the row at t_(k+1) (every `decimation` steps, at
+    /// t_n and at an early end) and the progress bar.
+    #[inline(always)]
+    fn macro_step<A: Algorithm, P: Probe>(
+        &mut self,
+        algorithm: &A,
+        k: u64,
+        grid: &TimeGrid,
+        next_event: &mut usize,
+        count: &mut StepCount,
+        probe: &mut P,
+    ) -> Result<()> {
+        let t = grid.at(k);
+        if self.interrupted() {
+            return Err(self.interrupt_at(t));
+        }
+        let first = *next_event;
+        while *next_event < self.events.len() && self.events[*next_event].step == k {
+            *next_event += 1;
+        }
+        let step = MacroStep {
+            k,
+            t,
+            events: &self.events[first..*next_event],
+        };
+        algorithm.step(&step, grid, &mut self.slots, &mut self.values, count, probe)?;
+        let k = k + 1;
+        let ended = count.terminated_by.is_some();
+        if let Some(r) = self.recording.as_mut() {
+            if k % r.decimation == 0 || k == grid.n_steps() || ended {
+                r.row(grid.at(k), &self.values)?;
+            }
+        }
+        if let Some(p) = &self.progress {
+            p.update(k, grid);
+        }
         Ok(())
     }
 
