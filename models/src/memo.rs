@@ -39,6 +39,33 @@ impl<K: PartialEq, V> Memo<K, V> {
     }
 }
 
+impl<K: PartialEq, V> Memo<K, V> {
+    /// The kept value if it was computed for `key` (the memo is then empty).
+    #[inline]
+    pub fn take(&mut self, key: &K) -> Option<V> {
+        match self.0.take() {
+            Some((k, v)) if k == *key => Some(v),
+            other => {
+                self.0 = other;
+                None
+            }
+        }
+    }
+}
+
+impl<K, V> Memo<K, V> {
+    /// Keeps `value`, computed for `key`.
+    #[inline]
+    pub fn put(&mut self, key: K, value: V) {
+        self.0 = Some((key, value));
+    }
+
+    /// Forgets the kept value (when what it was derived from changes).
+    pub fn clear(&mut self) {
+        self.0 = None;
+    }
+}
+
 /// Bit patterns of floats, for keys that must distinguish −0 from +0 (and compare NaNs by
 /// payload).
 pub fn bits<const N: usize>(values: [f64; N]) -> [u64; N] {
@@ -67,6 +94,19 @@ mod tests {
         assert_eq!(get(&mut m, -0.0).to_bits(), (-0.0f64).to_bits());
         assert_eq!(calls, 3);
         assert!(Memo::<u8, u8>::default() == m_with(1));
+    }
+
+    #[test]
+    fn take_put_and_clear() {
+        let mut m = m_with(7);
+        assert_eq!(m.take(&1), None);
+        assert_eq!(m.take(&0), Some(7));
+        assert_eq!(m.take(&0), None);
+        m.put(2, 9);
+        m.clear();
+        assert_eq!(m.take(&2), None);
+        m.put(2, 9);
+        assert_eq!(*m.get(2, || unreachable!("kept")), 9);
     }
 
     fn m_with(v: u8) -> Memo<u8, u8> {
