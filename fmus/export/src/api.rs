@@ -136,7 +136,7 @@ pub unsafe fn instantiate<M: FmuModel>(
                 M::MODEL_IDENTIFIER
             ));
         }
-        let expected = crate::xml::guid::<M>();
+        let expected = crate::xml::guid_str::<M>();
         if guid.is_null() {
             return fail("fmi2Instantiate: missing GUID");
         }
@@ -155,10 +155,10 @@ pub unsafe fn instantiate<M: FmuModel>(
             logging_on != fmi2False,
             fnv1a(expected.as_bytes()),
         );
-        inst.log(
+        inst.log_fmt(
             fmi2OK,
             CAT_EVENTS,
-            &format!("instantiated {} {expected}", M::MODEL_IDENTIFIER),
+            format_args!("instantiated {} {expected}", M::MODEL_IDENTIFIER),
         );
         Box::into_raw(Box::new(inst)) as fmi2Component
     }));
@@ -268,10 +268,10 @@ pub unsafe fn exit_initialization_mode<M: FmuModel>(c: fmi2Component) -> fmi2Sta
             Ok(()) => {
                 inst.dirty = false;
                 inst.core.state = LifeState::StepComplete;
-                inst.log(
+                inst.log_fmt(
                     fmi2OK,
                     CAT_EVENTS,
-                    &format!("initialized at t = {}", inst.core.start_time),
+                    format_args!("initialized at t = {}", inst.core.start_time),
                 );
                 fmi2OK
             }
@@ -288,10 +288,10 @@ pub unsafe fn exit_initialization_mode<M: FmuModel>(c: fmi2Component) -> fmi2Sta
 pub unsafe fn terminate<M: FmuModel>(c: fmi2Component) -> fmi2Status {
     with_instance::<M>(c, "fmi2Terminate", mask::TERMINATE, |inst| {
         inst.core.state = LifeState::Terminated;
-        inst.log(
+        inst.log_fmt(
             fmi2OK,
             CAT_EVENTS,
-            &format!("terminated at t = {}", inst.core.time),
+            format_args!("terminated at t = {}", inst.core.time),
         );
         fmi2OK
     })
@@ -797,10 +797,10 @@ pub unsafe fn set_fmu_state<M: FmuModel>(c: fmi2Component, s: fmi2FMUstate) -> f
                 inst.model = b.snapshot.model.clone();
                 inst.core = b.snapshot.core.clone();
                 inst.dirty = false;
-                inst.log(
+                inst.log_fmt(
                     fmi2OK,
                     CAT_EVENTS,
-                    &format!("state restored to t = {}", inst.core.time),
+                    format_args!("state restored to t = {}", inst.core.time),
                 );
                 fmi2OK
             }

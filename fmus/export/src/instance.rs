@@ -154,6 +154,13 @@ impl<M: FmuModel> Instance<M> {
         );
     }
 
+    /// [`Instance::log`] of a message that is formatted only if its category is enabled.
+    pub fn log_fmt(&self, status: fmi2Status, category: usize, message: std::fmt::Arguments) {
+        if self.enabled[category] {
+            self.log(status, category, &message.to_string());
+        }
+    }
+
     pub fn error(&self, message: &str) -> fmi2Status {
         self.log(fmi2Error, CAT_ERROR, message);
         fmi2Error
