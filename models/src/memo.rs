@@ -40,6 +40,17 @@ impl<K: PartialEq, V> Memo<K, V> {
 }
 
 impl<K: PartialEq, V> Memo<K, V> {
+    /// [`Memo::get`] for a computation that can fail (a failure is not kept).
+    pub fn try_get<E>(&mut self, key: K, compute: impl FnOnce() -> Result<V, E>) -> Result<&V, E> {
+        if !matches!(&self.0, Some((k, _)) if *k == key) {
+            self.0 = Some((key, compute()?));
+        }
+        match &self.0 {
+            Some((_, v)) => Ok(v),
+            None => unreachable!("just filled"),
+        }
+    }
+
     /// The kept value if it was computed for `key` (the memo is then empty).
     #[inline]
     pub fn take(&mut self, key: &K) -> Option<V> {
@@ -107,6 +118,10 @@ mod tests {
         assert_eq!(m.take(&2), None);
         m.put(2, 9);
         assert_eq!(*m.get(2, || unreachable!("kept")), 9);
+        // a failure is not kept
+        assert_eq!(m.try_get(3, || Err::<u8, _>("no")), Err("no"));
+        assert_eq!(m.try_get(2, || Err::<u8, &str>("kept")), Ok(&9));
+        assert_eq!(m.try_get(3, || Ok::<u8, ()>(4)), Ok(&4));
     }
 
     fn m_with(v: u8) -> Memo<u8, u8> {
