@@ -6,74 +6,94 @@
 //! Hence it compares equal to any other memo, starts empty, and a model marks the field
 //! `#[serde(skip)]` (a serialized or restored model simply recomputes it on its next use).
 
-/// A value `V` computed for a key `K` (compared with `==`: use bit patterns for floats, see
-/// [`bits`]).
+/// Values `V` computed for keys `K` (compared with `==`: use bit patterns for floats, see
+/// [`bits`]), the `N` most recently used ones kept. `N` = 2 suits values that depend on the
+/// communication step: a master's steps t_(k+1) − t_k on a rounded time grid alternate between
+/// neighbouring floats.
 #[derive(Clone, Debug)]
-pub struct Memo<K, V>(Option<(K, V)>);
+pub struct Memo<K, V, const N: usize = 1>([Option<(K, V)>; N]);
 
-impl<K, V> Default for Memo<K, V> {
+impl<K, V, const N: usize> Default for Memo<K, V, N> {
     fn default() -> Self {
-        Memo(None)
+        Memo(std::array::from_fn(|_| None))
     }
 }
 
 /// Memos do not take part in a model's equality (they are derived, see the module docs).
-impl<K, V> PartialEq for Memo<K, V> {
+impl<K, V, const N: usize> PartialEq for Memo<K, V, N> {
     fn eq(&self, _other: &Self) -> bool {
         true
     }
 }
 
-impl<K: PartialEq, V> Memo<K, V> {
-    /// The value for `key`: the kept one if it was computed for the same key, else `compute()`
-    /// (which is then kept).
+impl<K: PartialEq, V, const N: usize> Memo<K, V, N> {
+    /// The slot holding `key`, moved to the front (most recently used).
+    #[inline]
+    fn find(&mut self, key: &K) -> bool {
+        match self
+            .0
+            .iter()
+            .position(|e| matches!(e, Some((k, _)) if k == key))
+        {
+            Some(i) => {
+                self.0[..=i].rotate_right(1);
+                true
+            }
+            None => false,
+        }
+    }
+
+    /// The front slot's value (present after `find` or `put`).
+    #[inline]
+    fn front(&self) -> &V {
+        match &self.0[0] {
+            Some((_, v)) => v,
+            None => unreachable!("filled before"),
+        }
+    }
+
+    /// The value for `key`: a kept one computed for the same key, else `compute()` (which is
+    /// then kept, in place of the least recently used).
     #[inline]
     pub fn get(&mut self, key: K, compute: impl FnOnce() -> V) -> &V {
-        if !matches!(&self.0, Some((k, _)) if *k == key) {
-            self.0 = Some((key, compute()));
+        if !self.find(&key) {
+            let value = compute();
+            self.put(key, value);
         }
-        match &self.0 {
-            Some((_, v)) => v,
-            None => unreachable!("just filled"),
-        }
+        self.front()
     }
-}
 
-impl<K: PartialEq, V> Memo<K, V> {
     /// [`Memo::get`] for a computation that can fail (a failure is not kept).
     pub fn try_get<E>(&mut self, key: K, compute: impl FnOnce() -> Result<V, E>) -> Result<&V, E> {
-        if !matches!(&self.0, Some((k, _)) if *k == key) {
-            self.0 = Some((key, compute()?));
+        if !self.find(&key) {
+            let value = compute()?;
+            self.put(key, value);
         }
-        match &self.0 {
-            Some((_, v)) => Ok(v),
-            None => unreachable!("just filled"),
-        }
+        Ok(self.front())
     }
 
-    /// The kept value if it was computed for `key` (the memo is then empty).
+    /// The kept value computed for `key`, which the memo then no longer holds.
     #[inline]
     pub fn take(&mut self, key: &K) -> Option<V> {
-        match self.0.take() {
-            Some((k, v)) if k == *key => Some(v),
-            other => {
-                self.0 = other;
-                None
-            }
+        if !self.find(key) {
+            return None;
         }
+        self.0.rotate_left(1);
+        self.0[N - 1].take().map(|(_, v)| v)
     }
 }
 
-impl<K, V> Memo<K, V> {
-    /// Keeps `value`, computed for `key`.
+impl<K, V, const N: usize> Memo<K, V, N> {
+    /// Keeps `value`, computed for `key`, in place of the least recently used.
     #[inline]
     pub fn put(&mut self, key: K, value: V) {
-        self.0 = Some((key, value));
+        self.0.rotate_right(1);
+        self.0[0] = Some((key, value));
     }
 
-    /// Forgets the kept value (when what it was derived from changes).
+    /// Forgets the kept values (when what they were derived from changes).
     pub fn clear(&mut self) {
-        self.0 = None;
+        self.0.iter_mut().for_each(|e| *e = None);
     }
 }
 
@@ -122,6 +142,29 @@ mod tests {
         assert_eq!(m.try_get(3, || Err::<u8, _>("no")), Err("no"));
         assert_eq!(m.try_get(2, || Err::<u8, &str>("kept")), Ok(&9));
         assert_eq!(m.try_get(3, || Ok::<u8, ()>(4)), Ok(&4));
+    }
+
+    /// Two slots: alternating keys are computed once each; a third key evicts the least
+    /// recently used.
+    #[test]
+    fn two_slots_keep_the_two_most_recent_keys() {
+        let mut calls = Vec::new();
+        let mut m: Memo<u8, u32, 2> = Memo::default();
+        let mut get = |m: &mut Memo<u8, u32, 2>, k: u8| {
+            *m.get(k, || {
+                calls.push(k);
+                u32::from(k) * 10
+            })
+        };
+        for k in [1, 2, 1, 2, 1, 3, 1, 2, 2] {
+            assert_eq!(get(&mut m, k), u32::from(k) * 10);
+        }
+        // 1, 2 computed; 3 evicts 2 (1 was used after it); 2 evicts 3
+        assert_eq!(calls, [1, 2, 3, 2]);
+        assert_eq!(m.take(&1), Some(10));
+        assert_eq!(m.take(&1), None);
+        assert_eq!(m.take(&2), Some(20));
+        assert_eq!(m.take(&2), None);
     }
 
     fn m_with(v: u8) -> Memo<u8, u8> {
