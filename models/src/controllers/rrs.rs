@@ -35,6 +35,7 @@
 use super::ControlError;
 use crate::error::{check_non_negative, check_positive, require};
 use crate::hull::rrs_ship::{RrsHullCoefficients, RrsSpeedLaws};
+use crate::memo::{bits, Memo};
 use crate::riccati;
 use nalgebra::{DMatrix, SMatrix, SVector};
 use serde::{Deserialize, Serialize};
@@ -247,6 +248,20 @@ impl Agc {
     /// Evaluates the AGC for the controller output `u` after a sample interval `dt` (no state
     /// change; [`Agc::commit`] stores it).
     pub fn evaluate(&self, u: f64, dt: f64) -> AgcOutput {
+        self.evaluate_with(u, dt, self.forget(dt))
+    }
+
+    /// The memory's forgetting factor e^(−dt/T_m) over `dt` (0 without memory).
+    pub fn forget(&self, dt: f64) -> f64 {
+        if self.memory_time > 0.0 {
+            (-dt / self.memory_time).exp()
+        } else {
+            0.0
+        }
+    }
+
+    /// [`Agc::evaluate`] with `forget` = [`Agc::forget`]`(dt)` given.
+    fn evaluate_with(&self, u: f64, dt: f64, forget: f64) -> AgcOutput {
         if !self.started || !(dt > 0.0) {
             return AgcOutput {
                 attenuation: 1.0,
@@ -256,11 +271,6 @@ impl Agc {
             };
         }
         let udot = ((u - self.prev_u) / dt).abs();
-        let forget = if self.memory_time > 0.0 {
-            (-dt / self.memory_time).exp()
-        } else {
-            0.0
-        };
         let memory = udot.max(self.memory * forget);
         let y = self.rate_max.max(udot).max(memory);
         let a = self.rate_max / y;
@@ -541,6 +551,12 @@ pub struct RrsAutopilot {
     /// set point seen downstream is exactly the sequence the AGC constrained). None before the
     /// first sample, when the outputs follow the inputs.
     held: Option<RrsOutputs>,
+    /// e^(−dt/T_m) of the AGC memory and e^(−h/T_σ) of the roll-variance filter for the last two
+    /// step lengths (derived, see [`crate::memo`]).
+    #[serde(skip)]
+    agc_forget: Memo<[u64; 2], f64, 2>,
+    #[serde(skip)]
+    variance_decay: Memo<[u64; 2], f64, 2>,
 }
 
 impl RrsAutopilot {
@@ -560,6 +576,8 @@ impl RrsAutopilot {
             last_dt: 0.0,
             prev_command: None,
             held: None,
+            agc_forget: Memo::default(),
+            variance_decay: Memo::default(),
             params,
         })
     }
@@ -612,6 +630,11 @@ impl RrsAutopilot {
     }
 
     fn evaluate(&self, i: &RrsInputs) -> (RrsOutputs, f64, AgcOutput) {
+        self.evaluate_with(i, self.agc.forget(self.last_dt))
+    }
+
+    /// [`RrsAutopilot::evaluate`] with the AGC's forgetting factor over the last step given.
+    fn evaluate_with(&self, i: &RrsInputs, agc_forget: f64) -> (RrsOutputs, f64, AgcOutput) {
         let p = &self.params;
         let k = self.roll_gains(i.speed);
         let roll_fb = -(k[0] * i.roll + k[1] * i.roll_rate + k[2] * i.sway_rudder);
@@ -630,7 +653,7 @@ impl RrsAutopilot {
             AgcTarget::Total => roll + course,
             AgcTarget::RollOnly => roll,
         };
-        let mut agc = self.agc.evaluate(agc_in, self.last_dt);
+        let mut agc = self.agc.evaluate_with(agc_in, self.last_dt, agc_forget);
         if !p.agc_enabled {
             agc.attenuation = 1.0;
             agc.setpoint = agc_in;
@@ -678,14 +701,22 @@ impl RrsAutopilot {
         if !(h > 0.0) || !h.is_finite() {
             return;
         }
-        let (out, agc_in, agc) = self.evaluate(i);
+        let (dt, memory_time) = (self.last_dt, self.agc.memory_time);
+        let forget = *self
+            .agc_forget
+            .get(bits([dt, memory_time]), || self.agc.forget(dt));
+        let (out, agc_in, agc) = self.evaluate_with(i, forget);
         self.agc.commit(agc_in, &agc);
         self.prev_command = Some(out.rudder_command);
         self.held = Some(out);
         self.last_dt = h;
         let a = self.params.adaptation;
         // roll variance: first-order low-pass of φ² [Klugt1987, Fig. 6.10], exact for the held input
-        let f = (-h / a.roll_variance_time).exp();
+        let f = *self
+            .variance_decay
+            .get(bits([h, a.roll_variance_time]), || {
+                (-h / a.roll_variance_time).exp()
+            });
         self.roll_variance = f * self.roll_variance + (1.0 - f) * i.roll * i.roll;
         if a.enabled {
             // rule 2: required rudder rate (of the AGC input, before attenuation, peak-held by
