@@ -36,7 +36,9 @@ impl<K: PartialEq, V, const N: usize> Memo<K, V, N> {
             .position(|e| matches!(e, Some((k, _)) if k == key))
         {
             Some(i) => {
-                self.0[..=i].rotate_right(1);
+                for k in (1..=i).rev() {
+                    self.0.swap(k, k - 1);
+                }
                 true
             }
             None => false,
@@ -78,8 +80,11 @@ impl<K: PartialEq, V, const N: usize> Memo<K, V, N> {
         if !self.find(key) {
             return None;
         }
-        self.0.rotate_left(1);
-        self.0[N - 1].take().map(|(_, v)| v)
+        let kept = self.0[0].take().map(|(_, v)| v);
+        for k in 1..N {
+            self.0.swap(k - 1, k);
+        }
+        kept
     }
 }
 
@@ -87,7 +92,9 @@ impl<K, V, const N: usize> Memo<K, V, N> {
     /// Keeps `value`, computed for `key`, in place of the least recently used.
     #[inline]
     pub fn put(&mut self, key: K, value: V) {
-        self.0.rotate_right(1);
+        for k in (1..N).rev() {
+            self.0.swap(k, k - 1);
+        }
         self.0[0] = Some((key, value));
     }
 
