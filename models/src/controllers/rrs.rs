@@ -557,6 +557,39 @@ pub struct RrsAutopilot {
     agc_forget: Memo<[u64; 2], f64, 2>,
     #[serde(skip)]
     variance_decay: Memo<[u64; 2], f64, 2>,
+    /// What the autopilot derives from the speed input, for the last speed (derived).
+    #[serde(skip)]
+    speed_terms: Memo<[u64; 13], SpeedTerms>,
+}
+
+/// The roll model (A, B) and the course gains at one speed.
+#[derive(Clone, Copy, Debug)]
+struct SpeedTerms {
+    roll_a: SMatrix<f64, 3, 3>,
+    roll_b: SVector<f64, 3>,
+    course: [f64; 3],
+}
+
+impl SpeedTerms {
+    fn at(p: &RrsAutopilotParams, speed: f64) -> Self {
+        let c = coefficients_at(p, speed);
+        let (roll_a, roll_b) = roll_model(&c);
+        SpeedTerms {
+            roll_a,
+            roll_b,
+            course: course_gains(c.tau_r, c.k_dr, p.lambda).unwrap_or([0.0; 3]),
+        }
+    }
+}
+
+/// The speed laws at `speed` (floored at `min_speed`; the floor for a non-finite speed).
+fn coefficients_at(p: &RrsAutopilotParams, speed: f64) -> RrsHullCoefficients {
+    let u = if speed.is_finite() {
+        speed.max(p.min_speed)
+    } else {
+        p.min_speed
+    };
+    p.laws.at(u)
 }
 
 impl RrsAutopilot {
@@ -578,6 +611,7 @@ impl RrsAutopilot {
             held: None,
             agc_forget: Memo::default(),
             variance_decay: Memo::default(),
+            speed_terms: Memo::default(),
             params,
         })
     }
@@ -601,12 +635,16 @@ impl RrsAutopilot {
     }
 
     fn coefficients(&self, speed: f64) -> RrsHullCoefficients {
-        let u = if speed.is_finite() {
-            speed.max(self.params.min_speed)
-        } else {
-            self.params.min_speed
-        };
-        self.params.laws.at(u)
+        coefficients_at(&self.params, speed)
+    }
+
+    /// [`SpeedTerms::at`], kept for the last speed (and parameters).
+    fn kept_speed_terms(&mut self, speed: f64) -> SpeedTerms {
+        let p = self.params;
+        let mut key = [0; 13];
+        key[..3].copy_from_slice(&bits([speed, p.min_speed, p.lambda]));
+        key[3..].copy_from_slice(&p.laws.bits());
+        *self.speed_terms.get(key, || SpeedTerms::at(&p, speed))
     }
 
     /// Current roll gains (k1, k2, k3) at speed `speed`.
@@ -630,13 +668,20 @@ impl RrsAutopilot {
     }
 
     fn evaluate(&self, i: &RrsInputs) -> (RrsOutputs, f64, AgcOutput) {
-        self.evaluate_with(i, self.agc.forget(self.last_dt))
+        let terms = SpeedTerms::at(&self.params, i.speed);
+        self.evaluate_with(i, self.agc.forget(self.last_dt), &terms)
     }
 
-    /// [`RrsAutopilot::evaluate`] with the AGC's forgetting factor over the last step given.
-    fn evaluate_with(&self, i: &RrsInputs, agc_forget: f64) -> (RrsOutputs, f64, AgcOutput) {
+    /// [`RrsAutopilot::evaluate`] with the AGC's forgetting factor over the last step and the
+    /// terms at the input speed given.
+    fn evaluate_with(
+        &self,
+        i: &RrsInputs,
+        agc_forget: f64,
+        terms: &SpeedTerms,
+    ) -> (RrsOutputs, f64, AgcOutput) {
         let p = &self.params;
-        let k = self.roll_gains(i.speed);
+        let k = self.roll_process.gain(&terms.roll_b, p.r);
         let roll_fb = -(k[0] * i.roll + k[1] * i.roll_rate + k[2] * i.sway_rudder);
         let roll = match p.roll_mode {
             RollMode::Off => 0.0,
@@ -644,7 +689,7 @@ impl RrsAutopilot {
             RollMode::Forced => -roll_fb,
         };
         let course = if p.course_auto {
-            let kc = self.course_gains(i.speed);
+            let kc = terms.course;
             -(kc[0] * i.heading_error + kc[1] * i.yaw_rate + kc[2] * i.yaw_offset)
         } else {
             i.wheel
@@ -705,7 +750,8 @@ impl RrsAutopilot {
         let forget = *self
             .agc_forget
             .get(bits([dt, memory_time]), || self.agc.forget(dt));
-        let (out, agc_in, agc) = self.evaluate_with(i, forget);
+        let terms = self.kept_speed_terms(i.speed);
+        let (out, agc_in, agc) = self.evaluate_with(i, forget, &terms);
         self.agc.commit(agc_in, &agc);
         self.prev_command = Some(out.rudder_command);
         self.held = Some(out);
@@ -732,7 +778,7 @@ impl RrsAutopilot {
             let hi = a.q_operator.min(a.q_max);
             self.q_phi = (self.q_phi + a.alpha * a.q_max * h * dq).clamp(0.0, hi);
         }
-        let (am, bm) = roll_model(&self.coefficients(i.speed));
+        let (am, bm) = (terms.roll_a, terms.roll_b);
         let q = SVector::<f64, 3>::from([self.q_phi, self.params.roll_q2, self.params.roll_q3]);
         // a step that is a multiple of max_substep up to rounding (0.1 vs 0.10000000000000002)
         // must not get an extra sub-step

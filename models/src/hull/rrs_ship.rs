@@ -222,6 +222,22 @@ impl RrsSpeedLaws {
         }
     }
 
+    /// The bits of the ten constants (a key for what is derived from them, see [`crate::memo`]).
+    pub fn bits(&self) -> [u64; 10] {
+        bits([
+            self.k_dp0,
+            self.k_dv0,
+            self.k_dr0,
+            self.k_vp0,
+            self.t_v0,
+            self.z_n0,
+            self.z_n1,
+            self.k_vr0,
+            self.omega_n0,
+            self.t_r0,
+        ])
+    }
+
     /// The coefficients at speed `u` [m/s] ([Klugt1987, Table 2.3]; k_rv = k_rp = 0).
     pub fn at(&self, u: f64) -> RrsHullCoefficients {
         RrsHullCoefficients {
