@@ -106,8 +106,20 @@ impl<K, V, const N: usize> Memo<K, V, N> {
 
 /// Bit patterns of floats, for keys that must distinguish −0 from +0 (and compare NaNs by
 /// payload).
-pub fn bits<const N: usize>(values: [f64; N]) -> [u64; N] {
-    values.map(f64::to_bits)
+pub fn bits<const N: usize>(values: [f64; N]) -> Bits<N> {
+    Bits(values.map(f64::to_bits))
+}
+
+/// A key of bit patterns. Its `==` is one branch-free pass (an array's `==` of more than a few
+/// elements is a `memcmp` call).
+#[derive(Clone, Copy, Debug)]
+pub struct Bits<const N: usize>(pub [u64; N]);
+
+impl<const N: usize> PartialEq for Bits<N> {
+    #[inline]
+    fn eq(&self, other: &Self) -> bool {
+        self.0.iter().zip(&other.0).fold(0, |d, (a, b)| d | (a ^ b)) == 0
+    }
 }
 
 #[cfg(test)]
@@ -117,8 +129,8 @@ mod tests {
     #[test]
     fn recomputes_only_for_a_new_key() {
         let mut calls = 0;
-        let mut m: Memo<[u64; 1], f64> = Memo::default();
-        let mut get = |m: &mut Memo<[u64; 1], f64>, x: f64| {
+        let mut m: Memo<Bits<1>, f64> = Memo::default();
+        let mut get = |m: &mut Memo<Bits<1>, f64>, x: f64| {
             *m.get(bits([x]), || {
                 calls += 1;
                 2.0 * x

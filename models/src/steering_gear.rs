@@ -38,7 +38,7 @@
 //! most [`SteeringGearParams::max_substep`].
 
 use crate::error::{check_positive, ParamError};
-use crate::memo::{bits, Memo};
+use crate::memo::{bits, Bits, Memo};
 use serde::{Deserialize, Serialize};
 
 /// Order of the servo loop.
@@ -148,7 +148,7 @@ pub struct SteeringGear {
     /// e^(−t/τ) of the first-order servo for the last two durations t (the communication step,
     /// unless the rate limiter was active; derived, see [`crate::memo`]).
     #[serde(skip)]
-    decay: Memo<[u64; 2], f64, 2>,
+    decay: Memo<Bits<2>, f64, 2>,
 }
 
 impl SteeringGear {

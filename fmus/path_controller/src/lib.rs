@@ -8,7 +8,7 @@ use models::controllers::path::{
     path_gains, Adaptation, DisturbanceModel, PathController, PathControllerParams, PathGains,
     PathInputs, EPSILON,
 };
-use models::memo::Memo;
+use models::memo::{Bits, Memo};
 use serde::{Deserialize, Serialize};
 
 /// Parameters, inputs and state of one path-controller instance.
@@ -28,14 +28,14 @@ pub struct PathControllerFmu {
     /// after each input it sets, and each read initializes again: the two Riccati solutions are
     /// kept while the design does not change; derived, see `models::memo`).
     #[serde(skip)]
-    gains: Memo<[u64; 22], PathGains>,
+    gains: Memo<Bits<22>, PathGains>,
 }
 
 impl PathControllerFmu {
     /// A controller for `params`, its initial gains from `memo` when the design is unchanged.
     fn build(
         params: PathControllerParams,
-        memo: &mut Memo<[u64; 22], PathGains>,
+        memo: &mut Memo<Bits<22>, PathGains>,
     ) -> Result<PathController, String> {
         PathController::new_with(params, |d| memo.try_get(d.key(), || path_gains(d)).copied())
             .map_err(|e| e.to_string())

@@ -4,7 +4,7 @@
 use fmi2_export::FmuModel;
 use models::error::check_positive;
 use models::hull::tokyo_maru::{TokyoMaruCoefficients, L, U};
-use models::memo::Memo;
+use models::memo::{Bits, Memo};
 use models::observers::path_kalman::{KalmanGain, PathKalmanConfig, PathKalmanFilter};
 use serde::{Deserialize, Serialize};
 
@@ -30,7 +30,7 @@ pub struct PathKalmanFilterFmu {
     /// Mode after each input it sets, and each read initializes again: the Riccati solution is
     /// kept while the design does not change; derived, see `models::memo`).
     #[serde(skip)]
-    gain: Memo<[u64; 22], KalmanGain>,
+    gain: Memo<Bits<22>, KalmanGain>,
 }
 
 impl Default for PathKalmanFilterFmu {

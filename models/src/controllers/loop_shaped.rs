@@ -30,7 +30,7 @@
 
 use super::ControlError;
 use crate::error::{check_finite, check_positive, check_positive_or_infinite};
-use crate::memo::{bits, Memo};
+use crate::memo::{bits, Bits, Memo};
 use nalgebra::{Complex, DMatrix, SMatrix, SVector};
 use serde::{Deserialize, Serialize};
 
@@ -537,7 +537,7 @@ struct Sampler {
 
 /// A realisation kept for the (sample step, limit) it was built for (derived, see
 /// [`crate::memo`]).
-type Spare<const N: usize> = Memo<[u64; 2], TustinController<N>>;
+type Spare<const N: usize> = Memo<Bits<2>, TustinController<N>>;
 
 impl Sampler {
     /// (n, τ) for a communication step of `h_prime`.

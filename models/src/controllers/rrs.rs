@@ -35,7 +35,7 @@
 use super::ControlError;
 use crate::error::{check_non_negative, check_positive, require};
 use crate::hull::rrs_ship::{RrsHullCoefficients, RrsSpeedLaws};
-use crate::memo::{bits, Memo};
+use crate::memo::{bits, Bits, Memo};
 use crate::riccati;
 use nalgebra::{DMatrix, SMatrix, SVector};
 use serde::{Deserialize, Serialize};
@@ -554,12 +554,12 @@ pub struct RrsAutopilot {
     /// e^(−dt/T_m) of the AGC memory and e^(−h/T_σ) of the roll-variance filter for the last two
     /// step lengths (derived, see [`crate::memo`]).
     #[serde(skip)]
-    agc_forget: Memo<[u64; 2], f64, 2>,
+    agc_forget: Memo<Bits<2>, f64, 2>,
     #[serde(skip)]
-    variance_decay: Memo<[u64; 2], f64, 2>,
+    variance_decay: Memo<Bits<2>, f64, 2>,
     /// What the autopilot derives from the speed input, for the last speed (derived).
     #[serde(skip)]
-    speed_terms: Memo<[u64; 13], SpeedTerms>,
+    speed_terms: Memo<Bits<13>, SpeedTerms>,
 }
 
 /// The roll model (A, B) and the course gains at one speed.
@@ -641,9 +641,9 @@ impl RrsAutopilot {
     /// [`SpeedTerms::at`], kept for the last speed (and parameters).
     fn kept_speed_terms(&mut self, speed: f64) -> SpeedTerms {
         let p = self.params;
-        let mut key = [0; 13];
-        key[..3].copy_from_slice(&bits([speed, p.min_speed, p.lambda]));
-        key[3..].copy_from_slice(&p.laws.bits());
+        let mut key = Bits([0; 13]);
+        key.0[..3].copy_from_slice(&bits([speed, p.min_speed, p.lambda]).0);
+        key.0[3..].copy_from_slice(&p.laws.bits().0);
         *self.speed_terms.get(key, || SpeedTerms::at(&p, speed))
     }
 
@@ -756,7 +756,7 @@ impl RrsAutopilot {
         self.prev_command = Some(out.rudder_command);
         self.held = Some(out);
         self.last_dt = h;
-        let a = self.params.adaptation;
+        let a = &self.params.adaptation;
         // roll variance: first-order low-pass of φ² [Klugt1987, Fig. 6.10], exact for the held input
         let f = *self
             .variance_decay

@@ -48,7 +48,7 @@
 use super::{wrap_pi, KNOT};
 use crate::error::{check_finite, check_positive, ParamError};
 use crate::integrate::rk4_advance;
-use crate::memo::{bits, Memo};
+use crate::memo::{bits, Bits, Memo};
 use nalgebra::{SMatrix, SVector};
 use serde::{Deserialize, Serialize};
 
@@ -223,7 +223,7 @@ impl RrsSpeedLaws {
     }
 
     /// The bits of the ten constants (a key for what is derived from them, see [`crate::memo`]).
-    pub fn bits(&self) -> [u64; 10] {
+    pub fn bits(&self) -> Bits<10> {
         bits([
             self.k_dp0,
             self.k_dv0,
@@ -342,10 +342,10 @@ pub struct RrsShip {
 }
 
 /// What (A, B) depend on: the hull coefficients at the step's speed and the wave filters, as bits.
-type SystemKey = ([u64; 11], Option<[u64; 11]>);
+type SystemKey = (Bits<11>, Option<Bits<11>>);
 
 impl RrsHullCoefficients {
-    fn bits(&self) -> [u64; 11] {
+    fn bits(&self) -> Bits<11> {
         bits([
             self.k_dv,
             self.tau_v,
@@ -363,7 +363,7 @@ impl RrsHullCoefficients {
 }
 
 impl RrsWaveCoefficients {
-    fn bits(&self) -> [u64; 11] {
+    fn bits(&self) -> Bits<11> {
         bits([
             self.k_wv,
             self.tau_wv,

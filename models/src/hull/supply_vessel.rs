@@ -25,7 +25,7 @@
 use super::wrap_pi;
 use crate::error::{check_finite, check_positive, require, ParamError};
 use crate::integrate::rk4_advance;
-use crate::memo::{bits, Memo};
+use crate::memo::{bits, Bits, Memo};
 use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 
@@ -67,7 +67,7 @@ pub struct SupplyVessel {
     time: f64,
     /// M⁻¹ of the last step's M (derived, see [`crate::memo`]).
     #[serde(skip)]
-    m_inverse: Memo<[u64; 9], Matrix3<f64>>,
+    m_inverse: Memo<Bits<9>, Matrix3<f64>>,
 }
 
 /// Northern Clipper M [Fossen1999, eq. (56)].

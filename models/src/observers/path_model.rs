@@ -29,7 +29,7 @@
 //! All quantities are nondimensional (t′ = tU/L, r′ = rL/U, η′ = η/L, angles in rad).
 
 use crate::hull::tokyo_maru::{TokyoMaruCoefficients, T_R};
-use crate::memo::bits;
+use crate::memo::{bits, Bits};
 use crate::riccati::{self, RiccatiError};
 use nalgebra::{DMatrix, SMatrix};
 use serde::{Deserialize, Serialize};
@@ -138,7 +138,7 @@ impl PathDesignModel {
 
     /// The bits of every number of the design (a key for gains computed from it, see
     /// [`crate::memo`]).
-    pub fn key(&self) -> [u64; 22] {
+    pub fn key(&self) -> Bits<22> {
         let c = &self.coefficients;
         let (kind, d1, d2) = match self.disturbance {
             DisturbanceModel::ShapingFilter { t_n, t_y } => (0, t_n, t_y),
@@ -149,7 +149,7 @@ impl PathDesignModel {
             self.q[0], self.q[1], self.r[0], self.r[1], self.r[2], self.a44, self.a55, self.b11,
             0.0,
         ]);
-        k[21] = kind;
+        k.0[21] = kind;
         k
     }
 
