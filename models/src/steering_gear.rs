@@ -38,6 +38,7 @@
 //! most [`SteeringGearParams::max_substep`].
 
 use crate::error::{check_positive, ParamError};
+use crate::memo::{bits, Bits, Memo};
 use serde::{Deserialize, Serialize};
 
 /// Order of the servo loop.
@@ -144,6 +145,10 @@ pub struct SteeringGear {
     command: f64,
     /// Time [s] spent with the rate limiter active since the start.
     rate_saturated_time: f64,
+    /// e^(−t/τ) of the first-order servo for the last two durations t (the communication step,
+    /// unless the rate limiter was active; derived, see [`crate::memo`]).
+    #[serde(skip)]
+    decay: Memo<Bits<2>, f64, 2>,
 }
 
 impl SteeringGear {
@@ -158,6 +163,7 @@ impl SteeringGear {
             rate: 0.0,
             command: angle,
             rate_saturated_time: 0.0,
+            decay: Memo::default(),
         })
     }
 
@@ -246,8 +252,12 @@ impl SteeringGear {
             }
         }
         if remaining > 0.0 {
-            angle = c - (c - angle) * (-remaining / tau).exp();
+            let decay = *self
+                .decay
+                .get(bits([remaining, tau]), || (-remaining / tau).exp());
+            angle = c - (c - angle) * decay;
         }
+        let p = &self.params;
         self.angle = angle.clamp(-p.angle_max, p.angle_max);
         self.rate_saturated_time += saturated;
     }

@@ -25,6 +25,11 @@ fn panic_message(p: &(dyn std::any::Any + Send)) -> String {
 
 /// Runs `f` on the instance behind `c` if `function` is legal in its state; a panic becomes
 /// fmi2Error, the instance moves to the Error state and the panic is logged.
+///
+/// Inlined into every entry, with the error paths out of line (`#[cold]`), so that a legal call
+/// costs a null test, a state-mask test, a logging-flag test and the body: `catch_unwind` costs
+/// nothing unless a panic unwinds.
+#[inline(always)]
 unsafe fn with_instance<M: FmuModel>(
     c: fmi2Component,
     function: &str,
@@ -41,21 +46,36 @@ unsafe fn with_instance<M: FmuModel>(
     }
     match catch_unwind(AssertUnwindSafe(|| f(&mut *inst))) {
         Ok(status) => status,
-        Err(p) => {
-            let inst = &mut *inst;
-            inst.core.state = LifeState::Error;
-            inst.log(
-                fmi2Error,
-                CAT_ERROR,
-                &format!(
-                    "{function}: internal error (panic: {}); the instance is in the Error state \
-                     (fmi2Reset, fmi2SetFMUstate or fmi2FreeInstance)",
-                    panic_message(p.as_ref())
-                ),
-            );
-            fmi2Error
-        }
+        Err(p) => panicked(&mut *inst, function, p.as_ref()),
     }
+}
+
+/// A panic caught in `function`: the instance moves to the Error state and the panic is logged.
+#[cold]
+#[inline(never)]
+fn panicked<M: FmuModel>(
+    inst: &mut Instance<M>,
+    function: &str,
+    p: &(dyn std::any::Any + Send),
+) -> fmi2Status {
+    inst.core.state = LifeState::Error;
+    inst.log(
+        fmi2Error,
+        CAT_ERROR,
+        &format!(
+            "{function}: internal error (panic: {}); the instance is in the Error state \
+             (fmi2Reset, fmi2SetFMUstate or fmi2FreeInstance)",
+            panic_message(p)
+        ),
+    );
+    fmi2Error
+}
+
+/// An error status and a log line with `message` (out of line: only failures build messages).
+#[cold]
+#[inline(never)]
+fn fail<M: FmuModel>(inst: &Instance<M>, message: std::fmt::Arguments) -> fmi2Status {
+    inst.error(&message.to_string())
 }
 
 /// `fmi2GetTypesPlatform`.
@@ -116,7 +136,7 @@ pub unsafe fn instantiate<M: FmuModel>(
                 M::MODEL_IDENTIFIER
             ));
         }
-        let expected = crate::xml::guid::<M>();
+        let expected = crate::xml::guid_str::<M>();
         if guid.is_null() {
             return fail("fmi2Instantiate: missing GUID");
         }
@@ -135,10 +155,10 @@ pub unsafe fn instantiate<M: FmuModel>(
             logging_on != fmi2False,
             fnv1a(expected.as_bytes()),
         );
-        inst.log(
+        inst.log_fmt(
             fmi2OK,
             CAT_EVENTS,
-            &format!("instantiated {} {expected}", M::MODEL_IDENTIFIER),
+            format_args!("instantiated {} {expected}", M::MODEL_IDENTIFIER),
         );
         Box::into_raw(Box::new(inst)) as fmi2Component
     }));
@@ -248,10 +268,10 @@ pub unsafe fn exit_initialization_mode<M: FmuModel>(c: fmi2Component) -> fmi2Sta
             Ok(()) => {
                 inst.dirty = false;
                 inst.core.state = LifeState::StepComplete;
-                inst.log(
+                inst.log_fmt(
                     fmi2OK,
                     CAT_EVENTS,
-                    &format!("initialized at t = {}", inst.core.start_time),
+                    format_args!("initialized at t = {}", inst.core.start_time),
                 );
                 fmi2OK
             }
@@ -268,10 +288,10 @@ pub unsafe fn exit_initialization_mode<M: FmuModel>(c: fmi2Component) -> fmi2Sta
 pub unsafe fn terminate<M: FmuModel>(c: fmi2Component) -> fmi2Status {
     with_instance::<M>(c, "fmi2Terminate", mask::TERMINATE, |inst| {
         inst.core.state = LifeState::Terminated;
-        inst.log(
+        inst.log_fmt(
             fmi2OK,
             CAT_EVENTS,
-            &format!("terminated at t = {}", inst.core.time),
+            format_args!("terminated at t = {}", inst.core.time),
         );
         fmi2OK
     })
@@ -295,51 +315,86 @@ pub unsafe fn reset<M: FmuModel>(c: fmi2Component) -> fmi2Status {
 }
 
 /// Looks up `vr` and checks the base type; the error names the function and the reference.
+#[inline(always)]
 fn lookup<'a, M: FmuModel>(
     inst: &Instance<M>,
     function: &str,
     vr: fmi2ValueReference,
     expected: crate::BaseType,
 ) -> Result<&'a Variable<M>, fmi2Status> {
-    let vars = M::variables();
-    match vars.get(vr as usize) {
+    match M::variables().get(vr as usize) {
         Some(v) if v.base_type() == expected => Ok(v),
-        Some(v) => Err(inst.error(&format!(
+        found => Err(lookup_error(inst, function, vr, expected, found)),
+    }
+}
+
+#[cold]
+#[inline(never)]
+fn lookup_error<M: FmuModel>(
+    inst: &Instance<M>,
+    function: &str,
+    vr: fmi2ValueReference,
+    expected: crate::BaseType,
+    found: Option<&Variable<M>>,
+) -> fmi2Status {
+    match found {
+        Some(v) => inst.error(&format!(
             "{function}: value reference {vr} is {} {:?}, not a {expected} variable",
             v.base_type(),
             v.name
-        ))),
-        None => Err(inst.error(&format!(
+        )),
+        None => inst.error(&format!(
             "{function}: no variable with value reference {vr} in {} (valid: 0..{})",
             M::MODEL_IDENTIFIER,
-            vars.len().saturating_sub(1)
-        ))),
+            M::variables().len().saturating_sub(1)
+        )),
     }
 }
 
 /// Checks that `v` may be set in the current state (FMI 2.0 section 4.2.4 and the variability
 /// rules: fixed parameters only before initialization is left; tunable parameters and inputs also
 /// in StepComplete; nothing else ever).
+#[inline(always)]
 fn check_settable<M: FmuModel>(inst: &Instance<M>, function: &str, v: &Variable<M>) -> fmi2Status {
+    let fixed_after_init = inst.core.state == LifeState::StepComplete
+        && v.causality == Causality::Parameter
+        && v.variability == Variability::Fixed;
+    if v.settable() && !fixed_after_init {
+        fmi2OK
+    } else {
+        not_settable(inst, function, v)
+    }
+}
+
+#[cold]
+#[inline(never)]
+fn not_settable<M: FmuModel>(inst: &Instance<M>, function: &str, v: &Variable<M>) -> fmi2Status {
     if !v.settable() {
         return inst.error(&format!(
             "{function}: variable {:?} has causality {:?} and cannot be set",
             v.name, v.causality
         ));
     }
-    if inst.core.state == LifeState::StepComplete
-        && v.causality == Causality::Parameter
-        && v.variability == Variability::Fixed
-    {
-        return inst.error(&format!(
-            "{function}: fixed parameter {:?} cannot be changed after initialization",
-            v.name
-        ));
+    inst.error(&format!(
+        "{function}: fixed parameter {:?} cannot be changed after initialization",
+        v.name
+    ))
+}
+
+/// In Initialization Mode the outputs (InitialUnknowns) must reflect the parameters and start
+/// values set so far (FMI 2.0 sections 3.2.3 and 4.2.4): rebuild the model from them.
+/// `initialize` is idempotent; an error is reported by fmi2ExitInitializationMode.
+#[cold]
+#[inline(never)]
+fn initial_outputs<M: FmuModel>(inst: &mut Instance<M>) {
+    if inst.model.initialize(inst.core.start_time).is_ok() {
+        inst.model.calculate_outputs();
     }
-    fmi2OK
+    inst.dirty = false;
 }
 
 /// Shared body of the typed getters.
+#[inline(always)]
 unsafe fn get_values<M: FmuModel, T>(
     c: fmi2Component,
     function: &str,
@@ -354,16 +409,10 @@ unsafe fn get_values<M: FmuModel, T>(
             return fmi2OK;
         }
         if vr.is_null() || out.is_null() {
-            return inst.error(&format!("{function}: NULL array with nvr = {n}"));
+            return fail(inst, format_args!("{function}: NULL array with nvr = {n}"));
         }
         if inst.core.state == LifeState::InitializationMode && inst.dirty {
-            // In Initialization Mode the outputs (InitialUnknowns) must reflect the parameters
-            // and start values set so far (FMI 2.0 sections 3.2.3 and 4.2.4): rebuild the model from them.
-            // `initialize` is idempotent; an error is reported by fmi2ExitInitializationMode.
-            if inst.model.initialize(inst.core.start_time).is_ok() {
-                inst.model.calculate_outputs();
-            }
-            inst.dirty = false;
+            initial_outputs(inst);
         }
         inst.refresh_outputs();
         let vrs = std::slice::from_raw_parts(vr, n);
@@ -465,9 +514,12 @@ pub unsafe fn get_string<M: FmuModel>(
     })
 }
 
-/// Shared body of the typed setters. `apply` validates the value and writes it; it returns an
-/// error message naming the variable on refusal. A tunable parameter changed in StepComplete is
-/// checked by `parameters_changed` and restored on refusal.
+/// Shared body of the typed setters. `apply` validates the value and writes it; it returns the
+/// old value of a parameter (`None` for an input, which is never restored) or an error message
+/// naming the variable on refusal. A tunable parameter changed in StepComplete is checked by
+/// `parameters_changed` and restored on refusal.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
 unsafe fn set_values<M: FmuModel, T: Copy>(
     c: fmi2Component,
     function: &'static str,
@@ -483,7 +535,7 @@ unsafe fn set_values<M: FmuModel, T: Copy>(
             return fmi2OK;
         }
         if vr.is_null() || values.is_null() {
-            return inst.error(&format!("{function}: NULL array with nvr = {n}"));
+            return fail(inst, format_args!("{function}: NULL array with nvr = {n}"));
         }
         let vrs = std::slice::from_raw_parts(vr, n);
         let vals = std::slice::from_raw_parts(values, n);
@@ -499,28 +551,63 @@ unsafe fn set_values<M: FmuModel, T: Copy>(
             let old = match apply(v, &mut inst.model, x) {
                 Ok(old) => old,
                 Err(msg) => {
-                    return inst.error(&format!(
-                        "{function}: instance {:?}: {msg}",
-                        inst.name.to_string_lossy()
-                    ))
+                    return fail(
+                        inst,
+                        format_args!(
+                            "{function}: instance {:?}: {msg}",
+                            inst.name.to_string_lossy()
+                        ),
+                    )
                 }
             };
             inst.dirty = true;
             if inst.core.state == LifeState::StepComplete && v.causality == Causality::Parameter {
-                if let Err(msg) = inst.model.parameters_changed() {
-                    if let Some(old) = old {
-                        let _ = apply(v, &mut inst.model, old);
-                    }
-                    return inst.error(&format!(
-                        "{function}: instance {:?}: refused {:?}: {msg}",
-                        inst.name.to_string_lossy(),
-                        v.name
-                    ));
+                let s = tunable_changed(inst, function, v, old, &apply);
+                if s != fmi2OK {
+                    return s;
                 }
             }
         }
         fmi2OK
     })
+}
+
+/// A tunable parameter changed in StepComplete: `parameters_changed` checks it; on refusal the
+/// old value is restored and the error names the variable.
+#[inline(never)]
+fn tunable_changed<M: FmuModel, T>(
+    inst: &mut Instance<M>,
+    function: &str,
+    v: &Variable<M>,
+    old: Option<T>,
+    apply: &impl Fn(&Variable<M>, &mut M, T) -> Result<Option<T>, String>,
+) -> fmi2Status {
+    match inst.model.parameters_changed() {
+        Ok(()) => fmi2OK,
+        Err(msg) => {
+            if let Some(old) = old {
+                let _ = apply(v, &mut inst.model, old);
+            }
+            inst.error(&format!(
+                "{function}: instance {:?}: refused {:?}: {msg}",
+                inst.name.to_string_lossy(),
+                v.name
+            ))
+        }
+    }
+}
+
+/// The old value of `v`, read only for a parameter (the only kind `set_values` restores).
+#[inline(always)]
+fn old_value<M, T>(v: &Variable<M>, m: &M, get: fn(&M) -> T) -> Option<T> {
+    (v.causality == Causality::Parameter).then(|| get(m))
+}
+
+/// A refusal message (out of line: only refusals build messages).
+#[cold]
+#[inline(never)]
+fn refused(message: std::fmt::Arguments) -> String {
+    message.to_string()
 }
 
 /// # Safety
@@ -544,19 +631,22 @@ pub unsafe fn set_real<M: FmuModel>(
                 get, set, min, max, ..
             } => {
                 if !x.is_finite() {
-                    return Err(format!("{:?} = {x} refused: not a finite number", v.name));
+                    return Err(refused(format_args!(
+                        "{:?} = {x} refused: not a finite number",
+                        v.name
+                    )));
                 }
                 if min.is_some_and(|lo| x < lo) || max.is_some_and(|hi| x > hi) {
-                    return Err(format!(
+                    return Err(refused(format_args!(
                         "{:?} = {x} refused: outside [{}, {}]",
                         v.name,
                         min.unwrap_or(f64::NEG_INFINITY),
                         max.unwrap_or(f64::INFINITY)
-                    ));
+                    )));
                 }
-                let old = get(m);
+                let old = old_value(v, m, get);
                 (set.expect("settable variables have setters (check_table)"))(m, x);
-                Ok(Some(old))
+                Ok(old)
             }
             _ => unreachable!("type checked by lookup"),
         },
@@ -582,16 +672,16 @@ pub unsafe fn set_integer<M: FmuModel>(
         |v, m, x| match v.access {
             Access::Integer { get, set, min, max } => {
                 if min.is_some_and(|lo| x < lo) || max.is_some_and(|hi| x > hi) {
-                    return Err(format!(
+                    return Err(refused(format_args!(
                         "{:?} = {x} refused: outside [{}, {}]",
                         v.name,
                         min.unwrap_or(i32::MIN),
                         max.unwrap_or(i32::MAX)
-                    ));
+                    )));
                 }
-                let old = get(m);
+                let old = old_value(v, m, get);
                 (set.expect("settable variables have setters (check_table)"))(m, x);
-                Ok(Some(old))
+                Ok(old)
             }
             _ => unreachable!("type checked by lookup"),
         },
@@ -616,9 +706,9 @@ pub unsafe fn set_boolean<M: FmuModel>(
         values,
         |v, m, x| match v.access {
             Access::Boolean { get, set } => {
-                let old = get(m) as fmi2Boolean;
+                let old = old_value(v, m, get).map(|b| b as fmi2Boolean);
                 (set.expect("settable variables have setters (check_table)"))(m, x != fmi2False);
-                Ok(Some(old))
+                Ok(old)
             }
             _ => unreachable!("type checked by lookup"),
         },
@@ -707,10 +797,10 @@ pub unsafe fn set_fmu_state<M: FmuModel>(c: fmi2Component, s: fmi2FMUstate) -> f
                 inst.model = b.snapshot.model.clone();
                 inst.core = b.snapshot.core.clone();
                 inst.dirty = false;
-                inst.log(
+                inst.log_fmt(
                     fmi2OK,
                     CAT_EVENTS,
-                    &format!("state restored to t = {}", inst.core.time),
+                    format_args!("state restored to t = {}", inst.core.time),
                 );
                 fmi2OK
             }
@@ -924,22 +1014,26 @@ pub unsafe fn do_step<M: FmuModel>(
     with_instance::<M>(c, "fmi2DoStep", mask::DO_STEP, |inst| {
         let now = inst.core.time;
         if !(h.is_finite() && h > 0.0) {
-            return inst.error(&format!(
-                "fmi2DoStep: communicationStepSize = {h} must be > 0"
-            ));
+            return fail(
+                inst,
+                format_args!("fmi2DoStep: communicationStepSize = {h} must be > 0"),
+            );
         }
         let tol = 1e-10 * now.abs().max(1.0);
         if !t.is_finite() || (t - now).abs() > tol {
-            return inst.error(&format!(
-                "fmi2DoStep: currentCommunicationPoint = {t} does not match the FMU's time {now}"
-            ));
+            return fail(
+                inst,
+                format_args!(
+                    "fmi2DoStep: currentCommunicationPoint = {t} does not match the FMU's time {now}"
+                ),
+            );
         }
         if let Some(stop) = inst.core.stop_time {
             if t + h > stop + 1e-10 * stop.abs().max(1.0) {
-                return inst.error(&format!(
-                    "fmi2DoStep: step to {} passes stopTime = {stop}",
-                    t + h
-                ));
+                return fail(
+                    inst,
+                    format_args!("fmi2DoStep: step to {} passes stopTime = {stop}", t + h),
+                );
             }
         }
         match inst.model.do_step(t, h) {
@@ -948,15 +1042,20 @@ pub unsafe fn do_step<M: FmuModel>(
                 inst.dirty = false;
                 fmi2OK
             }
-            Err(msg) => {
-                inst.core.state = LifeState::Error;
-                inst.error(&format!(
-                    "fmi2DoStep at t = {t}, h = {h}: instance {:?}: {msg}",
-                    inst.name.to_string_lossy()
-                ))
-            }
+            Err(msg) => step_failed(inst, t, h, &msg),
         }
     })
+}
+
+/// The model refused a step: the instance moves to the Error state.
+#[cold]
+#[inline(never)]
+fn step_failed<M: FmuModel>(inst: &mut Instance<M>, t: f64, h: f64, msg: &str) -> fmi2Status {
+    inst.core.state = LifeState::Error;
+    inst.error(&format!(
+        "fmi2DoStep at t = {t}, h = {h}: instance {:?}: {msg}",
+        inst.name.to_string_lossy()
+    ))
 }
 
 /// # Safety

@@ -154,26 +154,48 @@ impl<M: FmuModel> Instance<M> {
         );
     }
 
+    /// [`Instance::log`] of a message that is formatted only if its category is enabled.
+    pub fn log_fmt(&self, status: fmi2Status, category: usize, message: std::fmt::Arguments) {
+        if self.enabled[category] {
+            self.log(status, category, &message.to_string());
+        }
+    }
+
     pub fn error(&self, message: &str) -> fmi2Status {
         self.log(fmi2Error, CAT_ERROR, message);
         fmi2Error
     }
 
     /// Returns an error status and a log line unless the current state is in `mask`.
+    /// Inlined into every entry: the legal, logging-off path is a mask test and a flag test.
+    #[inline(always)]
     pub fn check_state(&self, function: &str, mask: u32) -> Result<(), fmi2Status> {
         if self.core.state as u32 & mask != 0 {
             if self.enabled[CAT_CALLS] {
-                self.log(fmi2OK, CAT_CALLS, function);
+                self.log_call(function);
             }
             Ok(())
         } else {
-            Err(self.error(&format!(
-                "Illegal call sequence: {function} is not allowed in state {}.",
-                self.core.state.name()
-            )))
+            Err(self.illegal_call(function))
         }
     }
 
+    #[cold]
+    #[inline(never)]
+    fn log_call(&self, function: &str) {
+        self.log(fmi2OK, CAT_CALLS, function);
+    }
+
+    #[cold]
+    #[inline(never)]
+    fn illegal_call(&self, function: &str) -> fmi2Status {
+        self.error(&format!(
+            "Illegal call sequence: {function} is not allowed in state {}.",
+            self.core.state.name()
+        ))
+    }
+
+    #[inline(always)]
     pub fn refresh_outputs(&mut self) {
         if self.dirty {
             self.model.calculate_outputs();

@@ -109,6 +109,11 @@ macro_rules! fmu_description {
             fn documentation_html() -> &'static str {
                 $html
             }
+
+            fn guid_cell() -> &'static ::std::sync::OnceLock<String> {
+                static GUID: ::std::sync::OnceLock<String> = ::std::sync::OnceLock::new();
+                &GUID
+            }
         }
     };
 }

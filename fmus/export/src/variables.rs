@@ -90,6 +90,7 @@ impl<M> Variable<M> {
         self
     }
 
+    #[inline]
     pub fn base_type(&self) -> BaseType {
         match self.access {
             Access::Real { .. } => BaseType::Real,
@@ -115,6 +116,7 @@ impl<M> Variable<M> {
     }
 
     /// Whether fmi2SetXXX may write it at all.
+    #[inline]
     pub fn settable(&self) -> bool {
         matches!(self.causality, Causality::Parameter | Causality::Input)
     }

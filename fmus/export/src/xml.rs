@@ -216,9 +216,17 @@ fn description_template<M: FmuModel>() -> String {
 /// The GUID: a name-based (v5) UUID of the description text, so that any change to the variable
 /// table, units, capabilities or version gives a new GUID and an unchanged FMU keeps its GUID.
 pub fn guid<M: FmuModel>() -> String {
-    let text = description_template::<M>();
-    let id = uuid::Uuid::new_v5(&uuid::Uuid::NAMESPACE_URL, text.as_bytes());
-    format!("{{{id}}}")
+    guid_str::<M>().to_string()
+}
+
+/// [`guid`], computed once per process (it is a constant of the binary; `fmi2Instantiate` checks
+/// it, and building the description runs `M::default()` and formats every variable).
+pub fn guid_str<M: FmuModel>() -> &'static str {
+    M::guid_cell().get_or_init(|| {
+        let text = description_template::<M>();
+        let id = uuid::Uuid::new_v5(&uuid::Uuid::NAMESPACE_URL, text.as_bytes());
+        format!("{{{id}}}")
+    })
 }
 
 /// The complete `modelDescription.xml`.

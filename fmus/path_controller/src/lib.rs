@@ -5,8 +5,10 @@
 
 use fmi2_export::FmuModel;
 use models::controllers::path::{
-    Adaptation, DisturbanceModel, PathController, PathControllerParams, PathInputs, EPSILON,
+    path_gains, Adaptation, DisturbanceModel, PathController, PathControllerParams, PathGains,
+    PathInputs, EPSILON,
 };
+use models::memo::{Bits, Memo};
 use serde::{Deserialize, Serialize};
 
 /// Parameters, inputs and state of one path-controller instance.
@@ -22,6 +24,22 @@ pub struct PathControllerFmu {
     shaping_time_constant: f64,
     inputs: PathInputs,
     controller: PathController,
+    /// The gains of the last initial design (an importer reads outputs in Initialization Mode
+    /// after each input it sets, and each read initializes again: the two Riccati solutions are
+    /// kept while the design does not change; derived, see `models::memo`).
+    #[serde(skip)]
+    gains: Memo<Bits<22>, PathGains>,
+}
+
+impl PathControllerFmu {
+    /// A controller for `params`, its initial gains from `memo` when the design is unchanged.
+    fn build(
+        params: PathControllerParams,
+        memo: &mut Memo<Bits<22>, PathGains>,
+    ) -> Result<PathController, String> {
+        PathController::new_with(params, |d| memo.try_get(d.key(), || path_gains(d)).copied())
+            .map_err(|e| e.to_string())
+    }
 }
 
 impl PathControllerFmu {
@@ -46,6 +64,7 @@ impl PathControllerFmu {
 impl Default for PathControllerFmu {
     fn default() -> Self {
         let params = PathControllerParams::default();
+        let mut gains = Memo::default();
         PathControllerFmu {
             steering_time_constant: params.design.t_r * params.length / params.speed,
             disturbance_model: 2,
@@ -55,7 +74,8 @@ impl Default for PathControllerFmu {
                 depth_ratio: params.design_depth_ratio,
                 ..PathInputs::default()
             },
-            controller: PathController::new(params).expect("default design solves"),
+            controller: Self::build(params, &mut gains).expect("default design solves"),
+            gains,
             params,
         }
     }
@@ -171,7 +191,7 @@ fmi2_export::fmu! {
 
 impl FmuModel for PathControllerFmu {
     fn initialize(&mut self, _start_time: f64) -> Result<(), String> {
-        self.controller = PathController::new(self.model_params()).map_err(|e| e.to_string())?;
+        self.controller = Self::build(self.model_params(), &mut self.gains)?;
         self.controller.start(&self.inputs);
         Ok(())
     }

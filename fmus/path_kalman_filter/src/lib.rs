@@ -4,7 +4,8 @@
 use fmi2_export::FmuModel;
 use models::error::check_positive;
 use models::hull::tokyo_maru::{TokyoMaruCoefficients, L, U};
-use models::observers::path_kalman::{PathKalmanConfig, PathKalmanFilter};
+use models::memo::{Bits, Memo};
+use models::observers::path_kalman::{KalmanGain, PathKalmanConfig, PathKalmanFilter};
 use serde::{Deserialize, Serialize};
 
 /// Parameters, inputs and filter of one instance.
@@ -25,15 +26,25 @@ pub struct PathKalmanFilterFmu {
     /// Inputs: f22, f23, f25, f32, f33, f35 of the design in use (from the PathController).
     design_inputs: [f64; 6],
     filter: PathKalmanFilter,
+    /// The gain of the last design initialized (an importer reads outputs in Initialization
+    /// Mode after each input it sets, and each read initializes again: the Riccati solution is
+    /// kept while the design does not change; derived, see `models::memo`).
+    #[serde(skip)]
+    gain: Memo<Bits<22>, KalmanGain>,
 }
 
 impl Default for PathKalmanFilterFmu {
     fn default() -> Self {
         let config = PathKalmanConfig::default();
-        let design_inputs = coefficients_of(&config.design().expect("preset").coefficients);
+        let design = config.design().expect("preset");
+        let design_inputs = coefficients_of(&design.coefficients);
+        let mut gain = Memo::default();
+        let k = *gain
+            .try_get(design.key(), || design.kalman_gain())
+            .expect("preset design has a stabilising Riccati solution");
         PathKalmanFilterFmu {
-            filter: PathKalmanFilter::new(config.design().expect("preset"), [0.0; 7])
-                .expect("preset design has a stabilising Riccati solution"),
+            filter: PathKalmanFilter::with_gain(design, [0.0; 7], k),
+            gain,
             config,
             steering_time_constant: 10.0,
             euler_step_prime: 0.005,
@@ -189,8 +200,11 @@ impl FmuModel for PathKalmanFilterFmu {
         let design = self.config.design().map_err(|e| e.to_string())?;
         let x0 = self.initial_estimate;
         let xp = [x0[0], x0[1] / UL, x0[2], x0[3] / L, x0[4], x0[5], x0[6]];
-        self.filter = PathKalmanFilter::new(design, xp)
+        let k = *self
+            .gain
+            .try_get(design.key(), || design.kalman_gain())
             .map_err(|e| format!("Kalman gain design failed: {e}"))?;
+        self.filter = PathKalmanFilter::with_gain(design, xp, k);
         self.filter.dt_prime = self.euler_step_prime;
         self.filter.innovation_window = self.innovation_window;
         Ok(())

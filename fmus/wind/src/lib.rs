@@ -13,6 +13,21 @@ pub struct WindFmu {
     speed: f64,
     heading: f64,
     model: Wind,
+    /// `model.relative()`, computed once wherever the model changes (do_step, calculate_outputs,
+    /// initialize, parameters_changed) instead of in each of the four getters that need it;
+    /// `None` (after a deserialized restore) means compute it. Not part of the state.
+    #[serde(skip)]
+    relative: Option<(f64, f64)>,
+}
+
+impl WindFmu {
+    fn relative(&self) -> (f64, f64) {
+        self.relative.unwrap_or_else(|| self.model.relative())
+    }
+
+    fn keep_relative(&mut self) {
+        self.relative = Some(self.model.relative());
+    }
 }
 
 impl Default for WindFmu {
@@ -23,6 +38,7 @@ impl Default for WindFmu {
             params,
             speed: 0.0,
             heading: 0.0,
+            relative: None,
         }
     }
 }
@@ -60,13 +76,13 @@ fmi2_export::fmu! {
             "Mean plus gust wind speed";
         output real "true_wind_direction" ["rad"] (|m| m.model.true_direction()),
             "Mean plus varying direction (towards)";
-        output real "relative_wind_speed" ["m/s"] (|m| m.model.relative().0),
+        output real "relative_wind_speed" ["m/s"] (|m| m.relative().0),
             "V_w: relative wind speed as measured on board";
-        output real "relative_wind_angle" ["rad"] (|m| m.model.relative().1),
+        output real "relative_wind_angle" ["rad"] (|m| m.relative().1),
             "gamma in (-pi, pi]: 0 wind from astern, +pi/2 blowing towards starboard, pi head wind";
-        output real "roll_moment" ["N.m"] (|m| m.model.roll_moment()),
+        output real "roll_moment" ["N.m"] (|m| m.model.roll_moment_at(m.relative())),
             "K = c_w_phi V_w^2 sin(gamma) (003 eq. 2.19)";
-        output real "yaw_moment" ["N.m"] (|m| m.model.yaw_moment()),
+        output real "yaw_moment" ["N.m"] (|m| m.model.yaw_moment_at(m.relative())),
             "N = c_wR V_w^2 sin(2 gamma) (003 eq. 2.20)";
     }
 }
@@ -75,6 +91,7 @@ impl FmuModel for WindFmu {
     fn initialize(&mut self, start_time: f64) -> Result<(), String> {
         self.model = Wind::new(self.params.clone(), start_time)?;
         self.model.set_inputs(self.speed, self.heading);
+        self.keep_relative();
         Ok(())
     }
 
@@ -87,16 +104,72 @@ impl FmuModel for WindFmu {
             p.roll_coefficient,
             p.yaw_coefficient,
         );
+        self.keep_relative();
         Ok(())
     }
 
     fn calculate_outputs(&mut self) {
         self.model.set_inputs(self.speed, self.heading);
+        self.keep_relative();
     }
 
     fn do_step(&mut self, t: f64, h: f64) -> Result<(), String> {
         self.model.set_inputs(self.speed, self.heading);
         self.model.advance_to(t + h);
+        self.keep_relative();
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use fmi2_export::{Access, FmuDescription};
+
+    fn output(m: &WindFmu, name: &str) -> f64 {
+        let v = WindFmu::variables().iter().find(|v| v.name == name);
+        match v.map(|v| &v.access) {
+            Some(Access::Real { get, .. }) => get(m),
+            _ => panic!("no Real variable {name}"),
+        }
+    }
+
+    /// The outputs read from the relative wind kept at each change equal the model's own
+    /// functions bit for bit, and so do they when nothing is kept (a deserialized state).
+    #[test]
+    fn outputs_from_the_kept_relative_wind_equal_the_model() {
+        let mut m = WindFmu::default();
+        m.params.roll_coefficient = 2.35e-4;
+        m.params.yaw_coefficient = 2.3e-5;
+        m.params.direction = 1.2;
+        m.speed = 11.0;
+        m.initialize(0.0).unwrap();
+        let check = |m: &WindFmu| {
+            let (v, g) = m.model.relative();
+            for (name, want) in [
+                ("relative_wind_speed", v),
+                ("relative_wind_angle", g),
+                ("roll_moment", m.model.roll_moment()),
+                ("yaw_moment", m.model.yaw_moment()),
+            ] {
+                assert_eq!(output(m, name).to_bits(), want.to_bits(), "{name}");
+            }
+        };
+        check(&m);
+        for k in 0..300 {
+            m.heading = 0.01 * k as f64;
+            m.calculate_outputs();
+            check(&m);
+            m.do_step(0.1 * k as f64, 0.1).unwrap();
+            check(&m);
+            if k == 150 {
+                m.params.mean_speed = 14.0;
+                m.parameters_changed().unwrap();
+                check(&m);
+            }
+            let mut restored = m.clone();
+            restored.relative = None;
+            check(&restored);
+        }
     }
 }

@@ -30,6 +30,7 @@
 
 use super::ControlError;
 use crate::error::{check_finite, check_positive, check_positive_or_infinite};
+use crate::memo::{bits, Bits, Memo};
 use nalgebra::{Complex, DMatrix, SMatrix, SVector};
 use serde::{Deserialize, Serialize};
 
@@ -210,20 +211,21 @@ impl<const N: usize> TustinController<N> {
         }
         check_positive("sample step", step)?;
         check_positive_or_infinite("command limit", limit)?;
+        // Normalised by a0 (computed where used: no allocation, the same divisions).
         let a0 = tf.den[0];
-        let den: Vec<f64> = tf.den.iter().map(|c| c / a0).collect();
-        let mut num = vec![0.0; N + 1 - tf.num.len()];
-        num.extend(tf.num.iter().map(|c| c / a0));
-        let d = num[0];
+        let den = |i: usize| tf.den[i] / a0;
+        let pad = N + 1 - tf.num.len();
+        let num = |i: usize| if i < pad { 0.0 } else { tf.num[i - pad] / a0 };
+        let d = num(0);
         // strictly proper remainder b(s) = num − d·den, coefficients of s^(N−1) … s^0
-        let b: Vec<f64> = (1..=N).map(|i| num[i] - d * den[i]).collect();
+        let b: [f64; N] = std::array::from_fn(|k| num(k + 1) - d * den(k + 1));
         // controllable canonical form: x = (x1 … xN), ẋ_i = x_(i+1), ẋ_N = −Σ den_(N−j) x_(j+1) + u
         let mut a = SMatrix::<f64, N, N>::zeros();
         for i in 0..N - 1 {
             a[(i, i + 1)] = 1.0;
         }
         for j in 0..N {
-            a[(N - 1, j)] = -den[N - j];
+            a[(N - 1, j)] = -den(N - j);
         }
         let mut bv = SVector::<f64, N>::zeros();
         bv[N - 1] = 1.0;
@@ -259,11 +261,15 @@ impl<const N: usize> TustinController<N> {
         step: f64,
         limit: f64,
     ) -> Result<Self, ControlError> {
-        let mut c = Self::new(tf, step, limit)?;
-        c.x = self.x;
-        c.output = self.output;
-        c.unlimited = self.unlimited;
-        Ok(c)
+        Ok(Self::new(tf, step, limit)?.with_state_of(self))
+    }
+
+    /// This realisation with the state and the held output of `other`.
+    fn with_state_of(mut self, other: &Self) -> Self {
+        self.x = other.x;
+        self.output = other.output;
+        self.unlimited = other.unlimited;
+        self
     }
 
     /// One sample: output for the error `e` (held until the next sample), then the state update.
@@ -529,6 +535,10 @@ struct Sampler {
     sample_step: f64,
 }
 
+/// A realisation kept for the (sample step, limit) it was built for (derived, see
+/// [`crate::memo`]).
+type Spare<const N: usize> = Memo<Bits<2>, TustinController<N>>;
+
 impl Sampler {
     /// (n, τ) for a communication step of `h_prime`.
     fn split(h_prime: f64, tau_max: f64) -> (usize, f64) {
@@ -539,9 +549,14 @@ impl Sampler {
     /// Splits a communication step of `h` seconds into n equal samples of at most the design's
     /// sample step (in t′) and re-discretises `discrete` when the sample step changes (keeping
     /// the old realisation if the new one cannot be built). Returns n.
+    ///
+    /// A master's steps t_(k+1) − t_k differ in their last bits (the grid times are rounded), so
+    /// the sample step alternates between a few values: the realisation it replaces is kept in
+    /// `spare` and reused when its step comes back.
     fn prepare<const N: usize>(
         &mut self,
         discrete: &mut TustinController<N>,
+        spare: &mut Spare<N>,
         transfer_function: &TransferFunction,
         c: &LoopShapingCommon,
         h: f64,
@@ -549,8 +564,14 @@ impl Sampler {
         let scale = c.speed / c.length;
         let (n, tau) = Sampler::split(h * scale, c.sample_step);
         if tau != self.sample_step {
-            if let Ok(rediscretised) = discrete.rediscretised(transfer_function, tau, c.limit) {
-                *discrete = rediscretised;
+            let key = bits([tau, c.limit]);
+            let next = match spare.take(&key) {
+                Some(kept) => Ok(kept),
+                None => TustinController::new(transfer_function, tau, c.limit),
+            };
+            if let Ok(next) = next {
+                spare.put(bits([self.sample_step, discrete.limit]), *discrete);
+                *discrete = next.with_state_of(discrete);
                 self.sample_step = tau;
             }
         }
@@ -577,6 +598,9 @@ pub struct HeadingAutopilot {
     transfer_function: TransferFunction,
     /// Its Tustin realisation at the current sample step.
     discrete: TustinController<2>,
+    /// The realisation at the previous sample step.
+    #[serde(skip)]
+    spare: Spare<2>,
     sampler: Sampler,
     initial_heading: f64,
     last_reference: f64,
@@ -595,6 +619,7 @@ impl HeadingAutopilot {
                 time: 0.0,
                 sample_step: design.common.sample_step,
             },
+            spare: Spare::default(),
             initial_heading: 0.0,
             last_reference: 0.0,
         })
@@ -607,6 +632,7 @@ impl HeadingAutopilot {
             self.discrete
                 .rediscretised(&tf, self.sampler.sample_step, design.common.limit)?;
         self.transfer_function = tf;
+        self.spare.clear();
         self.design = design;
         Ok(())
     }
@@ -655,9 +681,13 @@ impl HeadingAutopilot {
             return;
         }
         let c = self.design.common;
-        let n = self
-            .sampler
-            .prepare(&mut self.discrete, &self.transfer_function, &c, h);
+        let n = self.sampler.prepare(
+            &mut self.discrete,
+            &mut self.spare,
+            &self.transfer_function,
+            &c,
+            h,
+        );
         for i in 0..n {
             let t = self.sampler.time + i as f64 * h / n as f64;
             let r = self.reference_at(t, external_reference);
@@ -689,6 +719,9 @@ pub struct TrackController {
     transfer_function: TransferFunction,
     /// Its Tustin realisation at the current sample step.
     discrete: TustinController<4>,
+    /// The realisation at the previous sample step.
+    #[serde(skip)]
+    spare: Spare<4>,
     sampler: Sampler,
     last_reference: f64,
 }
@@ -702,6 +735,7 @@ impl TrackController {
             design,
             reference: TrackReference::External,
             lateral_offset: LateralOffset::default(),
+            spare: Spare::default(),
             sampler: Sampler {
                 time: 0.0,
                 sample_step: design.common.sample_step,
@@ -716,6 +750,7 @@ impl TrackController {
             self.discrete
                 .rediscretised(&tf, self.sampler.sample_step, design.common.limit)?;
         self.transfer_function = tf;
+        self.spare.clear();
         self.design = design;
         Ok(())
     }
@@ -760,9 +795,13 @@ impl TrackController {
             return;
         }
         let c = self.design.common;
-        let n = self
-            .sampler
-            .prepare(&mut self.discrete, &self.transfer_function, &c, h);
+        let n = self.sampler.prepare(
+            &mut self.discrete,
+            &mut self.spare,
+            &self.transfer_function,
+            &c,
+            h,
+        );
         for i in 0..n {
             let t = self.sampler.time + i as f64 * h / n as f64;
             let r = self.reference_at(t, external_reference);
@@ -1109,6 +1148,37 @@ mod tests {
     fn gear_time_constant_in_seconds() {
         let c = LoopShapingCommon::default();
         assert!((c.length / (c.gear_pole * c.speed) - 2.0916).abs() < 1e-3);
+    }
+
+    /// A master's steps t_(k+1) − t_k on a rounded time grid alternate in their last bits; the
+    /// realisation kept for the previous sample step gives bit for bit the commands of one
+    /// rebuilt at every change (`set_design` with the same design rebuilds it and forgets the
+    /// kept one).
+    #[test]
+    fn kept_realisation_equals_a_rebuilt_one() {
+        let grid = |k: u64| (k * 50_000_000) as f64 / 1e9;
+        let steps: Vec<f64> = (0..3000).map(|k| grid(k + 1) - grid(k)).collect();
+        assert!(steps.windows(2).filter(|w| w[0] != w[1]).count() > 1000);
+        let mut kept = HeadingAutopilot::new(HeadingDesign::default()).unwrap();
+        let mut rebuilt = kept.clone();
+        let mut track = TrackController::new(TrackDesign::default()).unwrap();
+        let mut track_rebuilt = track.clone();
+        for (k, &h) in steps.iter().enumerate() {
+            let y = (k as f64 * 0.01).sin();
+            rebuilt.set_design(rebuilt.design).unwrap();
+            track_rebuilt.set_design(track_rebuilt.design).unwrap();
+            kept.step(y, 0.3, h);
+            rebuilt.step(y, 0.3, h);
+            track.step(y, 0.0, h);
+            track_rebuilt.step(y, 0.0, h);
+            assert_eq!(
+                kept.command().to_bits(),
+                rebuilt.command().to_bits(),
+                "k = {k}"
+            );
+            assert_eq!(track.command().to_bits(), track_rebuilt.command().to_bits());
+            assert_eq!(kept.controller(), rebuilt.controller());
+        }
     }
 
     #[test]

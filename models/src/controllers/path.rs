@@ -372,9 +372,19 @@ pub struct PathController {
 impl PathController {
     /// Designs the initial gains.
     pub fn new(params: PathControllerParams) -> Result<Self, ControlError> {
+        Self::new_with(params, path_gains)
+    }
+
+    /// [`PathController::new`] with the initial design's gains from `gains`, which must return
+    /// [`path_gains`] of the design it is given (e.g. kept in a [`crate::memo::Memo`] keyed on
+    /// [`PathDesignModel::key`]).
+    pub fn new_with(
+        params: PathControllerParams,
+        gains: impl FnOnce(&PathDesignModel) -> Result<PathGains, ControlError>,
+    ) -> Result<Self, ControlError> {
         params.validate()?;
         let coefficients = params.initial_coefficients();
-        let gains = path_gains(&PathDesignModel {
+        let gains = gains(&PathDesignModel {
             coefficients,
             ..params.design
         })?;

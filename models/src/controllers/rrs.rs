@@ -35,6 +35,7 @@
 use super::ControlError;
 use crate::error::{check_non_negative, check_positive, require};
 use crate::hull::rrs_ship::{RrsHullCoefficients, RrsSpeedLaws};
+use crate::memo::{bits, Bits, Memo};
 use crate::riccati;
 use nalgebra::{DMatrix, SMatrix, SVector};
 use serde::{Deserialize, Serialize};
@@ -247,6 +248,20 @@ impl Agc {
     /// Evaluates the AGC for the controller output `u` after a sample interval `dt` (no state
     /// change; [`Agc::commit`] stores it).
     pub fn evaluate(&self, u: f64, dt: f64) -> AgcOutput {
+        self.evaluate_with(u, dt, self.forget(dt))
+    }
+
+    /// The memory's forgetting factor e^(−dt/T_m) over `dt` (0 without memory).
+    pub fn forget(&self, dt: f64) -> f64 {
+        if self.memory_time > 0.0 {
+            (-dt / self.memory_time).exp()
+        } else {
+            0.0
+        }
+    }
+
+    /// [`Agc::evaluate`] with `forget` = [`Agc::forget`]`(dt)` given.
+    fn evaluate_with(&self, u: f64, dt: f64, forget: f64) -> AgcOutput {
         if !self.started || !(dt > 0.0) {
             return AgcOutput {
                 attenuation: 1.0,
@@ -256,11 +271,6 @@ impl Agc {
             };
         }
         let udot = ((u - self.prev_u) / dt).abs();
-        let forget = if self.memory_time > 0.0 {
-            (-dt / self.memory_time).exp()
-        } else {
-            0.0
-        };
         let memory = udot.max(self.memory * forget);
         let y = self.rate_max.max(udot).max(memory);
         let a = self.rate_max / y;
@@ -541,6 +551,45 @@ pub struct RrsAutopilot {
     /// set point seen downstream is exactly the sequence the AGC constrained). None before the
     /// first sample, when the outputs follow the inputs.
     held: Option<RrsOutputs>,
+    /// e^(−dt/T_m) of the AGC memory and e^(−h/T_σ) of the roll-variance filter for the last two
+    /// step lengths (derived, see [`crate::memo`]).
+    #[serde(skip)]
+    agc_forget: Memo<Bits<2>, f64, 2>,
+    #[serde(skip)]
+    variance_decay: Memo<Bits<2>, f64, 2>,
+    /// What the autopilot derives from the speed input, for the last speed (derived).
+    #[serde(skip)]
+    speed_terms: Memo<Bits<13>, SpeedTerms>,
+}
+
+/// The roll model (A, B) and the course gains at one speed.
+#[derive(Clone, Copy, Debug)]
+struct SpeedTerms {
+    roll_a: SMatrix<f64, 3, 3>,
+    roll_b: SVector<f64, 3>,
+    course: [f64; 3],
+}
+
+impl SpeedTerms {
+    fn at(p: &RrsAutopilotParams, speed: f64) -> Self {
+        let c = coefficients_at(p, speed);
+        let (roll_a, roll_b) = roll_model(&c);
+        SpeedTerms {
+            roll_a,
+            roll_b,
+            course: course_gains(c.tau_r, c.k_dr, p.lambda).unwrap_or([0.0; 3]),
+        }
+    }
+}
+
+/// The speed laws at `speed` (floored at `min_speed`; the floor for a non-finite speed).
+fn coefficients_at(p: &RrsAutopilotParams, speed: f64) -> RrsHullCoefficients {
+    let u = if speed.is_finite() {
+        speed.max(p.min_speed)
+    } else {
+        p.min_speed
+    };
+    p.laws.at(u)
 }
 
 impl RrsAutopilot {
@@ -560,6 +609,9 @@ impl RrsAutopilot {
             last_dt: 0.0,
             prev_command: None,
             held: None,
+            agc_forget: Memo::default(),
+            variance_decay: Memo::default(),
+            speed_terms: Memo::default(),
             params,
         })
     }
@@ -583,12 +635,16 @@ impl RrsAutopilot {
     }
 
     fn coefficients(&self, speed: f64) -> RrsHullCoefficients {
-        let u = if speed.is_finite() {
-            speed.max(self.params.min_speed)
-        } else {
-            self.params.min_speed
-        };
-        self.params.laws.at(u)
+        coefficients_at(&self.params, speed)
+    }
+
+    /// [`SpeedTerms::at`], kept for the last speed (and parameters).
+    fn kept_speed_terms(&mut self, speed: f64) -> SpeedTerms {
+        let p = self.params;
+        let mut key = Bits([0; 13]);
+        key.0[..3].copy_from_slice(&bits([speed, p.min_speed, p.lambda]).0);
+        key.0[3..].copy_from_slice(&p.laws.bits().0);
+        *self.speed_terms.get(key, || SpeedTerms::at(&p, speed))
     }
 
     /// Current roll gains (k1, k2, k3) at speed `speed`.
@@ -612,8 +668,20 @@ impl RrsAutopilot {
     }
 
     fn evaluate(&self, i: &RrsInputs) -> (RrsOutputs, f64, AgcOutput) {
+        let terms = SpeedTerms::at(&self.params, i.speed);
+        self.evaluate_with(i, self.agc.forget(self.last_dt), &terms)
+    }
+
+    /// [`RrsAutopilot::evaluate`] with the AGC's forgetting factor over the last step and the
+    /// terms at the input speed given.
+    fn evaluate_with(
+        &self,
+        i: &RrsInputs,
+        agc_forget: f64,
+        terms: &SpeedTerms,
+    ) -> (RrsOutputs, f64, AgcOutput) {
         let p = &self.params;
-        let k = self.roll_gains(i.speed);
+        let k = self.roll_process.gain(&terms.roll_b, p.r);
         let roll_fb = -(k[0] * i.roll + k[1] * i.roll_rate + k[2] * i.sway_rudder);
         let roll = match p.roll_mode {
             RollMode::Off => 0.0,
@@ -621,7 +689,7 @@ impl RrsAutopilot {
             RollMode::Forced => -roll_fb,
         };
         let course = if p.course_auto {
-            let kc = self.course_gains(i.speed);
+            let kc = terms.course;
             -(kc[0] * i.heading_error + kc[1] * i.yaw_rate + kc[2] * i.yaw_offset)
         } else {
             i.wheel
@@ -630,7 +698,7 @@ impl RrsAutopilot {
             AgcTarget::Total => roll + course,
             AgcTarget::RollOnly => roll,
         };
-        let mut agc = self.agc.evaluate(agc_in, self.last_dt);
+        let mut agc = self.agc.evaluate_with(agc_in, self.last_dt, agc_forget);
         if !p.agc_enabled {
             agc.attenuation = 1.0;
             agc.setpoint = agc_in;
@@ -678,14 +746,23 @@ impl RrsAutopilot {
         if !(h > 0.0) || !h.is_finite() {
             return;
         }
-        let (out, agc_in, agc) = self.evaluate(i);
+        let (dt, memory_time) = (self.last_dt, self.agc.memory_time);
+        let forget = *self
+            .agc_forget
+            .get(bits([dt, memory_time]), || self.agc.forget(dt));
+        let terms = self.kept_speed_terms(i.speed);
+        let (out, agc_in, agc) = self.evaluate_with(i, forget, &terms);
         self.agc.commit(agc_in, &agc);
         self.prev_command = Some(out.rudder_command);
         self.held = Some(out);
         self.last_dt = h;
-        let a = self.params.adaptation;
+        let a = &self.params.adaptation;
         // roll variance: first-order low-pass of φ² [Klugt1987, Fig. 6.10], exact for the held input
-        let f = (-h / a.roll_variance_time).exp();
+        let f = *self
+            .variance_decay
+            .get(bits([h, a.roll_variance_time]), || {
+                (-h / a.roll_variance_time).exp()
+            });
         self.roll_variance = f * self.roll_variance + (1.0 - f) * i.roll * i.roll;
         if a.enabled {
             // rule 2: required rudder rate (of the AGC input, before attenuation, peak-held by
@@ -701,7 +778,7 @@ impl RrsAutopilot {
             let hi = a.q_operator.min(a.q_max);
             self.q_phi = (self.q_phi + a.alpha * a.q_max * h * dq).clamp(0.0, hi);
         }
-        let (am, bm) = roll_model(&self.coefficients(i.speed));
+        let (am, bm) = (terms.roll_a, terms.roll_b);
         let q = SVector::<f64, 3>::from([self.q_phi, self.params.roll_q2, self.params.roll_q3]);
         // a step that is a multiple of max_substep up to rounding (0.1 vs 0.10000000000000002)
         // must not get an extra sub-step

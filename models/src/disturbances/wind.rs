@@ -194,13 +194,21 @@ impl Wind {
 
     /// [Klugt1987, eq. (2.19)]: c_wφ V_w² sin γ [N·m].
     pub fn roll_moment(&self) -> f64 {
-        let (v, g) = self.relative();
+        self.roll_moment_at(self.relative())
+    }
+
+    /// [`Wind::roll_moment`] for the relative wind `(V_w, γ)` of [`Wind::relative`].
+    pub fn roll_moment_at(&self, (v, g): (f64, f64)) -> f64 {
         self.params.roll_coefficient * v * v * g.sin()
     }
 
     /// [Klugt1987, eq. (2.20)]: c_wR V_w² sin 2γ [N·m].
     pub fn yaw_moment(&self) -> f64 {
-        let (v, g) = self.relative();
+        self.yaw_moment_at(self.relative())
+    }
+
+    /// [`Wind::yaw_moment`] for the relative wind `(V_w, γ)` of [`Wind::relative`].
+    pub fn yaw_moment_at(&self, (v, g): (f64, f64)) -> f64 {
         self.params.yaw_coefficient * v * v * (2.0 * g).sin()
     }
 }

@@ -48,6 +48,7 @@
 use super::{wrap_pi, KNOT};
 use crate::error::{check_finite, check_positive, ParamError};
 use crate::integrate::rk4_advance;
+use crate::memo::{bits, Bits, Memo};
 use nalgebra::{SMatrix, SVector};
 use serde::{Deserialize, Serialize};
 
@@ -221,6 +222,22 @@ impl RrsSpeedLaws {
         }
     }
 
+    /// The bits of the ten constants (a key for what is derived from them, see [`crate::memo`]).
+    pub fn bits(&self) -> Bits<10> {
+        bits([
+            self.k_dp0,
+            self.k_dv0,
+            self.k_dr0,
+            self.k_vp0,
+            self.t_v0,
+            self.z_n0,
+            self.z_n1,
+            self.k_vr0,
+            self.omega_n0,
+            self.t_r0,
+        ])
+    }
+
     /// The coefficients at speed `u` [m/s] ([Klugt1987, Table 2.3]; k_rv = k_rp = 0).
     pub fn at(&self, u: f64) -> RrsHullCoefficients {
         RrsHullCoefficients {
@@ -318,6 +335,49 @@ pub struct RrsShip {
     pub max_substep: f64,
     state: [f64; NX + 2],
     time: f64,
+    /// (A, B) of the last step's coefficients, kept while they do not change (derived, see
+    /// [`crate::memo`]).
+    #[serde(skip)]
+    system: Memo<SystemKey, (SMatrix<f64, NX, NX>, SMatrix<f64, NX, NU>)>,
+}
+
+/// What (A, B) depend on: the hull coefficients at the step's speed and the wave filters, as bits.
+type SystemKey = (Bits<11>, Option<Bits<11>>);
+
+impl RrsHullCoefficients {
+    fn bits(&self) -> Bits<11> {
+        bits([
+            self.k_dv,
+            self.tau_v,
+            self.k_rv,
+            self.k_dr,
+            self.tau_r,
+            self.k_vr,
+            self.k_dp,
+            self.omega_n,
+            self.z_n,
+            self.k_rp,
+            self.k_vp,
+        ])
+    }
+}
+
+impl RrsWaveCoefficients {
+    fn bits(&self) -> Bits<11> {
+        bits([
+            self.k_wv,
+            self.tau_wv,
+            self.z_wv,
+            self.omega_wv,
+            self.k_wr,
+            self.tau_wr,
+            self.z_wr,
+            self.omega_wr,
+            self.k_wp,
+            self.z_wp,
+            self.omega_wp,
+        ])
+    }
 }
 
 /// 22 kn in m/s (the simulation model's speed).
@@ -339,6 +399,7 @@ impl RrsShip {
             max_substep: 0.05,
             state: [0.0; NX + 2],
             time: 0.0,
+            system: Memo::default(),
         })
     }
 
@@ -388,61 +449,23 @@ impl RrsShip {
     /// c2]`, inputs `[δ, w_φ, w_ψ, w]`, at speed `u`. The wave-filter rows are zero (and
     /// decoupled) for the control model.
     pub fn linear_system(&self, u: f64) -> (SMatrix<f64, NX, NX>, SMatrix<f64, NX, NU>) {
-        let c = self.coefficients(u);
-        let mut a = SMatrix::<f64, NX, NX>::zeros();
-        let mut b = SMatrix::<f64, NX, NU>::zeros();
-        let wn2 = c.omega_n * c.omega_n;
-        // φ̇ = p
-        a[(0, 1)] = 1.0;
-        // ṗ
-        a[(1, 0)] = -wn2;
-        a[(1, 1)] = -2.0 * c.z_n * c.omega_n;
-        a[(1, 2)] = wn2 * c.k_vp;
-        a[(1, 3)] = wn2 * c.k_rp;
-        b[(1, 0)] = wn2 * c.k_dp;
-        b[(1, 1)] = wn2;
-        // v̇
-        a[(2, 2)] = -1.0 / c.tau_v;
-        a[(2, 3)] = c.k_rv / c.tau_v;
-        b[(2, 0)] = c.k_dv / c.tau_v;
-        // ṙ
-        a[(3, 2)] = c.k_vr / c.tau_r;
-        a[(3, 3)] = -1.0 / c.tau_r;
-        b[(3, 0)] = c.k_dr / c.tau_r;
-        b[(3, 2)] = 1.0 / c.tau_r;
-        // ψ̇ = r
-        a[(4, 3)] = 1.0;
-        if let RrsVariant::Simulation { waves: w, .. } = &self.variant {
-            // sway filter
-            a[(5, 6)] = 1.0;
-            a[(6, 5)] = -w.omega_wv * w.omega_wv;
-            a[(6, 6)] = -2.0 * w.z_wv * w.omega_wv;
-            b[(6, 3)] = 1.0;
-            let g = w.omega_wv * w.omega_wv * w.k_wv;
-            a[(2, 5)] = g / c.tau_v;
-            a[(2, 6)] = g * w.tau_wv / c.tau_v;
-            // yaw filter
-            a[(7, 8)] = 1.0;
-            a[(8, 7)] = -w.omega_wr * w.omega_wr;
-            a[(8, 8)] = -2.0 * w.z_wr * w.omega_wr;
-            b[(8, 3)] = 1.0;
-            let g = w.omega_wr * w.omega_wr * w.k_wr;
-            a[(3, 7)] = g / c.tau_r;
-            a[(3, 8)] = g * w.tau_wr / c.tau_r;
-            // roll filter
-            a[(9, 10)] = 1.0;
-            a[(10, 9)] = -w.omega_wp * w.omega_wp;
-            a[(10, 10)] = -2.0 * w.z_wp * w.omega_wp;
-            b[(10, 3)] = 1.0;
-            a[(1, 10)] = wn2 * w.omega_wp * w.omega_wp * w.k_wp;
+        system_of(&self.coefficients(u), self.wave_coefficients())
+    }
+
+    fn wave_coefficients(&self) -> Option<&RrsWaveCoefficients> {
+        match &self.variant {
+            RrsVariant::Simulation { waves, .. } => Some(waves),
+            RrsVariant::Control { .. } => None,
         }
-        (a, b)
     }
 
     /// Advances exactly `h` seconds (RK4, sub-step ≤ `max_substep`), inputs held.
     pub fn step(&mut self, inputs: &RrsShipInputs, h: f64) {
         let u = inputs.speed.max(self.min_speed);
-        let (a, b) = self.linear_system(u);
+        let c = self.coefficients(u);
+        let waves = self.wave_coefficients().copied();
+        let key = (c.bits(), waves.as_ref().map(RrsWaveCoefficients::bits));
+        let (a, b) = self.system.get(key, || system_of(&c, waves.as_ref()));
         let uin = SVector::<f64, NU>::new(
             inputs.rudder,
             inputs.roll_disturbance,
@@ -492,6 +515,62 @@ impl RrsShip {
             wave_roll: wp,
         }
     }
+}
+
+/// The linear system of [`RrsShip::linear_system`] for the coefficients `c` at one speed and the
+/// wave filters (simulation model) or none (control model).
+fn system_of(
+    c: &RrsHullCoefficients,
+    waves: Option<&RrsWaveCoefficients>,
+) -> (SMatrix<f64, NX, NX>, SMatrix<f64, NX, NU>) {
+    let mut a = SMatrix::<f64, NX, NX>::zeros();
+    let mut b = SMatrix::<f64, NX, NU>::zeros();
+    let wn2 = c.omega_n * c.omega_n;
+    // φ̇ = p
+    a[(0, 1)] = 1.0;
+    // ṗ
+    a[(1, 0)] = -wn2;
+    a[(1, 1)] = -2.0 * c.z_n * c.omega_n;
+    a[(1, 2)] = wn2 * c.k_vp;
+    a[(1, 3)] = wn2 * c.k_rp;
+    b[(1, 0)] = wn2 * c.k_dp;
+    b[(1, 1)] = wn2;
+    // v̇
+    a[(2, 2)] = -1.0 / c.tau_v;
+    a[(2, 3)] = c.k_rv / c.tau_v;
+    b[(2, 0)] = c.k_dv / c.tau_v;
+    // ṙ
+    a[(3, 2)] = c.k_vr / c.tau_r;
+    a[(3, 3)] = -1.0 / c.tau_r;
+    b[(3, 0)] = c.k_dr / c.tau_r;
+    b[(3, 2)] = 1.0 / c.tau_r;
+    // ψ̇ = r
+    a[(4, 3)] = 1.0;
+    if let Some(w) = waves {
+        // sway filter
+        a[(5, 6)] = 1.0;
+        a[(6, 5)] = -w.omega_wv * w.omega_wv;
+        a[(6, 6)] = -2.0 * w.z_wv * w.omega_wv;
+        b[(6, 3)] = 1.0;
+        let g = w.omega_wv * w.omega_wv * w.k_wv;
+        a[(2, 5)] = g / c.tau_v;
+        a[(2, 6)] = g * w.tau_wv / c.tau_v;
+        // yaw filter
+        a[(7, 8)] = 1.0;
+        a[(8, 7)] = -w.omega_wr * w.omega_wr;
+        a[(8, 8)] = -2.0 * w.z_wr * w.omega_wr;
+        b[(8, 3)] = 1.0;
+        let g = w.omega_wr * w.omega_wr * w.k_wr;
+        a[(3, 7)] = g / c.tau_r;
+        a[(3, 8)] = g * w.tau_wr / c.tau_r;
+        // roll filter
+        a[(9, 10)] = 1.0;
+        a[(10, 9)] = -w.omega_wp * w.omega_wp;
+        a[(10, 10)] = -2.0 * w.z_wp * w.omega_wp;
+        b[(10, 3)] = 1.0;
+        a[(1, 10)] = wn2 * w.omega_wp * w.omega_wp * w.k_wp;
+    }
+    (a, b)
 }
 
 #[cfg(test)]

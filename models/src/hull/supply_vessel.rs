@@ -25,6 +25,7 @@
 use super::wrap_pi;
 use crate::error::{check_finite, check_positive, require, ParamError};
 use crate::integrate::rk4_advance;
+use crate::memo::{bits, Bits, Memo};
 use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 
@@ -64,6 +65,9 @@ pub struct SupplyVessel {
     state: [f64; 6],
     wave_motion: [f64; 3],
     time: f64,
+    /// M⁻¹ of the last step's M (derived, see [`crate::memo`]).
+    #[serde(skip)]
+    m_inverse: Memo<Bits<9>, Matrix3<f64>>,
 }
 
 /// Northern Clipper M [Fossen1999, eq. (56)].
@@ -113,6 +117,7 @@ impl SupplyVessel {
             state: [0.0; 6],
             wave_motion: [0.0; 3],
             time: 0.0,
+            m_inverse: Memo::default(),
         })
     }
 
@@ -137,8 +142,13 @@ impl SupplyVessel {
 
     /// Advances exactly `h` seconds (RK4, sub-step ≤ `max_substep`), inputs held.
     pub fn step(&mut self, inputs: &SupplyVesselInputs, h: f64) {
-        let mm = Matrix3::from_fn(|i, j| self.m[i][j]);
-        let minv = mm.try_inverse().unwrap_or_else(Matrix3::zeros);
+        let m = self.m;
+        let key = bits(std::array::from_fn(|k| m[k / 3][k % 3]));
+        let minv = *self.m_inverse.get(key, || {
+            Matrix3::from_fn(|i, j| m[i][j])
+                .try_inverse()
+                .unwrap_or_else(Matrix3::zeros)
+        });
         let dd = Matrix3::from_fn(|i, j| self.d[i][j]);
         let tau = Vector3::from(inputs.tau);
         let b = Vector3::from(inputs.bias);

@@ -385,21 +385,75 @@ impl ParameterEkf {
 /// with the linear rudder): rows v̇′, ṙ′ hold −M⁻¹N in the (v′, r′) columns and
 /// −M⁻¹[:, 0]·(v′, r′), −M⁻¹[:, 1]·(v′, r′) in the (p₁, p₂), (p₃, p₄) columns.
 pub fn dynamics(x: &[f64], minv: &Matrix2<f64>, minv_b_delta: &Vector2<f64>) -> (Vector2<f64>, M8) {
+    let (nu_dot, rows) = dynamics_rows(x, minv, minv_b_delta);
+    (nu_dot, jacobian(&rows))
+}
+
+/// Rows 1 and 2 (v̇′, ṙ′) of the Jacobian, the only ones that are not +0.
+type JacobianRows = SMatrix<f64, 2, 8>;
+
+/// f(x̂) and the nonzero rows of F (see [`dynamics`]).
+fn dynamics_rows(
+    x: &[f64],
+    minv: &Matrix2<f64>,
+    minv_b_delta: &Vector2<f64>,
+) -> (Vector2<f64>, JacobianRows) {
     let (v, r) = (x[1], x[2]);
     let n = Matrix2::new(x[4], x[5], x[6], x[7]);
     let a = -minv * n;
     let nu_dot = a * Vector2::new(v, r) + minv_b_delta;
-    let mut f = M8::zeros();
+    let mut f = JacobianRows::zeros();
     for i in 0..2 {
         for j in 0..2 {
-            f[(1 + i, 1 + j)] = a[(i, j)];
+            f[(i, 1 + j)] = a[(i, j)];
         }
-        f[(1 + i, 4)] = -minv[(i, 0)] * v;
-        f[(1 + i, 5)] = -minv[(i, 0)] * r;
-        f[(1 + i, 6)] = -minv[(i, 1)] * v;
-        f[(1 + i, 7)] = -minv[(i, 1)] * r;
+        f[(i, 4)] = -minv[(i, 0)] * v;
+        f[(i, 5)] = -minv[(i, 0)] * r;
+        f[(i, 6)] = -minv[(i, 1)] * v;
+        f[(i, 7)] = -minv[(i, 1)] * r;
     }
     (nu_dot, f)
+}
+
+/// F from its nonzero rows (+0 elsewhere).
+fn jacobian(rows: &JacobianRows) -> M8 {
+    let mut f = M8::zeros();
+    f.fixed_rows_mut::<2>(1).copy_from(rows);
+    f
+}
+
+/// F P for the Jacobian F with nonzero rows `rows`, bit for bit equal to the dense product
+/// `F * P` without its 384 multiplications by +0.
+///
+/// nalgebra forms each element as the sum `F_i0 P_0j + F_i1 P_1j + …` in that order, and so
+/// are the elements of the two nonzero rows summed here. In every other row each term `+0 · P_kj` is a zero
+/// with the sign of `P_kj`, and a sum of zeros is −0 exactly when every term is −0: such an
+/// element is −0 when the whole column of P is negative-signed, else +0. A P with a non-finite
+/// element (0 · ∞ is NaN) takes the dense product.
+fn jacobian_times(rows: &JacobianRows, p: &M8) -> M8 {
+    const EXP: u64 = 0x7ff0_0000_0000_0000;
+    let f = &rows.data.0; // columns of the 2 × 8 rows
+    let mut non_finite = false;
+    let mut out = [[0.0; 8]; 8];
+    for (col, p_col) in out.iter_mut().zip(&p.data.0) {
+        let (mut s1, mut s2) = (f[0][0] * p_col[0], f[0][1] * p_col[0]);
+        for k in 1..8 {
+            s1 = f[k][0] * p_col[k] + s1;
+            s2 = f[k][1] * p_col[k] + s2;
+        }
+        let mut all_negative = !0u64;
+        for v in p_col {
+            let b = v.to_bits();
+            all_negative &= b;
+            non_finite |= b & EXP == EXP;
+        }
+        let zero = f64::from_bits(all_negative & (1 << 63));
+        *col = [zero, s1, s2, zero, zero, zero, zero, zero];
+    }
+    if non_finite {
+        return jacobian(rows) * p;
+    }
+    M8::from_data(nalgebra::ArrayStorage(out))
 }
 
 /// d/dt′ of [x̂, P]: f(x̂) and F P + P Fᵀ + Q.
@@ -410,9 +464,9 @@ fn derivative(
     qs: f64,
     qp: f64,
 ) -> [f64; NPROP] {
-    let (nu_dot, f) = dynamics(&y[..8], minv, bd);
+    let (nu_dot, rows) = dynamics_rows(&y[..8], minv, bd);
     let p = M8::from_column_slice(&y[8..]);
-    let fp = f * p;
+    let fp = jacobian_times(&rows, &p);
     let mut pd = fp + fp.transpose();
     for i in 0..4 {
         pd[(i, i)] += qs;
@@ -814,6 +868,58 @@ mod tests {
     }
 
     /// The analytic Jacobian (derived here) equals central finite differences of f.
+    /// `jacobian_times` equals nalgebra's `F * P` bit for bit: Jacobians of random states and
+    /// random P with signed zeros, negative-signed columns, tiny (underflowing) and huge
+    /// entries; P with ±∞ or NaN takes the dense product (NaN compared as NaN: payloads are
+    /// not specified).
+    #[test]
+    fn jacobian_times_equals_the_dense_product() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
+        let value = |rng: &mut rand_chacha::ChaCha8Rng, special: bool| -> f64 {
+            let sign = if rng.gen_bool(0.5) { -1.0 } else { 1.0 };
+            match rng.gen_range(0..if special { 8 } else { 6 }) {
+                0 => sign * 0.0,
+                1 => sign * 1e-300 * rng.gen::<f64>(),
+                2 => sign * 1e300 * rng.gen::<f64>(),
+                6 => sign * f64::INFINITY,
+                7 => f64::NAN,
+                _ => sign * rng.gen::<f64>(),
+            }
+        };
+        let minv = Matrix2::new(0.8, -0.1, 0.05, 1.3);
+        let mut checked = 0;
+        for case in 0..20_000 {
+            let x: Vec<f64> = (0..8).map(|_| value(&mut rng, false)).collect();
+            let (_, rows) = dynamics_rows(&x, &minv, &Vector2::new(0.01, -0.02));
+            let f = jacobian(&rows);
+            let full = dynamics(&x, &minv, &Vector2::new(0.01, -0.02)).1;
+            assert!(f
+                .iter()
+                .zip(full.iter())
+                .all(|(a, b)| a.to_bits() == b.to_bits()));
+            let special = rng.gen_bool(0.05);
+            let negative_columns = rng.gen_bool(0.3);
+            let p = M8::from_fn(|_, j| {
+                let v = value(&mut rng, special);
+                if negative_columns && j % 2 == 0 {
+                    -v.abs()
+                } else {
+                    v
+                }
+            });
+            let (want, got) = (f * p, jacobian_times(&rows, &p));
+            for (w, g) in want.iter().zip(got.iter()) {
+                assert!(
+                    w.to_bits() == g.to_bits() || (w.is_nan() && g.is_nan()),
+                    "case {case}: dense {w:e}, structured {g:e}"
+                );
+                checked += usize::from(*w == 0.0 && w.is_sign_negative());
+            }
+        }
+        assert!(checked > 1000, "too few −0 elements exercised: {checked}");
+    }
+
     #[test]
     fn jacobian_matches_finite_differences() {
         let (m, b, _, _) = esso();

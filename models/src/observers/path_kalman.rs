@@ -28,6 +28,9 @@ use crate::riccati::RiccatiError;
 use nalgebra::{SMatrix, SVector};
 use serde::{Deserialize, Serialize};
 
+/// The Kalman gain K (7×3; columns ψ′, r′, η′).
+pub type KalmanGain = SMatrix<f64, NX, NZ>;
+
 /// Parameters from which a [`PathDesignModel`] is built (the FMU's parameter set).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct PathKalmanConfig {
@@ -136,8 +139,13 @@ pub struct PathKalmanFilter {
 impl PathKalmanFilter {
     /// A filter for `design` with estimate `x0` (nondimensional, [ψ′, r′, β′, η′, δ′, N′, Y′]).
     pub fn new(design: PathDesignModel, x0: [f64; NX]) -> Result<Self, RiccatiError> {
-        let k = design.kalman_gain()?;
-        Ok(PathKalmanFilter {
+        Ok(Self::with_gain(design, x0, design.kalman_gain()?))
+    }
+
+    /// [`PathKalmanFilter::new`] with the gain `k = design.kalman_gain()` already solved (e.g.
+    /// kept in a [`crate::memo::Memo`] keyed on [`PathDesignModel::key`]).
+    pub fn with_gain(design: PathDesignModel, x0: [f64; NX], k: KalmanGain) -> Self {
+        PathKalmanFilter {
             f: design.f(false),
             g: design.g(),
             k,
@@ -147,7 +155,7 @@ impl PathKalmanFilter {
             x: SVector::from_row_slice(&x0),
             innovation: SVector::zeros(),
             innovation_ms: SVector::zeros(),
-        })
+        }
     }
 
     /// Gain-update event: new design model (e.g. new coefficient estimates); x̂′ carries over.

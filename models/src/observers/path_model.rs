@@ -29,6 +29,7 @@
 //! All quantities are nondimensional (t′ = tU/L, r′ = rL/U, η′ = η/L, angles in rad).
 
 use crate::hull::tokyo_maru::{TokyoMaruCoefficients, T_R};
+use crate::memo::{bits, Bits};
 use crate::riccati::{self, RiccatiError};
 use nalgebra::{DMatrix, SMatrix};
 use serde::{Deserialize, Serialize};
@@ -133,6 +134,23 @@ impl PathDesignModel {
         c.f23 = a.f23;
         c.f25 = a.f25;
         Self::new(c, DisturbanceModel::RandomWalk { epsilon: EPSILON })
+    }
+
+    /// The bits of every number of the design (a key for gains computed from it, see
+    /// [`crate::memo`]).
+    pub fn key(&self) -> Bits<22> {
+        let c = &self.coefficients;
+        let (kind, d1, d2) = match self.disturbance {
+            DisturbanceModel::ShapingFilter { t_n, t_y } => (0, t_n, t_y),
+            DisturbanceModel::RandomWalk { epsilon } => (1, epsilon, 0.0),
+        };
+        let mut k = bits([
+            c.f22, c.f23, c.f25, c.g21, c.g22, c.f32, c.f33, c.f35, c.g31, c.g32, self.t_r, d1, d2,
+            self.q[0], self.q[1], self.r[0], self.r[1], self.r[2], self.a44, self.a55, self.b11,
+            0.0,
+        ]);
+        k.0[21] = kind;
+        k
     }
 
     /// F_e [Parsons1980, eqs. (41), (59)]. `for_design`: with the random walk's −ε on the diagonal (gain design);
