@@ -195,15 +195,7 @@ impl FmuModel for CurrentFmu {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use fmi2_export::{Access, FmuDescription};
-
-    fn output(m: &CurrentFmu, name: &str) -> f64 {
-        let v = CurrentFmu::variables().iter().find(|v| v.name == name);
-        match v.map(|v| &v.access) {
-            Some(Access::Real { get, .. }) => get(m),
-            _ => panic!("no Real variable {name}"),
-        }
-    }
+    use fmi2_export::testing::real_of as output;
 
     /// With every disturbance on, the outputs read through the kept disturbance and bias equal
     /// the model's own functions bit for bit, after steps, input changes and parameter changes,
