@@ -35,6 +35,11 @@ pub struct ContainerShipFmu {
     initial_sway_velocity: f64,
     inputs: ContainerShipInputs,
     hull: Hull,
+    /// The model's outputs, computed once wherever the model changes (initialize, do_step,
+    /// calculate_outputs) instead of in every getter; `None` (after a deserialized restore)
+    /// means compute them. Not part of the state.
+    #[serde(skip)]
+    outputs: Option<ContainerShipOutputs>,
 }
 
 /// Start value of `rudder_command`: a small starboard rudder so that the default experiment turns.
@@ -60,6 +65,7 @@ impl Default for ContainerShipFmu {
                 ..Default::default()
             },
             hull: Hull::Nonlinear(ship),
+            outputs: None,
         }
     }
 }
@@ -75,11 +81,20 @@ fn param_error(e: ParamError) -> String {
 }
 
 impl ContainerShipFmu {
-    fn out(&self) -> ContainerShipOutputs {
+    fn model_outputs(&self) -> ContainerShipOutputs {
         match &self.hull {
             Hull::Nonlinear(s) => s.outputs(),
             Hull::Linear(s) => s.outputs(),
         }
+    }
+
+    fn out(&self) -> ContainerShipOutputs {
+        self.outputs.unwrap_or_else(|| self.model_outputs())
+    }
+
+    /// Keeps the outputs of the model as it is now (the getters read them).
+    fn keep_outputs(&mut self) {
+        self.outputs = Some(self.model_outputs());
     }
 
     /// Builds the hull from the parameters (exactly as `ContainerShip::new` /
@@ -199,11 +214,14 @@ fmi2_export::fmu! {
 
 impl FmuModel for ContainerShipFmu {
     fn initialize(&mut self, _start_time: f64) -> Result<(), String> {
+        self.outputs = None;
         self.hull = self.build()?;
+        self.keep_outputs();
         Ok(())
     }
 
     fn parameters_changed(&mut self) -> Result<(), String> {
+        self.outputs = None;
         self.params.validate().map_err(param_error)?;
         match &mut self.hull {
             Hull::Nonlinear(s) => s.params = self.params.clone(),
@@ -215,6 +233,10 @@ impl FmuModel for ContainerShipFmu {
         Ok(())
     }
 
+    fn calculate_outputs(&mut self) {
+        self.keep_outputs();
+    }
+
     fn do_step(&mut self, _t: f64, h: f64) -> Result<(), String> {
         match &mut self.hull {
             Hull::Nonlinear(s) => s.step(&self.inputs, h),
@@ -224,6 +246,7 @@ impl FmuModel for ContainerShipFmu {
                 s.step(&LinearContainerShipInputs { rudder_command }, h)
             }
         }
+        self.keep_outputs();
         Ok(())
     }
 }

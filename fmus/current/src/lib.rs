@@ -5,6 +5,7 @@
 use fmi2_export::FmuModel;
 use models::disturbances::current::{Current, CurrentParams};
 use serde::{Deserialize, Serialize};
+use std::cell::Cell;
 
 /// Parameters, input and state of one instance.
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -12,6 +13,38 @@ pub struct CurrentFmu {
     params: CurrentParams,
     heading: f64,
     model: Current,
+    /// `model.disturbance()` and `model.bias()`, computed by the first getter that needs them
+    /// after the model changed (each of N', Y', N, Y, and of the five bias outputs, needs all
+    /// of one); reset wherever the model changes. Not part of the state.
+    #[serde(skip)]
+    disturbance: Cell<Option<[f64; 2]>>,
+    #[serde(skip)]
+    bias: Cell<Option<[f64; 3]>>,
+}
+
+/// The value in `cell`, computed by `compute` if empty.
+fn kept<T: Copy>(cell: &Cell<Option<T>>, compute: impl FnOnce() -> T) -> T {
+    cell.get().unwrap_or_else(|| {
+        let v = compute();
+        cell.set(Some(v));
+        v
+    })
+}
+
+impl CurrentFmu {
+    fn disturbance(&self) -> [f64; 2] {
+        kept(&self.disturbance, || self.model.disturbance())
+    }
+
+    fn bias(&self) -> [f64; 3] {
+        kept(&self.bias, || self.model.bias())
+    }
+
+    /// Forgets the kept values (the model is about to change).
+    fn forget(&mut self) {
+        self.disturbance.set(None);
+        self.bias.set(None);
+    }
 }
 
 impl Default for CurrentFmu {
@@ -21,6 +54,8 @@ impl Default for CurrentFmu {
             model: Current::new(params.clone(), 0.0).expect("preset parameters are valid"),
             params,
             heading: 0.0,
+            disturbance: Cell::new(None),
+            bias: Cell::new(None),
         }
     }
 }
@@ -104,20 +139,20 @@ fmi2_export::fmu! {
             "Current velocity along the ship, V cos(direction - heading)";
         output real "current_sway" ["m/s"] (|m| m.model.current_body()[1]),
             "Current velocity to starboard, V sin(direction - heading)";
-        output real "n_prime" (|m| m.model.disturbance()[0]),
+        output real "n_prime" (|m| m.disturbance()[0]),
             "Total 004 nondimensional yaw moment N'";
-        output real "y_prime" (|m| m.model.disturbance()[1]),
+        output real "y_prime" (|m| m.disturbance()[1]),
             "Total 004 nondimensional side force Y'";
-        output real "yaw_moment" ["N.m"] (|m| m.model.disturbance_dimensional()[0]),
+        output real "yaw_moment" ["N.m"] (|m| m.model.dimensional(m.disturbance())[0]),
             "N = N' rho L^3 U^2/2";
-        output real "side_force" ["N"] (|m| m.model.disturbance_dimensional()[1]),
+        output real "side_force" ["N"] (|m| m.model.dimensional(m.disturbance())[1]),
             "Y = Y' rho L^2 U^2/2";
-        output real "bias_x" ["N"] (|m| m.model.bias()[0]), "001 earth-fixed bias force, x";
-        output real "bias_y" ["N"] (|m| m.model.bias()[1]), "001 earth-fixed bias force, y";
-        output real "bias_n" ["N.m"] (|m| m.model.bias()[2]), "001 bias yaw moment";
-        output real "bias_surge" ["N"] (|m| m.model.bias_body()[0]),
+        output real "bias_x" ["N"] (|m| m.bias()[0]), "001 earth-fixed bias force, x";
+        output real "bias_y" ["N"] (|m| m.bias()[1]), "001 earth-fixed bias force, y";
+        output real "bias_n" ["N.m"] (|m| m.bias()[2]), "001 bias yaw moment";
+        output real "bias_surge" ["N"] (|m| m.model.body(m.bias())[0]),
             "001 bias in the body frame, J(psi)^T b, surge";
-        output real "bias_sway" ["N"] (|m| m.model.bias_body()[1]),
+        output real "bias_sway" ["N"] (|m| m.model.body(m.bias())[1]),
             "001 bias in the body frame, sway";
         output real "nondimensional_time" (|m| m.model.nondimensional_time()),
             "t' = (t - t0) U/L in ship lengths";
@@ -126,12 +161,14 @@ fmi2_export::fmu! {
 
 impl FmuModel for CurrentFmu {
     fn initialize(&mut self, start_time: f64) -> Result<(), String> {
+        self.forget();
         self.model = Current::new(self.params.clone(), start_time)?;
         self.model.set_heading(self.heading);
         Ok(())
     }
 
     fn parameters_changed(&mut self) -> Result<(), String> {
+        self.forget();
         let p = &self.params;
         self.model.set_current_profile(
             p.speed_initial,
@@ -143,12 +180,78 @@ impl FmuModel for CurrentFmu {
     }
 
     fn calculate_outputs(&mut self) {
+        self.forget();
         self.model.set_heading(self.heading);
     }
 
     fn do_step(&mut self, t: f64, h: f64) -> Result<(), String> {
+        self.forget();
         self.model.set_heading(self.heading);
         self.model.advance_to(t + h);
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use fmi2_export::testing::real_of as output;
+
+    /// With every disturbance on, the outputs read through the kept disturbance and bias equal
+    /// the model's own functions bit for bit, after steps, input changes and parameter changes,
+    /// and so do they when nothing is kept (a deserialized state).
+    #[test]
+    fn outputs_from_the_kept_values_equal_the_model() {
+        let mut m = CurrentFmu::default();
+        let p = &mut m.params;
+        p.design_current = true;
+        p.passing_factor = 1.0;
+        p.white_sigma = [2e-5, 5e-5];
+        p.shaping_sigma = [8.798e-5, 21.178e-5];
+        p.walk_q = [2e-8, 1.25e-7];
+        p.bias_psi = [1e3, 2e3, 3e4];
+        p.bias_initial = [1e4, -2e4, 5e5];
+        m.initialize(0.0).unwrap();
+        let check = |m: &CurrentFmu| {
+            let c = &m.model;
+            let (d, dd, b, bb) = (
+                c.disturbance(),
+                c.disturbance_dimensional(),
+                c.bias(),
+                c.bias_body(),
+            );
+            for (name, want) in [
+                ("n_prime", d[0]),
+                ("y_prime", d[1]),
+                ("yaw_moment", dd[0]),
+                ("side_force", dd[1]),
+                ("bias_x", b[0]),
+                ("bias_y", b[1]),
+                ("bias_n", b[2]),
+                ("bias_surge", bb[0]),
+                ("bias_sway", bb[1]),
+            ] {
+                assert_eq!(output(m, name).to_bits(), want.to_bits(), "{name}");
+            }
+        };
+        check(&m);
+        let mut nonzero = 0;
+        for k in 0..400 {
+            m.heading = 0.01 * k as f64;
+            m.calculate_outputs();
+            check(&m);
+            m.do_step(0.5 * k as f64, 0.5).unwrap();
+            check(&m);
+            nonzero += usize::from(output(&m, "n_prime") != 0.0 && output(&m, "bias_sway") != 0.0);
+            if k == 200 {
+                m.params.speed_final = 1.0;
+                m.parameters_changed().unwrap();
+                check(&m);
+            }
+            let mut restored = m.clone();
+            restored.forget();
+            check(&restored);
+        }
+        assert!(nonzero > 300);
     }
 }

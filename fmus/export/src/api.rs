@@ -136,7 +136,9 @@ pub unsafe fn instantiate<M: FmuModel>(
                 M::MODEL_IDENTIFIER
             ));
         }
-        let expected = crate::xml::guid_str::<M>();
+        // The start values, built once for the instance and, on the first call, the GUID.
+        let model = M::default();
+        let expected = crate::xml::guid_str_with(&model);
         if guid.is_null() {
             return fail("fmi2Instantiate: missing GUID");
         }
@@ -149,6 +151,7 @@ pub unsafe fn instantiate<M: FmuModel>(
             ));
         }
         let inst = Instance::<M>::new(
+            model,
             name_c.clone(),
             logger,
             env,

@@ -111,7 +111,9 @@ pub fn fnv1a(bytes: &[u8]) -> u64 {
 }
 
 impl<M: FmuModel> Instance<M> {
+    /// An instance of `model` (the start values, `M::default()`).
     pub fn new(
+        model: M,
         name: CString,
         logger: fmi2CallbackLogger,
         env: fmi2ComponentEnvironment,
@@ -122,7 +124,7 @@ impl<M: FmuModel> Instance<M> {
         enabled[CAT_EVENTS] = logging_on;
         enabled[CAT_CALLS] = logging_on;
         Instance {
-            model: M::default(),
+            model,
             core: Core {
                 state: LifeState::Instantiated,
                 time: 0.0,

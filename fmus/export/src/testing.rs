@@ -521,6 +521,19 @@ pub fn declared<M: FmuModel>() -> Vec<Declared> {
 }
 
 /// The layer's rules for the table of `M` (see [`check_table`]), with the problems listed.
+/// The Real variable `name` of a model value, read through its table getter (without the C API:
+/// for unit tests of an FMU type's own methods).
+pub fn real_of<M: FmuModel>(model: &M, name: &str) -> f64 {
+    match M::variables()
+        .iter()
+        .find(|v| v.name == name)
+        .map(|v| &v.access)
+    {
+        Some(Access::Real { get, .. }) => get(model),
+        _ => panic!("{}: no Real variable {name:?}", M::MODEL_IDENTIFIER),
+    }
+}
+
 pub fn check_variable_table<M: FmuModel>() {
     if let Err(problems) = check_table(M::variables()) {
         panic!("{}: {}", M::MODEL_IDENTIFIER, problems.join("; "));

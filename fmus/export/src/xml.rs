@@ -30,8 +30,12 @@ const GUID_PLACEHOLDER: &str = "@GUID@";
 
 /// The model description with the GUID placeholder (the GUID is a hash of this text).
 fn description_template<M: FmuModel>() -> String {
+    description_template_of(&M::default())
+}
+
+/// [`description_template`] with the start values read from `default` (= `M::default()`).
+fn description_template_of<M: FmuModel>(default: &M) -> String {
     let vars = M::variables();
-    let default = M::default();
     let mut x = String::new();
     let _ = writeln!(x, r#"<?xml version="1.0" encoding="UTF-8"?>"#);
     let _ = writeln!(
@@ -132,7 +136,7 @@ fn description_template<M: FmuModel>() -> String {
                     let _ = write!(x, r#" max="{}""#, real(*m));
                 }
                 if v.has_start() {
-                    let _ = write!(x, r#" start="{}""#, real(get(&default)));
+                    let _ = write!(x, r#" start="{}""#, real(get(default)));
                 }
             }
             Access::Integer { get, min, max, .. } => {
@@ -144,13 +148,13 @@ fn description_template<M: FmuModel>() -> String {
                     let _ = write!(x, r#" max="{m}""#);
                 }
                 if v.has_start() {
-                    let _ = write!(x, r#" start="{}""#, get(&default));
+                    let _ = write!(x, r#" start="{}""#, get(default));
                 }
             }
             Access::Boolean { get, .. } => {
                 x.push_str("<Boolean");
                 if v.has_start() {
-                    let _ = write!(x, r#" start="{}""#, get(&default));
+                    let _ = write!(x, r#" start="{}""#, get(default));
                 }
             }
         }
@@ -222,11 +226,18 @@ pub fn guid<M: FmuModel>() -> String {
 /// [`guid`], computed once per process (it is a constant of the binary; `fmi2Instantiate` checks
 /// it, and building the description runs `M::default()` and formats every variable).
 pub fn guid_str<M: FmuModel>() -> &'static str {
-    M::guid_cell().get_or_init(|| {
-        let text = description_template::<M>();
-        let id = uuid::Uuid::new_v5(&uuid::Uuid::NAMESPACE_URL, text.as_bytes());
-        format!("{{{id}}}")
-    })
+    M::guid_cell().get_or_init(|| guid_of(&description_template::<M>()))
+}
+
+/// [`guid_str`], reading the start values from `default` (= `M::default()`, which the first
+/// `fmi2Instantiate` builds for its instance anyway) if it has not been computed yet.
+pub(crate) fn guid_str_with<M: FmuModel>(default: &M) -> &'static str {
+    M::guid_cell().get_or_init(|| guid_of(&description_template_of(default)))
+}
+
+fn guid_of(template: &str) -> String {
+    let id = uuid::Uuid::new_v5(&uuid::Uuid::NAMESPACE_URL, template.as_bytes());
+    format!("{{{id}}}")
 }
 
 /// The complete `modelDescription.xml`.

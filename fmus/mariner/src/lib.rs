@@ -18,6 +18,11 @@ pub struct MarinerFmu {
     trim: f64,
     inputs: MarinerInputs,
     ship: Mariner,
+    /// The model's outputs, computed once wherever the model changes (initialize, do_step,
+    /// calculate_outputs) instead of in every getter; `None` (after a deserialized restore)
+    /// means compute them. Not part of the state.
+    #[serde(skip)]
+    outputs: Option<MarinerOutputs>,
 }
 
 /// Start value of `rudder_command`: a small starboard rudder so that the default experiment turns.
@@ -33,6 +38,7 @@ impl Default for MarinerFmu {
                 rudder_command: DEFAULT_RUDDER_COMMAND,
             },
             ship: Mariner::trimmed(U0_DEFAULT).expect("valid preset"),
+            outputs: None,
         }
     }
 }
@@ -43,8 +49,17 @@ fn param_error(e: ParamError) -> String {
 }
 
 impl MarinerFmu {
-    fn out(&self) -> MarinerOutputs {
+    fn model_outputs(&self) -> MarinerOutputs {
         self.ship.outputs()
+    }
+
+    fn out(&self) -> MarinerOutputs {
+        self.outputs.unwrap_or_else(|| self.model_outputs())
+    }
+
+    /// Keeps the outputs of the model as it is now (the getters read them).
+    fn keep_outputs(&mut self) {
+        self.outputs = Some(self.model_outputs());
     }
 }
 
@@ -94,6 +109,7 @@ fmi2_export::fmu! {
 
 impl FmuModel for MarinerFmu {
     fn initialize(&mut self, _start_time: f64) -> Result<(), String> {
+        self.outputs = None;
         self.params.validate().map_err(param_error)?;
         let mut ship = if self.trimmed {
             Mariner::trimmed(self.params.u0).map_err(param_error)?
@@ -103,17 +119,24 @@ impl FmuModel for MarinerFmu {
         ship.params = self.params.clone();
         self.trim = Mariner::trim_input(self.params.u0);
         self.ship = ship;
+        self.keep_outputs();
         Ok(())
     }
 
     fn parameters_changed(&mut self) -> Result<(), String> {
+        self.outputs = None;
         self.params.validate().map_err(param_error)?;
         self.ship.params = self.params.clone();
         Ok(())
     }
 
+    fn calculate_outputs(&mut self) {
+        self.keep_outputs();
+    }
+
     fn do_step(&mut self, _t: f64, h: f64) -> Result<(), String> {
         self.ship.step(&self.inputs, h);
+        self.keep_outputs();
         Ok(())
     }
 }

@@ -26,6 +26,11 @@ pub struct NomotoShipFmu {
     max_substep: f64,
     inputs: NomotoInputs,
     ship: NomotoShip,
+    /// The model's outputs, computed once wherever the model changes (initialize, do_step,
+    /// calculate_outputs) instead of in every getter; `None` (after a deserialized restore)
+    /// means compute them. Not part of the state.
+    #[serde(skip)]
+    outputs: Option<NomotoOutputs>,
 }
 
 /// Start value of `rudder_angle`: a small starboard rudder so that the default experiment turns.
@@ -57,6 +62,7 @@ impl Default for NomotoShipFmu {
                 ..Default::default()
             },
             ship: ddg,
+            outputs: None,
         }
     }
 }
@@ -67,8 +73,17 @@ fn param_error(e: ParamError) -> String {
 }
 
 impl NomotoShipFmu {
-    fn out(&self) -> NomotoOutputs {
+    fn model_outputs(&self) -> NomotoOutputs {
         self.ship.outputs()
+    }
+
+    fn out(&self) -> NomotoOutputs {
+        self.outputs.unwrap_or_else(|| self.model_outputs())
+    }
+
+    /// Keeps the outputs of the model as it is now (the getters read them).
+    fn keep_outputs(&mut self) {
+        self.outputs = Some(self.model_outputs());
     }
 
     /// Builds the ship from the parameters (the preset gives length and speed when they are 0).
@@ -176,12 +191,19 @@ fmi2_export::fmu! {
 
 impl FmuModel for NomotoShipFmu {
     fn initialize(&mut self, _start_time: f64) -> Result<(), String> {
+        self.outputs = None;
         self.ship = self.build()?;
+        self.keep_outputs();
         Ok(())
+    }
+
+    fn calculate_outputs(&mut self) {
+        self.keep_outputs();
     }
 
     fn do_step(&mut self, _t: f64, h: f64) -> Result<(), String> {
         self.ship.step(&self.inputs, h);
+        self.keep_outputs();
         Ok(())
     }
 }

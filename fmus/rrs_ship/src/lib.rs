@@ -22,6 +22,11 @@ pub struct RrsShipFmu {
     wind_roll: f64,
     wind_yaw: f64,
     ship: RrsShip,
+    /// The model's outputs, computed once wherever the model changes (initialize, do_step,
+    /// calculate_outputs) instead of in every getter; `None` (after a deserialized restore)
+    /// means compute them. Not part of the state.
+    #[serde(skip)]
+    outputs: Option<RrsShipOutputs>,
 }
 
 /// Start value of `rudder_angle`: a small rudder so that the default experiment turns and rolls.
@@ -42,13 +47,23 @@ impl Default for RrsShipFmu {
             wind_roll: 0.0,
             wind_yaw: 0.0,
             ship,
+            outputs: None,
         }
     }
 }
 
 impl RrsShipFmu {
-    fn out(&self) -> RrsShipOutputs {
+    fn model_outputs(&self) -> RrsShipOutputs {
         self.ship.outputs()
+    }
+
+    fn out(&self) -> RrsShipOutputs {
+        self.outputs.unwrap_or_else(|| self.model_outputs())
+    }
+
+    /// Keeps the outputs of the model as it is now (the getters read them).
+    fn keep_outputs(&mut self) {
+        self.outputs = Some(self.model_outputs());
     }
 
     fn check(&self) -> Result<(), String> {
@@ -119,6 +134,7 @@ fmi2_export::fmu! {
 
 impl FmuModel for RrsShipFmu {
     fn initialize(&mut self, _start_time: f64) -> Result<(), String> {
+        self.outputs = None;
         self.check()?;
         let mut ship = match self.model {
             1 => RrsShip::simulation_22kn(),
@@ -129,13 +145,19 @@ impl FmuModel for RrsShipFmu {
         ship.min_speed = self.min_speed;
         ship.max_substep = self.max_substep;
         self.ship = ship;
+        self.keep_outputs();
         Ok(())
     }
 
     fn parameters_changed(&mut self) -> Result<(), String> {
+        self.outputs = None;
         self.check()?;
         self.ship.min_speed = self.min_speed;
         Ok(())
+    }
+
+    fn calculate_outputs(&mut self) {
+        self.keep_outputs();
     }
 
     fn do_step(&mut self, _t: f64, h: f64) -> Result<(), String> {
@@ -143,6 +165,7 @@ impl FmuModel for RrsShipFmu {
         inputs.roll_disturbance += self.wind_roll;
         inputs.yaw_disturbance += self.wind_yaw;
         self.ship.step(&inputs, h);
+        self.keep_outputs();
         Ok(())
     }
 }

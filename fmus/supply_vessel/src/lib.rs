@@ -17,6 +17,11 @@ pub struct SupplyVesselFmu {
     max_substep: f64,
     inputs: SupplyVesselInputs,
     vessel: SupplyVessel,
+    /// The model's outputs, computed once wherever the model changes (initialize, do_step,
+    /// calculate_outputs) instead of in every getter; `None` (after a deserialized restore)
+    /// means compute them. Not part of the state.
+    #[serde(skip)]
+    outputs: Option<SupplyVesselOutputs>,
 }
 
 /// Start value of `surge_force` [N]: a small thrust so that the default experiment moves
@@ -35,13 +40,23 @@ impl Default for SupplyVesselFmu {
                 ..Default::default()
             },
             vessel,
+            outputs: None,
         }
     }
 }
 
 impl SupplyVesselFmu {
-    fn out(&self) -> SupplyVesselOutputs {
+    fn model_outputs(&self) -> SupplyVesselOutputs {
         self.vessel.outputs()
+    }
+
+    fn out(&self) -> SupplyVesselOutputs {
+        self.outputs.unwrap_or_else(|| self.model_outputs())
+    }
+
+    /// Keeps the outputs of the model as it is now (the getters read them).
+    fn keep_outputs(&mut self) {
+        self.outputs = Some(self.model_outputs());
     }
 }
 
@@ -130,15 +145,22 @@ fmi2_export::fmu! {
 
 impl FmuModel for SupplyVesselFmu {
     fn initialize(&mut self, _start_time: f64) -> Result<(), String> {
+        self.outputs = None;
         let mut vessel = SupplyVessel::new(self.mass, self.damping).map_err(|e| e.to_string())?;
         check_positive("max_substep", self.max_substep)?;
         vessel.max_substep = self.max_substep;
         self.vessel = vessel;
+        self.keep_outputs();
         Ok(())
+    }
+
+    fn calculate_outputs(&mut self) {
+        self.keep_outputs();
     }
 
     fn do_step(&mut self, _t: f64, h: f64) -> Result<(), String> {
         self.vessel.step(&self.inputs, h);
+        self.keep_outputs();
         Ok(())
     }
 }

@@ -26,6 +26,11 @@ pub struct TokyoMaruFmu {
     sway_force_prime: f64,
     current_lateral: f64,
     ship: TokyoMaru,
+    /// The model's outputs, computed once wherever the model changes (initialize, do_step,
+    /// calculate_outputs) instead of in every getter; `None` (after a deserialized restore)
+    /// means compute them. Not part of the state.
+    #[serde(skip)]
+    outputs: Option<TokyoMaruOutputs>,
 }
 
 /// Start value of the rudder inputs: a small rudder so that the default experiment turns.
@@ -46,6 +51,7 @@ impl Default for TokyoMaruFmu {
             sway_force_prime: 0.0,
             current_lateral: 0.0,
             ship: TokyoMaru::design_depth(),
+            outputs: None,
         }
     }
 }
@@ -60,8 +66,17 @@ fn param_error(e: ParamError) -> String {
 }
 
 impl TokyoMaruFmu {
-    fn out(&self) -> TokyoMaruOutputs {
+    fn model_outputs(&self) -> TokyoMaruOutputs {
         self.ship.outputs()
+    }
+
+    fn out(&self) -> TokyoMaruOutputs {
+        self.outputs.unwrap_or_else(|| self.model_outputs())
+    }
+
+    /// Keeps the outputs of the model as it is now (the getters read them).
+    fn keep_outputs(&mut self) {
+        self.outputs = Some(self.model_outputs());
     }
 
     /// The model's inputs: the rudder input in use depends on `internal_steering_gear`.
@@ -156,6 +171,7 @@ fmi2_export::fmu! {
 
 impl FmuModel for TokyoMaruFmu {
     fn initialize(&mut self, _start_time: f64) -> Result<(), String> {
+        self.outputs = None;
         let mut ship = TokyoMaru::new(1.89).map_err(param_error)?;
         self.apply_tunables(&mut ship)?;
         ship.internal_steering_gear = self.internal_steering_gear;
@@ -168,19 +184,26 @@ impl FmuModel for TokyoMaruFmu {
         };
         ship.validate().map_err(param_error)?;
         self.ship = ship;
+        self.keep_outputs();
         Ok(())
     }
 
     fn parameters_changed(&mut self) -> Result<(), String> {
+        self.outputs = None;
         let mut ship = self.ship.clone();
         self.apply_tunables(&mut ship)?;
         self.ship = ship;
         Ok(())
     }
 
+    fn calculate_outputs(&mut self) {
+        self.keep_outputs();
+    }
+
     fn do_step(&mut self, _t: f64, h: f64) -> Result<(), String> {
         let inputs = self.model_inputs();
         self.ship.step(&inputs, h);
+        self.keep_outputs();
         Ok(())
     }
 }

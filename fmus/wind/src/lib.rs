@@ -124,15 +124,7 @@ impl FmuModel for WindFmu {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use fmi2_export::{Access, FmuDescription};
-
-    fn output(m: &WindFmu, name: &str) -> f64 {
-        let v = WindFmu::variables().iter().find(|v| v.name == name);
-        match v.map(|v| &v.access) {
-            Some(Access::Real { get, .. }) => get(m),
-            _ => panic!("no Real variable {name}"),
-        }
-    }
+    use fmi2_export::testing::real_of as output;
 
     /// The outputs read from the relative wind kept at each change equal the model's own
     /// functions bit for bit, and so do they when nothing is kept (a deserialized state).

@@ -409,9 +409,13 @@ impl Current {
 
     /// Dimensional yaw moment N [N·m] and side force Y [N]: N′ ½ρL³U², Y′ ½ρL²U².
     pub fn disturbance_dimensional(&self) -> [f64; 2] {
+        self.dimensional(self.disturbance())
+    }
+
+    /// [`Current::disturbance_dimensional`] of a [`Current::disturbance`] `[n, y]`.
+    pub fn dimensional(&self, [n, y]: [f64; 2]) -> [f64; 2] {
         let p = &self.params;
         let q = 0.5 * p.density * p.ship_length * p.ship_length * p.ship_speed * p.ship_speed;
-        let [n, y] = self.disturbance();
         [n * q * p.ship_length, y * q]
     }
 
@@ -422,7 +426,11 @@ impl Current {
 
     /// Bias [Fossen1999, eq. (7)] in the body frame, Jᵀ(ψ) b.
     pub fn bias_body(&self) -> [f64; 3] {
-        let b = self.bias();
+        self.body(self.bias())
+    }
+
+    /// [`Current::bias_body`] of a [`Current::bias`] `b`.
+    pub fn body(&self, b: [f64; 3]) -> [f64; 3] {
         let (s, c) = self.heading.sin_cos();
         [c * b[0] + s * b[1], -s * b[0] + c * b[1], b[2]]
     }

@@ -437,6 +437,8 @@ fn jacobian_times(rows: &JacobianRows, p: &M8) -> M8 {
     let mut out = [[0.0; 8]; 8];
     for (col, p_col) in out.iter_mut().zip(&p.data.0) {
         let (mut s1, mut s2) = (f[0][0] * p_col[0], f[0][1] * p_col[0]);
+        // `term + sum`, nalgebra's operand order
+        #[allow(clippy::assign_op_pattern)]
         for k in 1..8 {
             s1 = f[k][0] * p_col[k] + s1;
             s2 = f[k][1] * p_col[k] + s2;
