@@ -15,12 +15,11 @@ over; every figure is the median over the runs of its set:
 
 See master/src/run/profile.rs for the method.
 
-The pure-Rust model loop of the RRS system (the `rrs-model-loop` binary of system-tests, if it
-is built: --model-loop, $SHIPSIM_MODEL_LOOP_BIN or target/release/rrs-model-loop) runs
---repeat times as well, pinned alike; it prints one JSON line
-{"stop_time": ..., "macro_steps": ..., "wall_s": ...} for its step loop. The section gives
-the ratio of the FMU system's step-loop time (default profile runs) to the model loop's, per
-macro step (the median of each).
+The pure-Rust model loop of the RRS system (the `rrs-model-loop` binary of system-tests:
+--model-loop, $SHIPSIM_MODEL_LOOP_BIN or target/release/rrs-model-loop; it prints one JSON line
+{"stop_time": ..., "macro_steps": ..., "wall_s": ...} for its step loop) runs in pairs with the
+FMU system, pinned alike, back to back; the section gives the median of the pairs' ratios of
+step-loop time per macro step.
 
 Prints a Markdown section on stdout (cargo xtask bench writes it into docs/bench.md).
 
@@ -81,11 +80,12 @@ def summarize(runs, every_step):
 
 
 def model_loop_bin(arg):
-    for p in [arg, os.environ.get("SHIPSIM_MODEL_LOOP_BIN"),
-              ROOT / "target/release/rrs-model-loop", ROOT / "target/release/rrs_model_loop"]:
-        if p and pathlib.Path(p).is_file():
-            return pathlib.Path(p)
-    return None
+    """The rrs-model-loop binary: --model-loop, $SHIPSIM_MODEL_LOOP_BIN or the release build."""
+    exe = pathlib.Path(arg or os.environ.get("SHIPSIM_MODEL_LOOP_BIN")
+                       or ROOT / "target/release/rrs-model-loop")
+    if not exe.is_file():
+        raise SystemExit(f"{exe} not found: cargo build --release -p system-tests --bin rrs-model-loop")
+    return exe
 
 
 def run_model_loop(exe, pin):
@@ -101,9 +101,6 @@ def model_loop_section(exe, shipsim, pin, repeat):
     pairs, back to back, so that a slow phase of a shared machine hits both; the ratio is the
     median of the pairs' ratios, and the per-pair ratios are listed."""
     out = ["", "### RRS: FMU system against the pure-Rust model loop", ""]
-    if exe is None:
-        out.append("Not measured: the `rrs-model-loop` binary of system-tests is not built.")
-        return out
     system = ROOT / "systems/rrs.toml"
     pairs = []
     for _ in range(repeat):
@@ -163,8 +160,8 @@ def main():
               f"| {r['master_share']:.1f} % |")
     print("\nProfile cost: the profile's own clock reads (their number times the measured cost of "
           "one) as a share of the step loop.")
-    exe = model_loop_bin(a.model_loop)
     if a.only is None or "rrs" in a.only:
+        exe = model_loop_bin(a.model_loop)
         print("\n".join(model_loop_section(exe, a.shipsim, pin, max(a.repeat, 9))))
 
 

@@ -181,14 +181,14 @@ fn report(dir: Option<&str>) -> Result<()> {
 
 /// Builds the release `report` binary of system-tests.
 pub fn build_report(root: &Path) -> Result<()> {
-    run(cargo().current_dir(root).args([
-        "build",
-        "--release",
-        "-p",
-        "system-tests",
-        "--bin",
-        "report",
-    ]))
+    build_tests_bin(root, "report")
+}
+
+/// Builds one release binary of system-tests (tests/src/bin).
+fn build_tests_bin(root: &Path, name: &str) -> Result<()> {
+    run(cargo()
+        .current_dir(root)
+        .args(["build", "--release", "-p", "system-tests", "--bin", name]))
 }
 
 /// Runs the (built) report binary with the FMUs of `fmu_dir`, writing the report into `out`.
@@ -245,7 +245,7 @@ fn bench(extra: &[String]) -> Result<()> {
     run(cargo()
         .current_dir(&root)
         .args(["build", "--release", "-p", "shipsim", "--bins"]))?;
-    let model_loop = build_model_loop(&root)?;
+    build_tests_bin(&root, "rrs-model-loop")?;
     let python = ensure_venv(&root)?;
     let script = |name: &str, args: &[String]| -> Result<String> {
         let mut cmd = Command::new(&python);
@@ -253,10 +253,11 @@ fn bench(extra: &[String]) -> Result<()> {
             .arg(format!("master/bench/{name}"))
             .args(args)
             .env("SHIPSIM_BIN", root.join("target/release/shipsim"))
+            .env(
+                "SHIPSIM_MODEL_LOOP_BIN",
+                root.join("target/release/rrs-model-loop"),
+            )
             .stderr(std::process::Stdio::inherit());
-        if let Some(bin) = &model_loop {
-            cmd.env("SHIPSIM_MODEL_LOOP_BIN", bin);
-        }
         let out = cmd.output()?;
         let text = String::from_utf8_lossy(&out.stdout).into_owned();
         print!("{text}");
@@ -277,29 +278,6 @@ fn bench(extra: &[String]) -> Result<()> {
     std::fs::write(root.join("docs/bench.md"), doc)?;
     println!("wrote docs/bench.md");
     Ok(())
-}
-
-/// Builds the pure-Rust RRS model loop of system-tests (tests/src/bin/rrs_model_loop.rs) when
-/// it exists, and returns its path; `None` when there is none (the bench says so).
-fn build_model_loop(root: &Path) -> Result<Option<PathBuf>> {
-    if !root.join("tests/src/bin/rrs_model_loop.rs").is_file() {
-        return Ok(None);
-    }
-    let manifest = std::fs::read_to_string(root.join("tests/Cargo.toml"))?;
-    let name = if manifest.contains("\"rrs-model-loop\"") {
-        "rrs-model-loop"
-    } else {
-        "rrs_model_loop"
-    };
-    run(cargo().current_dir(root).args([
-        "build",
-        "--release",
-        "-p",
-        "system-tests",
-        "--bin",
-        name,
-    ]))?;
-    Ok(Some(root.join("target/release").join(name)))
 }
 
 /// The built-in default system: rudder roll stabilization (systems/rrs.toml) with RRS off and

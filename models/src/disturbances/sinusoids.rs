@@ -14,7 +14,9 @@
 //! exact for |n| < 2²¹, |θ| < 6.5·10⁶), and `cos θ = (−1)ⁿ cos r` with `cos r` the Taylor polynomial to r²⁰ on
 //! |r| ≤ π/2 (truncation below 2·10⁻¹⁷). The absolute error is below 5·10⁻¹⁶ (about two units in the last place of 1) for |θ| < 10⁷
 //! (tested against libm); beyond, the reduction error grows like the rounding of θ itself.
-//! Valid for |θ| < 2⁵⁰ (a 10⁸ s run of 3 rad/s waves reaches 3·10⁸).
+//! Valid for |θ| < 2⁵⁰ (a 10⁸ s run of 3 rad/s waves reaches 3·10⁸); beyond, the result is
+//! meaningless but stays finite and within [−1, 1] (a hostile ship speed cannot make the
+//! elevation overflow).
 
 use serde::{Deserialize, Serialize};
 use std::f64::consts::FRAC_1_PI;
@@ -25,11 +27,11 @@ const LANES: usize = 4;
 /// Four components: amplitude a [m], wave frequency ω [rad/s], wave number k = ω²/g [rad/m] and
 /// phase φ [rad] at the reference time.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct Block {
-    pub amplitude: [f64; LANES],
-    pub frequency: [f64; LANES],
-    pub wavenumber: [f64; LANES],
-    pub phase: [f64; LANES],
+struct Block {
+    amplitude: [f64; LANES],
+    frequency: [f64; LANES],
+    wavenumber: [f64; LANES],
+    phase: [f64; LANES],
 }
 
 /// The components of a sum of sinusoids.
@@ -133,7 +135,8 @@ fn sum_avx(blocks: &[Block], tau: f64, x: f64) -> f64 {
             ),
             _mm256_mul_pd(n, p3),
         );
-        let r2 = _mm256_mul_pd(r, r);
+        // min(R2_MAX, r²) with a NaN r² kept, as in `cos`
+        let r2 = _mm256_min_pd(_mm256_set1_pd(R2_MAX), _mm256_mul_pd(r, r));
         let mut c = _mm256_set1_pd(COS_TAYLOR[0]);
         for &k in &COS_TAYLOR[1..] {
             c = _mm256_add_pd(_mm256_mul_pd(c, r2), _mm256_set1_pd(k));
@@ -167,6 +170,8 @@ const P2: f64 = 1.215_420_101_260_793_2e-10;
 const P3: f64 = 4.044_532_497_591_901e-21;
 /// 1.5·2⁵²: adding it rounds to an integer and leaves that integer in the low mantissa bits.
 const SHIFT: f64 = 6_755_399_441_055_744.0;
+/// Bound on r² = (θ − nπ)², above (π/2)² ≈ 2.467 so that it never acts on a valid argument.
+const R2_MAX: f64 = 2.5;
 /// (−1)^j/(2j)!, j = 10 .. 0 (Horner order).
 const COS_TAYLOR: [f64; 11] = [
     1.0 / 2_432_902_008_176_640_000.0,
@@ -190,6 +195,9 @@ pub fn cos(theta: f64) -> f64 {
     let odd = (shifted.to_bits() & 1) << 63;
     let r = ((theta - n * P1) - n * P2) - n * P3;
     let r2 = r * r;
+    // |r| ≤ π/2 for |θ| < 2⁵⁰; beyond, r is meaningless and the bound keeps the result within
+    // [−1, 1] instead of the polynomial's overflow (NaN stays NaN: the comparison is false)
+    let r2 = if R2_MAX < r2 { R2_MAX } else { r2 };
     let mut c = COS_TAYLOR[0];
     for k in &COS_TAYLOR[1..] {
         c = c * r2 + k;
@@ -235,6 +243,10 @@ mod tests {
         }
         assert!(worst < 1.2e-7, "|θ| < 3e8: {worst:e}");
         assert!(cos(f64::NAN).is_nan());
+        // out of range: meaningless but bounded, never an overflow
+        for t in [1e16, -3e17, 1e100, f64::MAX, -f64::MAX] {
+            assert!(cos(t).abs() <= 1.0, "cos({t:e}) = {}", cos(t));
+        }
     }
 
     /// The AVX2 path and the portable path give the same bits (on a machine without AVX2 there
@@ -247,13 +259,16 @@ mod tests {
             let w = 0.2 + 3.0 * rng.uniform();
             s.push(rng.uniform(), w, w * w / 9.81, 2.0 * PI * rng.uniform());
         }
-        for k in 0..2000 {
-            let (tau, x) = (
+        // ordinary arguments, and out-of-range ones (bounded the same way on both paths)
+        let far = [(0.0, 1e300), (1e18, -2e17), (1e300, 0.0)];
+        for k in 0..2000 + far.len() {
+            let (tau, x) = far.get(k.wrapping_sub(2000)).copied().unwrap_or((
                 k as f64 * 0.05,
                 3.0 * (k as f64 * 0.01).sin() - 7e3 * rng.uniform(),
-            );
+            ));
             let portable = sum_blocks(&s.blocks, tau, x);
             assert_eq!(s.sum(tau, x).to_bits(), portable.to_bits(), "{tau} {x}");
+            assert!(portable.abs() <= 401.0, "{tau} {x}: {portable}");
             #[cfg(target_arch = "x86_64")]
             if std::arch::is_x86_feature_detected!("avx2") {
                 // SAFETY: AVX2 is available (checked).
