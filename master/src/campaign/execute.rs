@@ -133,7 +133,7 @@ struct Context<'a> {
     campaign: &'a Campaign,
     fmus: Vec<Arc<Fmu>>,
     run_opts: RunOptions,
-    journal: Mutex<Journal>,
+    sink: Mutex<Sink>,
     progress: Option<indicatif::ProgressBar>,
     failed: AtomicUsize,
     /// Runs finished (recorded) by this call.
@@ -191,15 +191,35 @@ impl Context<'_> {
         if let Some(o) = &self.observer {
             o.finished(run, &record);
         }
-        self.journal
+        self.sink
             .lock()
             .unwrap_or_else(|e| e.into_inner())
-            .append(record)?;
+            .put(record)?;
         if let Some(p) = &self.progress {
             p.inc(1);
             p.set_message(format!("{} failed", self.failed.load(Ordering::Relaxed)));
         }
         Ok(())
+    }
+}
+
+/// Where finished runs go: the journal of the output folder (a local campaign), or a list
+/// handed back to the caller (a chunk run by a worker for a client that records it,
+/// [`super::remote`]).
+pub(super) enum Sink {
+    Journal(Journal),
+    Collect(Vec<RunRecord>),
+}
+
+impl Sink {
+    fn put(&mut self, record: RunRecord) -> Result<()> {
+        match self {
+            Sink::Journal(j) => j.append(record),
+            Sink::Collect(v) => {
+                v.push(record);
+                Ok(())
+            }
+        }
     }
 }
 
@@ -294,7 +314,7 @@ impl Context<'_> {
     fn recorders(&self, run: &Run) -> Result<RunRecorders<'_>> {
         let series = match &self.campaign.spec.series {
             Some(s) if s.runs.contains(&(run.index as u64)) => {
-                let path = self.series_dir.join(format!("run-{:06}.csv", run.index));
+                let path = self.series_dir.join(super::remote::series_name(run.index));
                 std::fs::create_dir_all(&self.series_dir).map_err(|e| {
                     Error::io(format!("cannot create {}", self.series_dir.display()), e)
                 })?;
@@ -358,24 +378,13 @@ pub fn run(campaign: &Campaign, opts: &CampaignOptions) -> Result<CampaignOutcom
     output::check_or_write_provenance(campaign, dir, opts.shard)?;
     let journal = Journal::open(dir)?;
     let fmus = run::load_fmus(&campaign.system)?;
+    let (jobs, jobs_note) = jobs_for(&fmus, opts.jobs);
     let mut outcome = CampaignOutcome {
         total: campaign.runs.len(),
+        jobs,
+        jobs_note,
         ..Default::default()
     };
-    let mut jobs = opts.jobs.unwrap_or_else(rayon::current_num_threads).max(1);
-    if let Some(f) = fmus
-        .iter()
-        .find(|f| f.co_simulation().can_be_instantiated_only_once_per_process)
-    {
-        if jobs > 1 {
-            outcome.jobs_note = Some(format!(
-                "{} declares canBeInstantiatedOnlyOncePerProcess: one job, until the out-of-process mode exists",
-                f.path.display()
-            ));
-        }
-        jobs = 1;
-    }
-    outcome.jobs = jobs;
     let mds: Vec<&ModelDescription> = fmus.iter().map(|f| &f.model_description).collect();
     let fork = fork_plan(campaign, &mds)?;
     let selected = select(campaign, fork.as_ref(), opts.shard);
@@ -383,29 +392,98 @@ pub fn run(campaign: &Campaign, opts: &CampaignOptions) -> Result<CampaignOutcom
     let todo: Vec<&Run> = selected
         .iter()
         .map(|&i| &campaign.runs[i])
-        .filter(|r| match journal.done(&r.key) {
-            Some(rec) => opts.retry_failed && rec.status.failed(),
-            None => true,
-        })
+        .filter(|r| to_do(&journal, r, opts.retry_failed))
         .collect();
     outcome.skipped = outcome.selected - todo.len();
     let ctx = Context {
-        campaign,
-        fmus: fmus.clone(),
-        run_opts: RunOptions {
-            interrupt: opts.interrupt.clone(),
-            log_sink: opts.log_sink.clone(),
-            ..Default::default()
-        },
-        journal: Mutex::new(journal),
         progress: opts.progress.then(|| progress_bar(todo.len())),
-        failed: Default::default(),
-        done: Default::default(),
-        slowest: Mutex::new(None),
-        interrupted: AtomicBool::new(false),
-        series_dir: dir.join("series"),
         observer: opts.observer.clone(),
+        ..Context::new(
+            campaign,
+            fmus,
+            opts,
+            Sink::Journal(journal),
+            dir.join("series"),
+        )
     };
+    outcome.groups = execute_all(&ctx, fork.as_ref(), &todo, jobs)?;
+    outcome.ran = ctx.done.load(Ordering::Relaxed);
+    outcome.interrupted = ctx.interrupted.load(Ordering::Relaxed) || ctx.stop();
+    outcome.failed = ctx.failed.load(Ordering::Relaxed);
+    outcome.slowest = *ctx.slowest.lock().unwrap_or_else(|e| e.into_inner());
+    let Sink::Journal(journal) = ctx.sink.into_inner().unwrap_or_else(|e| e.into_inner()) else {
+        unreachable!("a local campaign records into its journal")
+    };
+    outcome.files = output::write_tables(&campaign.spec, &campaign.runs, &journal, dir)?;
+    outcome.wall = begin.elapsed();
+    Ok(outcome)
+}
+
+/// Whether a run still has to run: not in the journal, or failed there and retried.
+pub(super) fn to_do(journal: &Journal, run: &Run, retry_failed: bool) -> bool {
+    match journal.done(&run.key) {
+        Some(rec) => retry_failed && rec.status.failed(),
+        None => true,
+    }
+}
+
+/// The worker threads to use (every core by default), and why they were limited: an FMU that
+/// can be instantiated only once per process allows one.
+fn jobs_for(fmus: &[Arc<Fmu>], jobs: Option<usize>) -> (usize, Option<String>) {
+    let jobs = jobs.unwrap_or_else(rayon::current_num_threads).max(1);
+    match fmus
+        .iter()
+        .find(|f| f.co_simulation().can_be_instantiated_only_once_per_process)
+    {
+        Some(f) if jobs > 1 => (
+            1,
+            Some(format!(
+                "{} declares canBeInstantiatedOnlyOncePerProcess: one job, until the out-of-process mode exists",
+                f.path.display()
+            )),
+        ),
+        _ => (jobs, None),
+    }
+}
+
+impl<'a> Context<'a> {
+    /// The workers' state for `campaign` with its loaded FMUs, recording into `sink`; no
+    /// progress bar and no observer.
+    fn new(
+        campaign: &'a Campaign,
+        fmus: Vec<Arc<Fmu>>,
+        opts: &CampaignOptions,
+        sink: Sink,
+        series_dir: PathBuf,
+    ) -> Context<'a> {
+        Context {
+            campaign,
+            fmus,
+            run_opts: RunOptions {
+                interrupt: opts.interrupt.clone(),
+                log_sink: opts.log_sink.clone(),
+                ..Default::default()
+            },
+            sink: Mutex::new(sink),
+            progress: None,
+            failed: Default::default(),
+            done: Default::default(),
+            slowest: Mutex::new(None),
+            interrupted: AtomicBool::new(false),
+            series_dir,
+            observer: None,
+        }
+    }
+}
+
+/// Runs `todo` on a pool of `jobs` threads: each run cold, or with forks each warm-up group
+/// once and its runs from the checkpoint (returns the group sizes then).
+fn execute_all(
+    ctx: &Context,
+    fork: Option<&Fork>,
+    todo: &[&Run],
+    jobs: usize,
+) -> Result<Option<Vec<usize>>> {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(jobs)
         .build()
@@ -416,34 +494,93 @@ pub fn run(campaign: &Campaign, opts: &CampaignOptions) -> Result<CampaignOutcom
             errors.lock().unwrap_or_else(|e| e.into_inner()).push(e);
         }
     };
-    pool.install(|| match &fork {
-        None => todo.par_iter().for_each(|r| {
-            if !ctx.stop() {
-                keep(ctx.finish(r, ctx.cold(r)));
-            }
-        }),
+    let groups = pool.install(|| match fork {
+        None => {
+            todo.par_iter().for_each(|r| {
+                if !ctx.stop() {
+                    keep(ctx.finish(r, ctx.cold(r)));
+                }
+            });
+            None
+        }
         Some(fork) => {
-            let groups = fork.groups_of(&todo);
-            outcome.groups = Some(groups.iter().map(Vec::len).collect());
+            let groups = fork.groups_of(todo);
             groups
                 .par_iter()
-                .for_each(|g| keep(fork.run_group(&ctx, g)));
+                .for_each(|g| keep(fork.run_group(ctx, g)));
+            Some(groups.iter().map(Vec::len).collect())
         }
     });
     if let Some(p) = &ctx.progress {
         p.finish();
     }
-    if let Some(e) = errors.into_inner().unwrap_or_else(|e| e.into_inner()).pop() {
-        return Err(e);
+    match errors.into_inner().unwrap_or_else(|e| e.into_inner()).pop() {
+        Some(e) => Err(e),
+        None => Ok(groups),
     }
-    outcome.ran = ctx.done.load(Ordering::Relaxed);
-    outcome.interrupted = ctx.interrupted.load(Ordering::Relaxed) || ctx.stop();
-    outcome.failed = ctx.failed.load(Ordering::Relaxed);
-    outcome.slowest = *ctx.slowest.lock().unwrap_or_else(|e| e.into_inner());
-    let journal = ctx.journal.into_inner().unwrap_or_else(|e| e.into_inner());
-    outcome.files = output::write_tables(&campaign.spec, &campaign.runs, &journal, dir)?;
-    outcome.wall = begin.elapsed();
-    Ok(outcome)
+}
+
+/// Runs the given runs (by index) into a list instead of a journal: a chunk of a campaign
+/// whose results another process records ([`super::remote`]). Series files go to
+/// `series_dir`. An interrupt ends it with [`Error::Interrupted`] (nothing is returned, the
+/// client runs the chunk again).
+pub(super) fn run_collect(
+    campaign: &Campaign,
+    fmus: &[Arc<Fmu>],
+    indices: &[usize],
+    opts: &CampaignOptions,
+    series_dir: PathBuf,
+) -> Result<Vec<RunRecord>> {
+    let todo = indices
+        .iter()
+        .map(|&i| {
+            campaign.runs.get(i).ok_or_else(|| {
+                Error::Other(format!(
+                    "campaign {}: no run {i} (it has {})",
+                    campaign.spec.source.display(),
+                    campaign.runs.len()
+                ))
+            })
+        })
+        .collect::<Result<Vec<&Run>>>()?;
+    let (jobs, _) = jobs_for(fmus, opts.jobs);
+    let mds: Vec<&ModelDescription> = fmus.iter().map(|f| &f.model_description).collect();
+    let fork = fork_plan(campaign, &mds)?;
+    let ctx = Context {
+        observer: opts.observer.clone(),
+        ..Context::new(
+            campaign,
+            fmus.to_vec(),
+            opts,
+            Sink::Collect(Vec::new()),
+            series_dir,
+        )
+    };
+    execute_all(&ctx, fork.as_ref(), &todo, jobs)?;
+    if ctx.interrupted.load(Ordering::Relaxed) || ctx.stop() {
+        return Err(Error::Interrupted { time: f64::NAN });
+    }
+    match ctx.sink.into_inner().unwrap_or_else(|e| e.into_inner()) {
+        Sink::Collect(records) => Ok(records),
+        Sink::Journal(_) => unreachable!("a chunk collects its records"),
+    }
+}
+
+/// The runs by warm-up group (a forked campaign) or one by one: the units of work that keep
+/// a group's warm-up in one place, in index order.
+pub(super) fn work_units(
+    campaign: &Campaign,
+    mds: &[&ModelDescription],
+    todo: &[&Run],
+) -> Result<Vec<Vec<usize>>> {
+    Ok(match fork_plan(campaign, mds)? {
+        Some(f) => f
+            .groups_of(todo)
+            .into_iter()
+            .map(|g| g.iter().map(|r| r.index).collect())
+            .collect(),
+        None => todo.iter().map(|r| vec![r.index]).collect(),
+    })
 }
 
 fn progress_bar(n: usize) -> indicatif::ProgressBar {

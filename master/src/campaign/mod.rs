@@ -8,6 +8,8 @@
 //! ([`journal`]), from which the run table and the derived table ([`derived`]) are written
 //! ([`output`], [`table`]). With `fork_at`, runs that share everything fixed at
 //! initialization share one warm-up to `fork_at` and continue from its checkpoint.
+//! [`remote`] splits the same work between worker processes that run chunks of runs and one
+//! client that records them (the Python package's Dask mode).
 
 use crate::error::{Error, Result};
 use crate::model_description::ModelDescription;
@@ -24,6 +26,7 @@ pub mod manoeuvre;
 pub mod merge;
 pub mod output;
 pub mod plot;
+pub mod remote;
 pub mod spec;
 pub mod table;
 

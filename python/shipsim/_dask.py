@@ -1,0 +1,74 @@
+"""Campaigns on a Dask cluster (``Campaign.run(client=...)``).
+
+The client (this process) opens the output folder, splits the runs not done yet into chunks
+(a warm-up group of a forked campaign stays in one chunk) and submits one task per chunk.
+Each task runs :func:`run_chunk` on a worker: the worker process loads the campaign and its
+FMUs on its first chunk and keeps them (``shipsim.fmu_load_count()`` counts the loads), runs
+the chunk with the GIL released, and returns one JSON record per run. The client records each
+chunk's runs in the journal as the chunk completes (synced, a run recorded twice is kept
+once) and writes the tables at the end, as on one machine, so that running again resumes.
+
+Files: workers read the campaign file, its base system and the FMUs at the same absolute
+paths as the client (a shared file system, or the same checkout on every machine). A worker
+that sees other files (a different hash of the system and FMUs) fails its chunk with an
+error that says so.
+
+A lost worker: Dask runs the chunk again on another worker (its ``allowed-failures`` limit
+applies); the runs of a chunk are recorded only when the chunk completes, so every run is
+recorded once.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Dict, List, Optional, Tuple
+
+from . import _native
+
+
+def run_chunk(campaign: str, base_hash: str, runs: List[int]) -> List[Tuple[str, Optional[bytes]]]:
+    """A Dask task: runs the given runs of a campaign in this worker process."""
+    return _native.worker_run(campaign, base_hash, runs)
+
+
+def run_on_dask(campaign, client, output: str, retry_failed: bool,
+                chunk_size: Optional[int], progress: Optional[bool]) -> Dict[str, Any]:
+    from distributed import as_completed
+
+    from ._campaign import _chunk_size, _Progress
+
+    native = campaign._native
+    collector = native.collector(output, retry_failed)
+    futures = []
+    try:
+        pending = collector.pending()
+        workers = len(client.scheduler_info().get("workers", {})) or 1
+        per = chunk_size or _chunk_size(pending, workers)
+        chunks = collector.chunks(per)
+        source, base_hash = str(native.source), native.base_hash
+        futures = [
+            client.submit(run_chunk, source, base_hash, chunk, pure=False,
+                          key=f"shipsim-{campaign.name}-chunk-{i}-{id(collector):x}")
+            for i, chunk in enumerate(chunks)
+        ]
+        bar = _Progress(pending, progress, campaign.name)
+        done = failed = 0
+        try:
+            for future in as_completed(futures):
+                for record, series in future.result():
+                    recorded, run_failed = collector.record(record, series)
+                    done += recorded
+                    failed += recorded and run_failed
+                bar.to(done, failed)
+        finally:
+            bar.close()
+        _, table = collector.finish()
+        return table
+    except BaseException:
+        client.cancel(futures)
+        try:
+            collector.finish()  # the tables of the runs recorded so far
+        except Exception:
+            pass
+        raise
+    finally:
+        collector.close()

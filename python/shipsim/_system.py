@@ -1,0 +1,237 @@
+"""Single runs: :func:`inspect` and :class:`System`."""
+
+from __future__ import annotations
+
+import difflib
+import os
+import warnings
+from dataclasses import dataclass, field
+from typing import Any, Dict, Iterable, List, Optional, Union
+
+import numpy as np
+
+from . import _native
+from ._native import VariableError
+
+PathLike = Union[str, "os.PathLike[str]"]
+
+
+class ShipsimWarning(UserWarning):
+    """A warning of the master (e.g. a system-file check that does not stop the run)."""
+
+
+@dataclass(frozen=True)
+class Variable:
+    """One variable of an FMU's model description (FMI 2.0, sec. 2.2.7)."""
+
+    name: str
+    value_reference: int
+    type: str
+    causality: str
+    variability: str
+    initial: Optional[str]
+    start: Any
+    unit: Optional[str]
+    display_unit: Optional[str]
+    declared_type: Optional[str]
+    min: Any
+    max: Any
+    nominal: Optional[float]
+    description: Optional[str]
+
+
+@dataclass(frozen=True)
+class ModelDescription:
+    """An FMU's model description, as :func:`inspect` reads it."""
+
+    path: str
+    model_name: str
+    fmi_version: str
+    guid: str
+    description: Optional[str]
+    generation_tool: Optional[str]
+    model_identifier: str
+    capabilities: Dict[str, bool]
+    default_experiment: Dict[str, Optional[float]]
+    variables: List[Variable] = field(repr=False)
+
+    def variable(self, name: str) -> Variable:
+        """The variable called ``name`` (:class:`VariableError` with close names if none)."""
+        for v in self.variables:
+            if v.name == name:
+                return v
+        close = difflib.get_close_matches(name, [v.name for v in self.variables], n=3)
+        hint = f" (did you mean {', '.join(repr(c) for c in close)}?)" if close else ""
+        raise VariableError(f"{self.path}: no variable '{name}'{hint}")
+
+    def by_causality(self, causality: str) -> List[Variable]:
+        """The variables of one causality: parameter, input, output, local, ..."""
+        return [v for v in self.variables if v.causality == causality]
+
+    def to_frame(self):
+        """The variables as a pandas DataFrame indexed by name."""
+        import pandas as pd
+
+        rows = [v.__dict__ for v in self.variables]
+        return pd.DataFrame(rows).set_index("name")
+
+
+def inspect(path: PathLike) -> ModelDescription:
+    """Reads an FMU's model description without loading its binary: variables with their
+    type, causality, variability, units, start values and ranges; capabilities; default
+    experiment. Raises :class:`FmuError` for an archive that cannot be used."""
+    d = _native.inspect(os.fspath(path))
+    variables = [Variable(**v) for v in d.pop("variables")]
+    d["path"] = os.fspath(d["path"])
+    return ModelDescription(variables=variables, **d)
+
+
+def _have_pandas() -> bool:
+    try:
+        import pandas  # noqa: F401
+    except ImportError:
+        return False
+    return True
+
+
+class Columns(dict):
+    """The result of :meth:`System.run` without pandas: ``time`` and one numpy array per
+    recorded variable; ``units`` (column -> unit or None) and ``summary`` as attributes."""
+
+    units: Dict[str, Optional[str]]
+    summary: Dict[str, Any]
+
+
+_DTYPES = {"Real": np.float64, "Integer": np.int32, "Enumeration": np.int32, "Boolean": np.bool_}
+
+
+class System:
+    """A coupled system (native TOML or OSP ``OspSystemStructure.xml``) with its FMUs loaded
+    once; every :meth:`run` makes fresh instances, so runs are independent and repeatable."""
+
+    def __init__(self, native: "_native.System"):
+        self._native = native
+
+    @classmethod
+    def load(cls, path: PathLike) -> "System":
+        """Reads a system file and loads its FMUs. Raises :class:`SystemFileError` for a file
+        that cannot be read or parsed, :class:`FmuError` for an FMU that cannot be loaded."""
+        return cls(_native.System.load(os.fspath(path)))
+
+    def set(self, name: str, value: Union[bool, int, float, str]) -> "System":
+        """Sets a parameter or start value, as ``shipsim run --set name=value`` does: ``name``
+        is ``instance.variable``; a str is parsed by the variable's type. Returns the system,
+        so calls chain. Raises :class:`VariableError` for an unknown instance or variable."""
+        self._native.set(name, value)
+        return self
+
+    @property
+    def source(self) -> str:
+        return os.fspath(self._native.source)
+
+    @property
+    def start_time(self) -> float:
+        return self._native.start_time
+
+    @property
+    def stop_time(self) -> Optional[float]:
+        return self._native.stop_time
+
+    @property
+    def step_size(self) -> float:
+        return self._native.step_size
+
+    @property
+    def algorithm(self) -> str:
+        return self._native.algorithm
+
+    @property
+    def instances(self) -> Dict[str, str]:
+        """Instance name -> FMU path, in system order."""
+        return {name: os.fspath(p) for name, p in self._native.instances}
+
+    @property
+    def connections(self) -> List[tuple]:
+        """(from, to, gain, offset) per connection."""
+        return list(self._native.connections)
+
+    @property
+    def values(self) -> Dict[str, str]:
+        """The values set on instances (by the file and :meth:`set`), as text."""
+        return dict(self._native.values())
+
+    def inspect(self, instance: str) -> ModelDescription:
+        """The model description of an instance's FMU."""
+        try:
+            return inspect(self.instances[instance])
+        except KeyError:
+            close = difflib.get_close_matches(instance, list(self.instances), n=3)
+            hint = f" (did you mean {', '.join(repr(c) for c in close)}?)" if close else ""
+            raise VariableError(f"{self.source}: no instance '{instance}'{hint}") from None
+
+    def check(self) -> List[str]:
+        """Validates the system against its FMUs (``shipsim check``); returns the warnings."""
+        return list(self._native.check())
+
+    def run(
+        self,
+        stop_time: Optional[float] = None,
+        variables: Optional[Iterable[str]] = None,
+        *,
+        start_time: Optional[float] = None,
+        step_size: Optional[float] = None,
+        algorithm: Optional[str] = None,
+        verbose: bool = False,
+        as_frame: Optional[bool] = None,
+    ):
+        """Runs the system and returns the recorded variables.
+
+        ``variables``: ``instance.variable`` or ``instance.*`` (every output of the instance);
+        default: the system file's ``[output]`` list, else every output. ``stop_time``,
+        ``start_time``, ``step_size`` [s] and ``algorithm`` (``"jacobi"`` or
+        ``"gauss-seidel"``) override the file's.
+
+        Returns a pandas DataFrame indexed by time [s], one column per variable, with
+        ``df.attrs["units"]`` (column -> unit), ``df.attrs["summary"]`` (steps, wall time,
+        real-time factor) and ``df.attrs["warnings"]``; without pandas (or with
+        ``as_frame=False``), a :class:`Columns` dict of numpy arrays with ``time``.
+
+        The GIL is released while the master runs. Ctrl-C stops the run at its next
+        communication point and raises ``KeyboardInterrupt``. FMU log messages go to the
+        ``shipsim.fmu`` logger (warnings and worse; everything with ``verbose``).
+        """
+        raw = self._native.run(
+            stop_time=stop_time,
+            variables=None if variables is None else list(variables),
+            start_time=start_time,
+            step_size=step_size,
+            algorithm=algorithm,
+            verbose=verbose,
+        )
+        for w in raw["warnings"]:
+            warnings.warn(w, ShipsimWarning, stacklevel=2)
+        time = np.frombuffer(raw["time"], dtype="<f8")
+        arrays = {}
+        for name, kind, buf in zip(raw["columns"], raw["types"], raw["data"]):
+            values = np.frombuffer(buf, dtype="<f8")
+            dtype = _DTYPES.get(kind, np.float64)
+            arrays[name] = values if dtype is np.float64 else values.astype(dtype)
+        units = dict(zip(raw["columns"], raw["units"]))
+        if as_frame is None:
+            as_frame = _have_pandas()
+        if as_frame:
+            import pandas as pd
+
+            df = pd.DataFrame(arrays, index=pd.Index(time, name="time"))
+            df.attrs["units"] = units
+            df.attrs["summary"] = raw["summary"]
+            df.attrs["warnings"] = list(raw["warnings"])
+            return df
+        out = Columns(time=time, **arrays)
+        out.units = units
+        out.summary = raw["summary"]
+        return out
+
+    def __repr__(self) -> str:
+        names = ", ".join(self.instances)
+        return f"System({self.source!r}: {names}; step {self.step_size} s, stop {self.stop_time} s)"
