@@ -34,37 +34,37 @@ use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
 create_exception!(
-    _native,
+    shipsim,
     ShipsimError,
     PyException,
     "Base class of every error shipsim raises."
 );
 create_exception!(
-    _native,
+    shipsim,
     FmuError,
     ShipsimError,
     "An FMU archive, its modelDescription.xml or its binary cannot be used."
 );
 create_exception!(
-    _native,
+    shipsim,
     SystemFileError,
     ShipsimError,
     "A system or campaign file cannot be read, or does not validate against its FMUs."
 );
 create_exception!(
-    _native,
+    shipsim,
     VariableError,
     ShipsimError,
     "No such instance or variable (the message suggests close names)."
 );
 create_exception!(
-    _native,
+    shipsim,
     SimulationError,
     ShipsimError,
     "An FMU failed during a run: an FMI call returned fmi2Error or fmi2Fatal."
 );
 create_exception!(
-    _native,
+    shipsim,
     CheckpointError,
     ShipsimError,
     "A checkpoint file cannot be used."
@@ -76,10 +76,7 @@ create_exception!(
 fn py_err(py: Python<'_>, e: Error) -> PyErr {
     let message = e.to_string();
     let (err, attrs): (PyErr, Vec<(&str, Py<PyAny>)>) = match e {
-        Error::Fmu { path, .. } => (
-            FmuError::new_err(message),
-            vec![("path", obj(py, path))],
-        ),
+        Error::Fmu { path, .. } => (FmuError::new_err(message), vec![("path", obj(py, path))]),
         Error::Fmi {
             instance,
             function,
@@ -215,7 +212,13 @@ impl Logs {
                 3 => 40,     // ERROR
                 _ => 50,     // CRITICAL
             };
-            let text = format!("[{}] {} {}: {}", r.instance, fmi_status(r.status), r.category, r.message);
+            let text = format!(
+                "[{}] {} {}: {}",
+                r.instance,
+                fmi_status(r.status),
+                r.category,
+                r.message
+            );
             logger.call_method1("log", (level, text))?;
         }
         Ok(())
@@ -298,12 +301,21 @@ fn inspect<'py>(py: Python<'py>, path: PathBuf) -> PyResult<Bound<'py, PyDict>> 
     d.set_item("model_identifier", &cs.model_identifier)?;
     let caps = PyDict::new(py);
     for (k, v) in [
-        ("can_handle_variable_communication_step_size", cs.can_handle_variable_communication_step_size),
-        ("can_be_instantiated_only_once_per_process", cs.can_be_instantiated_only_once_per_process),
+        (
+            "can_handle_variable_communication_step_size",
+            cs.can_handle_variable_communication_step_size,
+        ),
+        (
+            "can_be_instantiated_only_once_per_process",
+            cs.can_be_instantiated_only_once_per_process,
+        ),
         ("can_get_and_set_fmu_state", cs.can_get_and_set_fmu_state),
         ("can_serialize_fmu_state", cs.can_serialize_fmu_state),
         ("needs_execution_tool", cs.needs_execution_tool),
-        ("provides_directional_derivative", cs.provides_directional_derivative),
+        (
+            "provides_directional_derivative",
+            cs.provides_directional_derivative,
+        ),
     ] {
         caps.set_item(k, v)?;
     }
@@ -466,7 +478,10 @@ impl PySystem {
 
     /// Checks the system against its FMUs (as `shipsim check`); returns the warnings.
     fn check(&self, py: Python<'_>) -> PyResult<Vec<String>> {
-        let plan = self.system.validate(&self.mds()).map_err(|e| py_err(py, e))?;
+        let plan = self
+            .system
+            .validate(&self.mds())
+            .map_err(|e| py_err(py, e))?;
         Ok(plan.warnings)
     }
 
@@ -522,13 +537,18 @@ impl PySystem {
         };
         let mut rec = MemoryRecorder::new();
         let fmus = &self.fmus;
-        let result = run_detached(py, &interrupt, |_| Ok(()), || {
-            let begin = std::time::Instant::now();
-            run::run_with(&plan, fmus, Some(&mut rec), &opts).map(|mut s| {
-                s.total_wall_time = begin.elapsed();
-                s
-            })
-        });
+        let result = run_detached(
+            py,
+            &interrupt,
+            |_| Ok(()),
+            || {
+                let begin = std::time::Instant::now();
+                run::run_with(&plan, fmus, Some(&mut rec), &opts).map(|mut s| {
+                    s.total_wall_time = begin.elapsed();
+                    s
+                })
+            },
+        );
         logs.emit(py)?;
         let summary = result?.map_err(|e| py_err(py, e))?;
         let out = PyDict::new(py);
@@ -542,14 +562,21 @@ impl PySystem {
                 let md = mds[o.instance];
                 let prefix = format!("{}.", sys.instances[o.instance].name);
                 let name = o.header.strip_prefix(&prefix)?;
-                let v = md.model_variables.variables.iter().find(|v| v.name == name)?;
+                let v = md
+                    .model_variables
+                    .variables
+                    .iter()
+                    .find(|v| v.name == name)?;
                 md.real_unit(v).map(str::to_string)
             })
             .collect();
         out.set_item("units", units)?;
         out.set_item(
             "columns",
-            rec.columns.iter().map(|c| c.name.clone()).collect::<Vec<_>>(),
+            rec.columns
+                .iter()
+                .map(|c| c.name.clone())
+                .collect::<Vec<_>>(),
         )?;
         out.set_item(
             "types",
@@ -634,9 +661,18 @@ struct PyCampaign {
     campaign: Campaign,
 }
 
+/// An error of a campaign: reading a campaign file (or its base system) is a
+/// [`SystemFileError`] unless an FMU is at fault; the rest as [`py_err`].
 fn campaign_err(py: Python<'_>, e: Error) -> PyErr {
     match e {
         Error::Other(m) if m.starts_with("campaign ") => SystemFileError::new_err(m),
+        e => py_err(py, e),
+    }
+}
+
+fn campaign_load_err(py: Python<'_>, e: Error) -> PyErr {
+    match e {
+        Error::Io { .. } | Error::Other(_) => SystemFileError::new_err(e.to_string()),
         e => py_err(py, e),
     }
 }
@@ -648,7 +684,7 @@ impl PyCampaign {
     fn load(py: Python<'_>, path: PathBuf) -> PyResult<PyCampaign> {
         let campaign = py
             .detach(|| Campaign::load(&path))
-            .map_err(|e| campaign_err(py, e))?;
+            .map_err(|e| campaign_load_err(py, e))?;
         Ok(PyCampaign { campaign })
     }
 
@@ -680,7 +716,12 @@ impl PyCampaign {
         self.campaign
             .runs
             .iter()
-            .map(|r| r.sets.iter().map(|(k, v)| (k.clone(), v.to_string())).collect())
+            .map(|r| {
+                r.sets
+                    .iter()
+                    .map(|(k, v)| (k.clone(), v.to_string()))
+                    .collect()
+            })
             .collect()
     }
 
@@ -737,8 +778,14 @@ impl PyCampaign {
 
     /// Opens the output folder for recording results computed elsewhere (the Dask mode).
     #[pyo3(signature = (output, retry_failed=false))]
-    fn collector(&self, py: Python<'_>, output: PathBuf, retry_failed: bool) -> PyResult<PyCollector> {
-        let c = Collector::open(&self.campaign, &output, retry_failed).map_err(|e| py_err(py, e))?;
+    fn collector(
+        &self,
+        py: Python<'_>,
+        output: PathBuf,
+        retry_failed: bool,
+    ) -> PyResult<PyCollector> {
+        let c =
+            Collector::open(&self.campaign, &output, retry_failed).map_err(|e| py_err(py, e))?;
         Ok(PyCollector {
             campaign: self.campaign.clone(),
             collector: Some(c),
@@ -800,10 +847,7 @@ impl PyCollector {
     /// Writes the tables; returns (files, run table).
     fn finish<'py>(&mut self, py: Python<'py>) -> PyResult<(Vec<PathBuf>, Bound<'py, PyDict>)> {
         let campaign = self.campaign.clone();
-        let (files, table) = self
-            .get()?
-            .finish(&campaign)
-            .map_err(|e| py_err(py, e))?;
+        let (files, table) = self.get()?.finish(&campaign).map_err(|e| py_err(py, e))?;
         Ok((files, table_dict(py, &table)?))
     }
 
@@ -858,16 +902,20 @@ fn worker_run<'py>(
         log_sink: Some(logs.sink(false)),
         ..Default::default()
     };
-    let result = run_detached(py, &interrupt, |_| Ok(()), || {
-        worker_for(&campaign, &base_hash)?.run(&runs, &opts)
-    });
+    let result = run_detached(
+        py,
+        &interrupt,
+        |_| Ok(()),
+        || worker_for(&campaign, &base_hash)?.run(&runs, &opts),
+    );
     logs.emit(py)?;
     let finished = result?.map_err(|e| campaign_err(py, e))?;
     finished
         .into_iter()
         .map(|(r, series)| {
-            let json = serde_json::to_string(&r)
-                .map_err(|e| ShipsimError::new_err(format!("cannot encode run {}: {e}", r.index)))?;
+            let json = serde_json::to_string(&r).map_err(|e| {
+                ShipsimError::new_err(format!("cannot encode run {}: {e}", r.index))
+            })?;
             Ok((json, series.map(|b| PyBytes::new(py, &b))))
         })
         .collect()

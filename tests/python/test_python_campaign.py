@@ -1,0 +1,215 @@
+"""Campaigns from the `shipsim` Python package: locally and on Dask.
+
+- Campaign.run equals `shipsim campaign run`'s runs.parquet, row for row (every column but
+  wall_time, which is a measurement);
+- a campaign through a LocalCluster of 2 worker processes gives the local table row for row,
+  with its series files, and each worker loads each FMU once (load counter);
+- a worker killed at its k-th completed chunk: Dask runs the chunk again, and every run is
+  recorded exactly once (journal lines and table);
+- resume: a second run of the same folder runs nothing and returns the same table."""
+import json
+import os
+import pathlib
+import subprocess
+
+import pandas as pd
+import pytest
+
+import shipsim
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+BIN = os.environ.get("SHIPSIM_BIN", str(ROOT / "target" / "release" / "shipsim"))
+
+# A forked campaign: 2 directions x 2 wave heights x 2 seeds x 2 arms = 16 runs in 4 warm-up
+# groups, with series files for two runs.
+FORKED = f"""
+name = "py_forked"
+system = "{ROOT / 'systems' / 'rrs.toml'}"
+stop_time = 400.0
+seed = 5
+fork_at = 100.0
+[[factors]]
+name = "direction_deg"
+variable = "waves.wave_direction"
+values = [60, 120]
+scale = 0.017453292519943295
+[[factors]]
+name = "hs"
+variable = "waves.significant_wave_height"
+values = [2.0, 4.0]
+[replications]
+count = 2
+seeds = ["waves.seed", "wind.seed", "sensors.seed"]
+[[arms]]
+name = "off"
+set = {{ "autopilot.roll_mode" = 0 }}
+[[arms]]
+name = "on"
+set = {{ "autopilot.roll_mode" = 1 }}
+[[kpis]]
+name = "roll_var"
+variable = "ship.roll"
+stat = "variance"
+window = [150, 400]
+[[kpis]]
+name = "rudder_rms"
+variable = "gear.rudder_angle"
+stat = "rms"
+window = [150, 400]
+[series]
+runs = [0, 5]
+variables = ["ship.roll"]
+decimation = 10
+"""
+
+
+def same_table(a: pd.DataFrame, b: pd.DataFrame):
+    cols = [c for c in a.columns if c != "wall_time"]
+    assert list(a.columns) == list(b.columns)
+    a = a.sort_values("run").reset_index(drop=True)[cols]
+    b = b.sort_values("run").reset_index(drop=True)[cols]
+    pd.testing.assert_frame_equal(a, b, check_exact=True, check_dtype=False)
+
+
+@pytest.fixture(scope="module")
+def forked(tmp_path_factory):
+    d = tmp_path_factory.mktemp("campaign")
+    path = d / "forked.toml"
+    path.write_text(FORKED)
+    return path
+
+
+@pytest.fixture(scope="module")
+def local(forked, tmp_path_factory):
+    """The forked campaign run locally (2 threads) from Python."""
+    out = tmp_path_factory.mktemp("local") / "out"
+    table = shipsim.Campaign.load(forked).run(out, jobs=2, progress=False)
+    return out, table
+
+
+def test_local_run_equals_the_cli(local, forked, tmp_path):
+    out, table = local
+    assert len(table) == 16 and sorted(table["run"]) == list(range(16))
+    assert set(table["status"]) == {"ok"}
+    cli_out = tmp_path / "cli"
+    subprocess.run([BIN, "campaign", "run", str(forked), "-o", str(cli_out), "-q", "-j", "2"], check=True)
+    same_table(table, pd.read_parquet(cli_out / "runs.parquet"))
+    # the Python run wrote the same files as the CLI
+    same_table(table, pd.read_parquet(out / "runs.parquet"))
+    for run in (0, 5):
+        name = f"run-{run:06d}.csv"
+        assert (out / "series" / name).read_bytes() == (cli_out / "series" / name).read_bytes()
+
+
+def test_reduced_polar_equals_the_cli(tmp_path):
+    c = shipsim.Campaign.load(ROOT / "campaigns" / "rrs_polar_reduced.toml")
+    assert len(c) == 12 and c.name == "rrs_polar_reduced"
+    table = c.run(tmp_path / "py", progress=False)
+    subprocess.run([BIN, "campaign", "run", str(c.source), "-o", str(tmp_path / "cli"), "-q"], check=True)
+    same_table(table, pd.read_parquet(tmp_path / "cli" / "runs.parquet"))
+    # resume: nothing left to run, the same table
+    again = c.run(tmp_path / "py", progress=False)
+    pd.testing.assert_frame_equal(table, again, check_exact=True)
+
+
+@pytest.fixture(scope="module")
+def cluster():
+    distributed = pytest.importorskip("distributed")
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                  dashboard_address=None, silence_logs=40) as cluster:
+        yield cluster
+
+
+def test_dask_equals_local_and_loads_each_fmu_once(cluster, local, forked, tmp_path):
+    from distributed import Client
+
+    _, table = local
+    c = shipsim.Campaign.load(forked)
+    out = tmp_path / "dask"
+    with Client(cluster) as client:
+        client.restart()
+        got = c.run(out, client=client, chunk_size=4, progress=False)
+        loads = client.run(shipsim.fmu_load_count)
+    same_table(table, got)
+    same_table(table, pd.read_parquet(out / "runs.parquet"))
+    fmus = set(shipsim.System.load(ROOT / "systems" / "rrs.toml").instances.values())
+    # each of the 2 workers loaded each FMU once, however many chunks it ran
+    assert sorted(loads.values()) == [len(fmus), len(fmus)], loads
+    lines = (out / "runs.jsonl").read_text().splitlines()
+    assert sorted(json.loads(x)["index"] for x in lines) == list(range(16))
+    local_out, _ = local
+    for run in (0, 5):
+        name = f"run-{run:06d}.csv"
+        assert (out / "series" / name).read_bytes() == (local_out / "series" / name).read_bytes()
+
+
+try:
+    from distributed.diagnostics.plugin import WorkerPlugin
+except ImportError:  # the Dask tests are skipped then
+    WorkerPlugin = object
+
+
+class KillAtChunk(WorkerPlugin):
+    """A worker plugin that kills its worker process when the k-th chunk completes there, once
+    in the cluster (a marker file says it happened)."""
+
+    name = "kill-at-chunk"
+
+    def __init__(self, k: int, marker: str):
+        self.k, self.marker, self.done = k, marker, 0
+
+    def setup(self, worker):
+        self.done = 0
+
+    def transition(self, key, start, finish, **kwargs):
+        if finish == "memory" and str(key).startswith("shipsim-"):
+            self.done += 1
+            if self.done == self.k and not os.path.exists(self.marker):
+                open(self.marker, "w").close()
+                os._exit(1)
+
+
+def test_dask_worker_loss_records_every_run_once(cluster, local, forked, tmp_path):
+    from distributed import Client
+
+    _, table = local
+    c = shipsim.Campaign.load(forked)
+    marker = tmp_path / "killed"
+    out = tmp_path / "dask"
+    with Client(cluster) as client:
+        client.restart()
+        # The plugin travels by value: workers cannot import this test module.
+        import sys
+
+        import cloudpickle
+
+        cloudpickle.register_pickle_by_value(sys.modules[__name__])
+        client.register_plugin(KillAtChunk(2, str(marker)))
+        try:
+            got = c.run(out, client=client, chunk_size=4, progress=False)
+        finally:
+            client.unregister_worker_plugin(KillAtChunk.name)
+    assert marker.exists(), "no worker was killed"
+    same_table(table, got)
+    lines = (out / "runs.jsonl").read_text().splitlines()
+    indices = sorted(json.loads(x)["index"] for x in lines)
+    assert indices == list(range(16)), indices
+
+
+def test_dask_resume_and_errors(cluster, local, forked, tmp_path):
+    from distributed import Client
+
+    _, table = local
+    c = shipsim.Campaign.load(forked)
+    out = tmp_path / "resume"
+    # half the runs on one machine, the rest on Dask: the journal carries over
+    (out).mkdir()
+    c.run(out, jobs=1, progress=False)
+    lines = (out / "runs.jsonl").read_text().splitlines()
+    (out / "runs.jsonl").write_text("\n".join(lines[:7]) + "\n")
+    with Client(cluster) as client:
+        got = c.run(out, client=client, progress=False)
+    same_table(table, got)
+    assert len((out / "runs.jsonl").read_text().splitlines()) == 16
+    with pytest.raises(shipsim.SystemFileError):
+        shipsim.Campaign.load(tmp_path / "missing.toml")
