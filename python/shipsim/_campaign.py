@@ -50,9 +50,14 @@ class _Progress:
         if not enabled or total == 0:
             return
         try:
+            import ipywidgets  # noqa: F401  (tqdm's notebook widget needs it)
+
             from tqdm.auto import tqdm
         except ImportError:
-            return
+            try:
+                from tqdm import tqdm
+            except ImportError:
+                return
         self.bar = tqdm(total=total, desc=desc, unit="run")
 
     def to(self, done: int, failed: int = 0) -> None:

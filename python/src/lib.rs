@@ -858,10 +858,13 @@ impl PyCollector {
 }
 
 /// The workers of this process, by campaign file and base hash: each loads its FMUs once.
-static WORKERS: Mutex<Option<HashMap<(PathBuf, String), Arc<Worker>>>> = Mutex::new(None);
+static WORKERS: Mutex<Option<HashMap<WorkerKey, Arc<Worker>>>> = Mutex::new(None);
 
-fn worker_for(path: &PathBuf, base_hash: &str) -> Result<Arc<Worker>, Error> {
-    let key = (path.clone(), base_hash.to_string());
+/// (campaign file, base hash): a worker is reused only for the same files.
+type WorkerKey = (PathBuf, String);
+
+fn worker_for(path: &std::path::Path, base_hash: &str) -> Result<Arc<Worker>, Error> {
+    let key = (path.to_path_buf(), base_hash.to_string());
     let mut guard = WORKERS.lock().unwrap_or_else(|e| e.into_inner());
     let map = guard.get_or_insert_with(HashMap::new);
     if let Some(w) = map.get(&key) {

@@ -225,3 +225,25 @@ def test_inspect_reads_the_model_description(fmu_path):
         md.variable("significant_wave_hight")
     frame = md.to_frame()
     assert frame.loc["significant_wave_height", "unit"] == "m"
+
+
+def test_readme_python_snippet(tmp_path):
+    """The README's Python example runs as written (with the reduced polar campaign and its
+    output in a temporary folder, so that the test stays short and leaves nothing behind)."""
+    text = (ROOT / "README.md").read_text()
+    section = text[text.index("## Python: the `shipsim` package"):]
+    start = section.index("```python\n") + len("```python\n")
+    code = section[start:section.index("```", start)]
+    assert 'c.run(jobs=2)' in code and "campaigns/rrs_polar.toml" in code
+    code = code.replace("campaigns/rrs_polar.toml", "campaigns/rrs_polar_reduced.toml")
+    code = code.replace("c.run(jobs=2)", f"c.run({str(tmp_path / 'out')!r}, jobs=2, progress=False)")
+    cwd = os.getcwd()
+    os.chdir(ROOT)
+    try:
+        scope = {}
+        exec(compile(code, "README.md", "exec"), scope)
+    finally:
+        os.chdir(cwd)
+    assert scope["df"].attrs["units"]["ship.roll"] == "rad"
+    assert scope["md"].variable("significant_wave_height").unit == "m"
+    assert len(scope["table"]) == 12

@@ -5,6 +5,7 @@
 //! * `test`: Rust tests, FMUs, a Python venv under `target/venv` with FMPy and libcosimpy, and
 //!   the Python checks in `tests/python`.
 //! * `demo`: the default coupled system (see README).
+//! * `wheel`: the `shipsim` Python package (python/) as a wheel under target/wheels/.
 //! * `export-osp`: every system file of systems/ as target/osp/<name>/OspSystemStructure.xml
 //!   (+ scenario.json for its events) for libcosim / cosim-cli.
 //! * `artifacts DIR` / `artifacts --compare A B`: captures the model descriptions, documentation,
@@ -26,6 +27,7 @@ fn main() {
         Some("bench") => bench(&args[1..]),
         Some("report") => report(args.get(1).map(String::as_str)),
         Some("export-osp") => export_osp(),
+        Some("wheel") => wheel(),
         Some("artifacts") => artifacts::main(&args[1..]),
         _ => {
             eprintln!(
@@ -34,6 +36,7 @@ fn main() {
                  build-fmus   build every FMU into target/fmu/<ModelIdentifier>.fmu\n  \
                  test         run every test: Rust, FMU packaging, FMPy and libcosim checks\n  \
                  demo         run the default coupled system\n  \
+                 wheel        build the shipsim Python package (python/) as a wheel in target/wheels\n  \
                  report [DIR] run every coupled system and write the validation report (target/report)\n  \
                  export-osp   every system of systems/ as target/osp/<name>/OspSystemStructure.xml for libcosim\n  \
                  bench        master overhead vs libcosim and FMPy, every system's speed and profile, campaigns (docs/bench.md)\n  \
@@ -89,18 +92,67 @@ fn ensure_venv(root: &Path) -> Result<PathBuf> {
         run(Command::new("python3").args(["-m", "venv"]).arg(&venv))?;
     }
     eprintln!("xtask: installing tests/python/requirements.txt into the venv");
-    run(Command::new(&python)
-        .args([
-            "-m",
-            "pip",
-            "install",
-            "--quiet",
-            "--disable-pip-version-check",
-            "-r",
-        ])
-        .arg(&req))?;
+    run(pip_install(&python).arg("-r").arg(&req))?;
     std::fs::write(&stamp, req_text)?;
     Ok(python)
+}
+
+/// `PATH` with the venv's `bin/` first (maturin's PEP 517 backend runs its `maturin` binary
+/// from there when pip does not isolate the build).
+fn venv_path(python: &Path) -> std::ffi::OsString {
+    let bin = python.parent().expect("the venv's bin/").to_path_buf();
+    let mut paths = vec![bin];
+    if let Some(p) = std::env::var_os("PATH") {
+        paths.extend(std::env::split_paths(&p));
+    }
+    std::env::join_paths(paths).expect("PATH entries without ':'")
+}
+
+/// Builds the `shipsim` Python package (python/, maturin, release) and installs it into the
+/// venv, without build isolation: maturin comes from requirements.txt, and the Rust build
+/// shares target/ with the workspace (a rebuild of an unchanged tree takes seconds).
+fn install_python_package(root: &Path, python: &Path) -> Result<()> {
+    eprintln!("xtask: building and installing the shipsim Python package (python/) into the venv");
+    run(pip_install(python)
+        .current_dir(root)
+        .args([
+            "--no-build-isolation",
+            "--force-reinstall",
+            "--no-deps",
+            "./python",
+        ])
+        .env("PATH", venv_path(python)))
+}
+
+/// `python -m pip install --quiet` (arguments to follow).
+fn pip_install(python: &Path) -> Command {
+    let mut cmd = Command::new(python);
+    cmd.args([
+        "-m",
+        "pip",
+        "install",
+        "--quiet",
+        "--disable-pip-version-check",
+    ]);
+    cmd
+}
+
+/// `cargo xtask wheel`: the Python package as a wheel (abi3: one wheel for CPython >= 3.9).
+fn wheel() -> Result<()> {
+    let root = workspace_root();
+    let python = ensure_venv(&root)?;
+    let out = root.join("target/wheels");
+    run(Command::new(python.with_file_name("maturin"))
+        .current_dir(&root)
+        .args(["build", "--release", "-m", "python/Cargo.toml", "-o"])
+        .arg(&out)
+        .env("PATH", venv_path(&python)))?;
+    eprintln!(
+        "xtask: wheel in {}; install it with `pip install {}/shipsim-*.whl`",
+        out.display(),
+        out.display()
+    );
+    Ok(())
 }
 
 fn test(extra: &[String]) -> Result<()> {
@@ -124,7 +176,8 @@ fn test(extra: &[String]) -> Result<()> {
         .args(extra)
         .env("SHIPSIM_FMU_DIR", &fmu_dir))?;
     let python = ensure_venv(&root)?;
-    eprintln!("xtask: Python checks (FMPy, libcosim) in tests/python");
+    install_python_package(&root, &python)?;
+    eprintln!("xtask: Python checks (FMPy, libcosim, the shipsim package) in tests/python");
     let bin = root.join("target/release");
     run(Command::new(&python)
         .current_dir(&root)
@@ -236,9 +289,9 @@ fn export_osp() -> Result<()> {
 
 /// `cargo xtask bench`: master overhead against libcosim and FMPy (bench_master.py, extra
 /// arguments are passed on to it), every system's speed and per-instance profile with the
-/// pure-Rust RRS model loop when it exists (bench_systems.py), and campaign throughput, fixed
-/// cost and warm-up forks (bench_campaign.py); printed, and written to docs/bench.md
-/// (committed).
+/// pure-Rust RRS model loop (bench_systems.py), campaign throughput, fixed cost and warm-up
+/// forks (bench_campaign.py), and the Python package's overhead over the CLI
+/// (bench_python.py); printed, and written to docs/bench.md (committed).
 fn bench(extra: &[String]) -> Result<()> {
     let root = workspace_root();
     fmu::build_fmus(&root)?;
@@ -247,6 +300,7 @@ fn bench(extra: &[String]) -> Result<()> {
         .args(["build", "--release", "-p", "shipsim", "--bins"]))?;
     build_tests_bin(&root, "rrs-model-loop")?;
     let python = ensure_venv(&root)?;
+    install_python_package(&root, &python)?;
     let script = |name: &str, args: &[String]| -> Result<String> {
         let mut cmd = Command::new(&python);
         cmd.current_dir(&root)
@@ -269,11 +323,12 @@ fn bench(extra: &[String]) -> Result<()> {
     let master = script("bench_master.py", extra)?;
     let systems = script("bench_systems.py", &[])?;
     let campaigns = script("bench_campaign.py", &[])?;
+    let python_pkg = script("bench_python.py", &[])?;
     let doc = format!(
         "# Benchmarks\n\nWritten by `cargo xtask bench` (do not edit by hand). Ratios are \
          measured in one run on one machine; absolute times depend on it.\n\n\
          ## Master overhead per FMU-step (master/bench/bench_master.py)\n\n```text\n{master}```\n\n\
-         {systems}\n{campaigns}"
+         {systems}\n{campaigns}\n{python_pkg}"
     );
     std::fs::write(root.join("docs/bench.md"), doc)?;
     println!("wrote docs/bench.md");

@@ -505,9 +505,7 @@ fn execute_all(
         }
         Some(fork) => {
             let groups = fork.groups_of(todo);
-            groups
-                .par_iter()
-                .for_each(|g| keep(fork.run_group(ctx, g)));
+            groups.par_iter().for_each(|g| keep(fork.run_group(ctx, g)));
             Some(groups.iter().map(Vec::len).collect())
         }
     });

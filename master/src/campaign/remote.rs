@@ -56,11 +56,7 @@ impl Collector {
 
     /// How many runs are not done yet.
     pub fn pending(&self, campaign: &Campaign) -> usize {
-        campaign
-            .runs
-            .iter()
-            .filter(|r| self.to_do(r))
-            .count()
+        campaign.runs.iter().filter(|r| self.to_do(r)).count()
     }
 
     /// Not in the journal (or failed there, with `retry_failed`), and not recorded since.
@@ -71,11 +67,7 @@ impl Collector {
     /// The runs not done yet, as chunks of about `per_chunk` runs in index order. The runs of
     /// a warm-up group (`fork_at`) stay in one chunk, so that each warm-up runs once.
     pub fn chunks(&self, campaign: &Campaign, per_chunk: usize) -> Result<Vec<Vec<usize>>> {
-        let todo: Vec<&Run> = campaign
-            .runs
-            .iter()
-            .filter(|r| self.to_do(r))
-            .collect();
+        let todo: Vec<&Run> = campaign.runs.iter().filter(|r| self.to_do(r)).collect();
         // Grouping needs the model descriptions only when the campaign forks (which variables
         // are tunable); they are read without loading the binaries.
         let unpacked = match campaign.spec.fork_at {
@@ -138,8 +130,7 @@ impl Collector {
     /// Writes the run table and the derived table from the journal; returns the files and
     /// the run table.
     pub fn finish(&self, campaign: &Campaign) -> Result<(Vec<PathBuf>, Table)> {
-        let files =
-            output::write_tables(&campaign.spec, &campaign.runs, &self.journal, &self.dir)?;
+        let files = output::write_tables(&campaign.spec, &campaign.runs, &self.journal, &self.dir)?;
         Ok((files, run_table(campaign, &self.journal)))
     }
 }
@@ -184,8 +175,13 @@ impl Worker {
             .prefix("shipsim-series-")
             .tempdir()
             .map_err(|e| Error::io("cannot create a folder for the series files", e))?;
-        let records =
-            execute::run_collect(&self.campaign, &self.fmus, indices, opts, series.path().into())?;
+        let records = execute::run_collect(
+            &self.campaign,
+            &self.fmus,
+            indices,
+            opts,
+            series.path().into(),
+        )?;
         records
             .into_iter()
             .map(|r| {
