@@ -135,6 +135,12 @@ class Campaign:
         Ctrl-C stops cleanly: finished runs are kept, and ``KeyboardInterrupt`` is raised.
         """
         out = os.fspath(output) if output is not None else self.default_output()
+        if isinstance(client, str) and client == "local":
+            from ._dask import local_client
+
+            with local_client(jobs) as local:
+                return self.run(output, client=local, retry_failed=retry_failed,
+                                progress=progress, chunk_size=chunk_size, as_frame=as_frame)
         if client is not None:
             from ._dask import run_on_dask
 

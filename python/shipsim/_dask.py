@@ -20,9 +20,23 @@ recorded once.
 
 from __future__ import annotations
 
-from typing import Any, Dict, List, Optional, Tuple
+import contextlib
+import os
+from typing import Any, Dict, Iterator, List, Optional, Tuple
 
 from . import _native
+
+
+@contextlib.contextmanager
+def local_client(workers: Optional[int]) -> Iterator[Any]:
+    """An embedded Dask cluster on this machine: ``workers`` processes (default: every core)
+    of one thread each, closed on exit."""
+    from distributed import Client, LocalCluster
+
+    n = workers or os.cpu_count() or 1
+    with LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
+                      dashboard_address=":0") as cluster, Client(cluster) as client:
+        yield client
 
 
 def run_chunk(campaign: str, base_hash: str, runs: List[int]) -> List[Tuple[str, Optional[bytes]]]:

@@ -116,7 +116,7 @@ def test_reduced_polar_equals_the_cli(tmp_path):
 def cluster():
     distributed = pytest.importorskip("distributed")
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                                  dashboard_address=None, silence_logs=40) as cluster:
+                                  dashboard_address=":0", silence_logs=40) as cluster:
         yield cluster
 
 
@@ -213,3 +213,11 @@ def test_dask_resume_and_errors(cluster, local, forked, tmp_path):
     assert len((out / "runs.jsonl").read_text().splitlines()) == 16
     with pytest.raises(shipsim.SystemFileError):
         shipsim.Campaign.load(tmp_path / "missing.toml")
+
+
+def test_embedded_local_cluster(local, forked, tmp_path):
+    pytest.importorskip("distributed")
+    _, table = local
+    got = shipsim.Campaign.load(forked).run(tmp_path / "embedded", client="local", jobs=2,
+                                            progress=False)
+    same_table(table, got)

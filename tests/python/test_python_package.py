@@ -247,3 +247,17 @@ def test_readme_python_snippet(tmp_path):
     assert scope["df"].attrs["units"]["ship.roll"] == "rad"
     assert scope["md"].variable("significant_wave_height").unit == "m"
     assert len(scope["table"]) == 12
+
+
+def test_osp_xml_system_equals_toml(tmp_path):
+    """System.load reads OSP OspSystemStructure.xml too: a system exported by
+    `shipsim export-osp` runs bit for bit like its TOML (same parameters, connections, step)."""
+    toml = ROOT / "systems" / "autopilot_current.toml"
+    xml = tmp_path / "OspSystemStructure.xml"
+    subprocess.run([BIN, "export-osp", str(toml), "-o", str(xml)], check=True, capture_output=True)
+    a, b = shipsim.System.load(toml), shipsim.System.load(xml)
+    assert list(a.instances) == list(b.instances)
+    every = [f"{name}.*" for name in a.instances]
+    ra, rb = a.run(stop_time=120, variables=every), b.run(stop_time=120, variables=every)
+    assert len(ra) > 100 and len(ra.columns) > 5
+    pd.testing.assert_frame_equal(ra, rb, check_exact=True)
