@@ -10,7 +10,9 @@
 //! 3. the connections, their types and units, and unconnected inputs (`connections.rs`),
 //! 4. the events (`events.rs`),
 //! 5. the recorded outputs (`outputs.rs`),
-//! 6. the stepping order, algebraic loops and dropped last steps (`order.rs`).
+//! 6. the stepping order, algebraic loops and dropped last steps (`order.rs`),
+//! 7. the FMUs themselves: GUIDs shared by different models (`guids.rs`) and variability the
+//!    standard forbids (`variability.rs`), both warnings.
 //!
 //! Every error names the file, the line when known, the instance and the variable, with
 //! close-name suggestions; all errors are returned together.
@@ -22,9 +24,11 @@ use std::collections::HashMap;
 
 mod connections;
 mod events;
+mod guids;
 mod order;
 mod outputs;
 mod values;
+mod variability;
 
 /// The base-step grid of a run.
 struct Grid {
@@ -66,6 +70,8 @@ impl System {
         let outputs = c.outputs();
         let order = c.order(&connections);
         c.step_multiples(grid.n_steps);
+        c.shared_guids();
+        c.invalid_variability();
         if !c.errors.is_empty() {
             return Err(if c.errors.len() == 1 {
                 c.errors.pop().unwrap()
