@@ -67,6 +67,10 @@ enum Command {
         /// Override the algorithm: jacobi or gauss-seidel.
         #[arg(long)]
         algorithm: Option<String>,
+        /// Make a unit mismatch on a connection an error in any system file (an OSP
+        /// OspSystemStructure.xml only warns, as libcosim runs it; the native TOML always errs).
+        #[arg(long)]
+        strict_units: bool,
         /// Show all FMU log messages and switch FMU debug logging on.
         #[arg(long, short)]
         verbose: bool,
@@ -87,6 +91,10 @@ enum Command {
         system: PathBuf,
         #[arg(long = "set", value_name = "INST.VAR=VALUE")]
         set: Vec<String>,
+        /// Make a unit mismatch on a connection an error in any system file (an OSP
+        /// OspSystemStructure.xml only warns, as libcosim runs it; the native TOML always errs).
+        #[arg(long)]
+        strict_units: bool,
     },
     /// Show an FMU's variables, units and capabilities.
     Inspect {
@@ -158,7 +166,11 @@ fn dispatch(cmd: Command) -> shipsim::Result<()> {
             print!("{}", shipsim::inspect::inspect(&fmu)?);
             Ok(())
         }
-        Command::Check { system, set } => check(&system, &set),
+        Command::Check {
+            system,
+            set,
+            strict_units,
+        } => check(&system, &set, strict_units),
         Command::Run {
             system,
             stop_time,
@@ -168,6 +180,7 @@ fn dispatch(cmd: Command) -> shipsim::Result<()> {
             profile_every,
             set,
             algorithm,
+            strict_units,
             verbose,
             quiet,
             checkpoint_at,
@@ -185,6 +198,7 @@ fn dispatch(cmd: Command) -> shipsim::Result<()> {
             if let Some(a) = algorithm {
                 sys.algorithm = parse_algorithm(&a)?;
             }
+            sys.strict_units |= strict_units;
             let flags = RunFlags {
                 output,
                 no_output,
@@ -252,9 +266,10 @@ fn print_warnings(warnings: &[String]) {
 
 /// `shipsim check`: the system validated against the FMUs' model descriptions (binaries are
 /// not loaded).
-fn check(system: &Path, set: &[String]) -> shipsim::Result<()> {
+fn check(system: &Path, set: &[String], strict_units: bool) -> shipsim::Result<()> {
     let mut sys = System::load(system)?;
     sys.apply_overrides(set)?;
+    sys.strict_units |= strict_units;
     let mut unpacked = Vec::new();
     for inst in &sys.instances {
         sys.require_fmu(inst)?;

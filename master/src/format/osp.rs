@@ -9,7 +9,7 @@
 
 use super::{collected, line_of};
 use crate::error::{Error, Result};
-use crate::model_description::{Causality, ModelDescription};
+use crate::model_description::{Causality, ModelDescription, VarType};
 use crate::system::{
     Algorithm, ConnectionSpec, InstanceSpec, OutputSpec, Plan, PlanConnection, System, TypedValue,
     Value, ValueSpec, VarRef,
@@ -200,6 +200,7 @@ pub fn parse(path: &Path, text: &str) -> Result<System> {
             variables: None,
             decimation: 1,
         },
+        strict_units: false,
     })
 }
 
@@ -500,7 +501,9 @@ pub fn write(sys: &System, out: &Path) -> Result<Vec<String>> {
     let mds: Vec<_> = unpacked.iter().map(|u| &u.model_description).collect();
     let plan = sys.validate(&mds)?;
     let scenario_path = out.with_file_name("scenario.json");
-    let warnings = lost_in_export(sys, &scenario_path);
+    let mut warnings = plan.warnings.clone();
+    warnings.extend(lost_in_export(sys, &scenario_path));
+    warnings.extend(enumerations_left_out(sys, &plan, &mds));
     let base = out.parent().unwrap_or(Path::new("."));
     let base = if base.as_os_str().is_empty() {
         Path::new(".")
@@ -515,7 +518,7 @@ pub fn write(sys: &System, out: &Path) -> Result<Vec<String>> {
     let _ = writeln!(x, "    <EndTime>{:?}</EndTime>", plan.stop_time);
     let _ = writeln!(x, "    <BaseStepSize>{:?}</BaseStepSize>", sys.step_size);
     x.push_str("    <Algorithm>fixedStep</Algorithm>\n");
-    write_simulators(&mut x, sys, &plan, base);
+    write_simulators(&mut x, sys, &plan, &mds, base);
     write_functions(&mut x, &plan.connections);
     write_connections(&mut x, sys, &plan.connections, &mds);
     x.push_str("</OspSystemStructure>\n");
@@ -551,8 +554,15 @@ fn lost_in_export(sys: &System, scenario_path: &Path) -> Vec<String> {
     warnings
 }
 
-/// `<Simulators>`: source relative to the output folder, stepSize, typed initial values.
-fn write_simulators(x: &mut String, sys: &System, plan: &Plan, base: &Path) {
+/// `<Simulators>`: source relative to the output folder, stepSize, typed initial values
+/// (Enumeration variables left out, see [`enumerations_left_out`]).
+fn write_simulators(
+    x: &mut String,
+    sys: &System,
+    plan: &Plan,
+    mds: &[&ModelDescription],
+    base: &Path,
+) {
     x.push_str("    <Simulators>\n");
     for (i, inst) in sys.instances.iter().enumerate() {
         let _ = write!(
@@ -562,7 +572,11 @@ fn write_simulators(x: &mut String, sys: &System, plan: &Plan, base: &Path) {
             esc(&relative(&inst.fmu, base)),
             inst.step_multiple as f64 * sys.step_size
         );
-        let svs = &plan.instances[i].start_values;
+        let svs: Vec<_> = plan.instances[i]
+            .start_values
+            .iter()
+            .filter(|sv| !is_enumeration(mds[i], &sv.variable))
+            .collect();
         if svs.is_empty() {
             x.push_str("/>\n");
             continue;
@@ -584,6 +598,61 @@ fn write_simulators(x: &mut String, sys: &System, plan: &Plan, base: &Path) {
         x.push_str("            </InitialValues>\n        </Simulator>\n");
     }
     x.push_str("    </Simulators>\n");
+}
+
+/// The variable is an Enumeration (its values travel as Integer in the plan).
+fn is_enumeration(md: &ModelDescription, variable: &str) -> bool {
+    md.model_variables
+        .variables
+        .iter()
+        .any(|v| v.name == variable && v.var_type() == Some(VarType::Enumeration))
+}
+
+/// The variable with this value reference (an input, or not) is an Enumeration.
+fn is_enumeration_vr(md: &ModelDescription, vr: u32, input: bool) -> bool {
+    md.model_variables.variables.iter().any(|v| {
+        v.value_reference == vr
+            && (v.causality == Causality::Input) == input
+            && v.var_type() == Some(VarType::Enumeration)
+    })
+}
+
+/// A connection with an Enumeration at either end.
+fn touches_enumeration(c: &PlanConnection, mds: &[&ModelDescription]) -> bool {
+    is_enumeration_vr(mds[c.from_instance], c.from_vr, false)
+        || is_enumeration_vr(mds[c.to_instance], c.to_vr, true)
+}
+
+/// libcosim ignores FMI 2.0 Enumeration variables: its FMU import leaves them out of the model
+/// description with the log warning "FMI 2.0 Enumeration variable type not supported"
+/// (libcosim `src/cosim/fmi/v2/fmu.cpp`), so an initial value or a connection that names one
+/// makes the whole file fail ("No such variable"), whichever element carries the value (its
+/// schema has no `<Enumeration>` initial value either). Such values and connections are left
+/// out of the file, with this warning: in libcosim those variables keep the FMU's start values.
+fn enumerations_left_out(sys: &System, plan: &Plan, mds: &[&ModelDescription]) -> Vec<String> {
+    let mut left: Vec<String> = Vec::new();
+    for (i, inst) in plan.instances.iter().enumerate() {
+        for sv in &inst.start_values {
+            if is_enumeration(mds[i], &sv.variable) {
+                left.push(format!("the value of {}.{}", inst.name, sv.variable));
+            }
+        }
+    }
+    for c in &plan.connections {
+        if touches_enumeration(c, mds) {
+            left.push(format!("the connection {}", c.name));
+        }
+    }
+    if left.is_empty() {
+        return left;
+    }
+    vec![format!(
+        "{}: libcosim ignores Enumeration variables (\"FMI 2.0 Enumeration variable type not \
+         supported\"), so OspSystemStructure.xml leaves out {}; in libcosim they keep the FMU's \
+         start values",
+        sys.source.display(),
+        left.join(", ")
+    )]
 }
 
 fn is_transformed(c: &PlanConnection) -> bool {
@@ -632,6 +701,9 @@ fn write_connections(
             .unwrap_or_default()
     };
     for (k, c) in connections.iter().enumerate() {
+        if touches_enumeration(c, mds) {
+            continue;
+        }
         let fname = esc(&var_name(c.from_instance, c.from_vr, false));
         let tname = esc(&var_name(c.to_instance, c.to_vr, true));
         let fi = esc(&sys.instances[c.from_instance].name);

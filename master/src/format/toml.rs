@@ -174,6 +174,7 @@ pub fn parse(path: &Path, text: &str) -> Result<System> {
         connections,
         events,
         output,
+        strict_units: true,
     })
 }
 

@@ -146,6 +146,12 @@ pub struct System {
     pub connections: Vec<ConnectionSpec>,
     pub events: Vec<EventSpec>,
     pub output: OutputSpec,
+    /// Units that do not match on a connection are an error (true) or a warning (false). The
+    /// native TOML reader sets it (a connection between different quantities says
+    /// `convert = true` there); the OSP reader does not, because libcosim runs OSP files
+    /// without a unit check and third-party FMUs declare units loosely (`dimensionless` for an
+    /// energy). `shipsim run/check --strict-units` sets it for any file.
+    pub strict_units: bool,
 }
 
 impl System {

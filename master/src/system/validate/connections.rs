@@ -22,6 +22,11 @@ struct Ends<'c> {
     to: (usize, usize),
 }
 
+/// BaseUnit exponents (kg, m, s, A, K, mol, cd, rad) that differ in the last one only.
+fn only_rad_differs(a: [i32; 8], b: [i32; 8]) -> bool {
+    a[..7] == b[..7] && a[7] != b[7]
+}
+
 /// Converts a Real unit to SI: (exponents, factor, offset) if the unit is defined.
 fn unit_si(md: &ModelDescription, unit: &str) -> Option<([i32; 8], f64, f64)> {
     md.unit(unit)
@@ -155,6 +160,11 @@ impl<'a> Checker<'a> {
 
     /// Units (FMI 2.0 section 2.2.2: BaseUnit exponents must agree). A conversion factor or
     /// offset without gain/offset is a warning that gives them; `convert = true` skips the check.
+    /// Exponents that differ are an error when [`System::strict_units`](crate::system::System)
+    /// is set (the native TOML) and a warning otherwise (OSP files, which libcosim runs without
+    /// a unit check). Exponents that differ only in `rad` are a warning either way: FMI 2.0
+    /// makes `rad` a base-unit exponent only to tell `rad/s` from `Hz`, and FMUs declare angles
+    /// with it (`rad`, rad = 1) and without it (PythonFMU's `radian`, rad = 0).
     fn check_units(&mut self, c: &Ends) -> bool {
         let (ft, tt) = self.types(c);
         if ft != VarType::Real || tt != VarType::Real || c.spec.convert {
@@ -172,10 +182,7 @@ impl<'a> Checker<'a> {
         match (unit_si(fmd, fu), unit_si(tmd, tu)) {
             (Some((fe, ff, fo)), Some((te, tf, to))) => {
                 if fe != te {
-                    let e = self.err(line, format!(
-                        "connection {name}: incompatible units: '{}' is in {fu} but '{}' is in {tu}", spec.from, spec.to));
-                    self.errors.push(e);
-                    return false;
+                    return self.unit_mismatch(c, fu, tu, only_rad_differs(fe, te));
                 } else if (ff != tf || fo != to) && spec.gain == 1.0 && spec.offset == 0.0 {
                     let g = ff / tf;
                     let o = (fo - to) / tf;
@@ -188,6 +195,39 @@ impl<'a> Checker<'a> {
                 "{}: connection {name} connects unit '{fu}' to unit '{tu}' (not comparable: no BaseUnit)", self.loc(line))),
         }
         true
+    }
+
+    /// BaseUnit exponents that differ: an error in strict mode unless only `rad` differs, else a
+    /// warning that says how the other mode would treat it. Returns whether the connection stays.
+    fn unit_mismatch(&mut self, c: &Ends, fu: &str, tu: &str, only_rad: bool) -> bool {
+        let (name, line, spec) = (&c.name, c.spec.line, &c.spec);
+        let what = format!(
+            "connection {name}: incompatible units: '{}' is in {fu} but '{}' is in {tu}",
+            spec.from, spec.to
+        );
+        if only_rad {
+            self.warnings.push(format!(
+                "{}: {what}, which differ only in the rad exponent (an angle declared with and without rad); connected as is",
+                self.loc(line)
+            ));
+            true
+        } else if self.sys.strict_units {
+            // `convert` is a key of the native TOML; an OSP file has no such attribute.
+            let toml = self.sys.source.extension().is_some_and(|e| e == "toml");
+            let hint = match toml {
+                true => "; if the gain converts between these quantities, set convert = true",
+                false => "",
+            };
+            let e = self.err(line, format!("{what}{hint}"));
+            self.errors.push(e);
+            false
+        } else {
+            self.warnings.push(format!(
+                "{}: {what}; connected as is, as libcosim does (--strict-units makes this an error)",
+                self.loc(line)
+            ));
+            true
+        }
     }
 
     /// An input is driven by one connection at most.
