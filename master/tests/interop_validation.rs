@@ -29,27 +29,11 @@ fn md(name: &str) -> ModelDescription {
     ModelDescription::parse(&md_text(name)).unwrap()
 }
 
-const UNITS_OSP: &str = r#"<?xml version="1.0" encoding="utf-8"?>
-<OspSystemStructure xmlns="http://opensimulationplatform.com/MSMI/OSPSystemStructure" version="0.1">
-    <StartTime>0.0</StartTime>
-    <EndTime>1.0</EndTime>
-    <BaseStepSize>0.0625</BaseStepSize>
-    <Simulators>
-        <Simulator name="src" source="RadianSource.fmu"/>
-        <Simulator name="sink" source="RadSink.fmu"/>
-    </Simulators>
-    <Connections>
-        <VariableConnection>
-            <Variable simulator="src" name="angle"/>
-            <Variable simulator="sink" name="angle_in"/>
-        </VariableConnection>
-        <VariableConnection>
-            <Variable simulator="sink" name="energy_in"/>
-            <Variable simulator="src" name="work"/>
-        </VariableConnection>
-    </Connections>
-</OspSystemStructure>
-"#;
+/// The OSP file of the units case (tests/fixtures/fmus/systems), also run by
+/// tests/python/test_fixture_fmus.py in shipsim and libcosim.
+fn units_osp() -> String {
+    std::fs::read_to_string(fixture_dir("systems/units_OspSystemStructure.xml")).unwrap()
+}
 
 fn units_mds() -> [ModelDescription; 2] {
     [md("RadianSource"), md("RadSink")]
@@ -64,7 +48,7 @@ fn unit_warnings(warnings: &[String]) -> Vec<&String> {
 
 #[test]
 fn osp_unit_mismatches_are_warnings_unless_strict() {
-    let sys = osp::parse(Path::new("/sys/OspSystemStructure.xml"), UNITS_OSP).unwrap();
+    let sys = osp::parse(Path::new("/sys/OspSystemStructure.xml"), &units_osp()).unwrap();
     assert!(
         !sys.strict_units,
         "the OSP reader does not ask for strict units"
@@ -95,23 +79,12 @@ fn osp_unit_mismatches_are_warnings_unless_strict() {
 
 #[test]
 fn toml_unit_mismatches_stay_errors_with_the_convert_hint() {
-    let text = r#"
-connections = ["src.work -> sink.energy_in", "src.angle -> sink.angle_in"]
-[simulation]
-stop_time = 1.0
-step_size = 0.0625
-[[instances]]
-name = "src"
-fmu = "RadianSource.fmu"
-[[instances]]
-name = "sink"
-fmu = "RadSink.fmu"
-"#;
-    let sys = toml::parse(Path::new("/sys/units.toml"), text).unwrap();
+    let text = std::fs::read_to_string(fixture_dir("systems/units.toml")).unwrap();
+    let sys = toml::parse(Path::new("/sys/units.toml"), &text).unwrap();
     assert!(sys.strict_units);
     let [a, b] = units_mds();
     let e = sys.validate(&[&a, &b]).unwrap_err().to_string();
-    assert!(e.contains("/sys/units.toml:2"), "{e}");
+    assert!(e.contains("/sys/units.toml:4"), "{e}");
     assert!(
         e.contains("incompatible units: 'src.work' is in dimensionless but 'sink.energy_in' is in kg.m2/s2; if the gain converts between these quantities, set convert = true"),
         "{e}"

@@ -50,8 +50,9 @@ def built(tmp_path_factory):
 
 
 def copy_fmus(built, names, dest):
+    """Copies the named fixtures, and our FMUs (from SHIPSIM_FMU_DIR) for other names, into dest."""
     for n in names:
-        shutil.copy(built[n], dest / f"{n}.fmu")
+        shutil.copy(built[n] if n in built else our_fmu(n), dest / f"{n}.fmu")
 
 
 def toml_value(v):
@@ -176,8 +177,7 @@ def test_export_osp_with_enumeration_value_runs_in_libcosim(built, tmp_path):
     for one made the whole exported file fail: "No such variable: m:enumeration_input". The
     export leaves it out with a warning; libcosim runs the file, with results equal to shipsim's
     run of the same file (bit for bit; the Real outputs, which libcosim_runner reads)."""
-    copy_fmus(built, ["Feedthrough"], tmp_path)
-    shutil.copy(our_fmu("SteeringGear"), tmp_path / "SteeringGear.fmu")
+    copy_fmus(built, ["Feedthrough", "SteeringGear"], tmp_path)
     (tmp_path / "ft.toml").write_text(textwrap.dedent("""
         connections = ["ft.real_continuous_output -> gear.rudder_command", "gear.rudder_angle -> ft.real_discrete_input"]
         [simulation]
@@ -236,28 +236,6 @@ def keep_columns(csv_path, columns, dest):
     return dest
 
 
-UNITS_OSP = """<?xml version="1.0" encoding="utf-8"?>
-<OspSystemStructure xmlns="http://opensimulationplatform.com/MSMI/OSPSystemStructure" version="0.1">
-    <StartTime>0.0</StartTime>
-    <EndTime>2.0</EndTime>
-    <BaseStepSize>0.0625</BaseStepSize>
-    <Algorithm>fixedStep</Algorithm>
-    <Simulators>
-        <Simulator name="src" source="RadianSource.fmu" stepSize="0.0625"/>
-        <Simulator name="sink" source="RadSink.fmu" stepSize="0.0625"/>
-    </Simulators>
-    <Connections>
-        <VariableConnection>
-            <Variable simulator="src" name="angle"/>
-            <Variable simulator="sink" name="angle_in"/>
-        </VariableConnection>
-        <VariableConnection>
-            <Variable simulator="src" name="work"/>
-            <Variable simulator="sink" name="energy_in"/>
-        </VariableConnection>
-    </Connections>
-</OspSystemStructure>
-"""
 
 
 def test_units_of_a_third_party_osp_file_warn_and_strict_units_errs(built, tmp_path):
@@ -267,7 +245,7 @@ def test_units_of_a_third_party_osp_file_warn_and_strict_units_errs(built, tmp_p
     warning even then (an angle declared with and without the rad exponent)."""
     copy_fmus(built, ["RadianSource", "RadSink"], tmp_path)
     osp = tmp_path / "OspSystemStructure.xml"
-    osp.write_text(UNITS_OSP)
+    shutil.copy(fixtures.FIXTURES / "systems" / "units_OspSystemStructure.xml", osp)
     r = shipsim("check", osp)
     assert "OK (2 instances, 2 connections" in r.stdout
     warnings = [w for w in r.stderr.splitlines() if "incompatible units" in w]
@@ -295,24 +273,14 @@ def test_units_in_our_own_toml_stay_an_error(built, tmp_path):
     """In the native TOML, where `convert = true` exists, a dimension mismatch is an error that
     suggests it; with convert = true the system is accepted."""
     copy_fmus(built, ["RadianSource", "RadSink"], tmp_path)
-    system = textwrap.dedent("""
-        connections = [{ from = "src.work", to = "sink.energy_in" CONVERT}, "src.angle -> sink.angle_in"]
-        [simulation]
-        stop_time = 1.0
-        step_size = 0.0625
-        [[instances]]
-        name = "src"
-        fmu = "RadianSource.fmu"
-        [[instances]]
-        name = "sink"
-        fmu = "RadSink.fmu"
-    """)
-    (tmp_path / "units.toml").write_text(system.replace("CONVERT", ""))
+    system = (fixtures.FIXTURES / "systems" / "units.toml").read_text()
+    (tmp_path / "units.toml").write_text(system)
     r = shipsim("check", tmp_path / "units.toml", check=False)
     assert r.returncode == 1
     assert "incompatible units: 'src.work' is in dimensionless but 'sink.energy_in' is in kg.m2/s2" in r.stderr
     assert "set convert = true" in r.stderr
-    (tmp_path / "units.toml").write_text(system.replace("CONVERT", ", convert = true"))
+    converted = '{ from = "src.work", to = "sink.energy_in", convert = true }'
+    (tmp_path / "units.toml").write_text(system.replace('"src.work -> sink.energy_in"', converted))
     r = shipsim("check", tmp_path / "units.toml")
     assert "only in the rad exponent" in r.stderr and "OK (2 instances, 2 connections" in r.stdout
 
@@ -366,8 +334,7 @@ def test_fixtures_coupled_with_our_steering_gear_equal_libcosim(built, tmp_path)
     a SteeringGear (rad), whose rudder angle drives RadSink; BouncingBall's height is recorded
     beside them. shipsim's run of the TOML equals libcosim's run of the exported file bit for
     bit (the unit warnings do not change the numbers)."""
-    copy_fmus(built, ["RadianSource", "RadSink", "BouncingBall"], tmp_path)
-    shutil.copy(our_fmu("SteeringGear"), tmp_path / "SteeringGear.fmu")
+    copy_fmus(built, ["RadianSource", "RadSink", "BouncingBall", "SteeringGear"], tmp_path)
     (tmp_path / "chain.toml").write_text(textwrap.dedent("""
         connections = ["src.angle -> gear.rudder_command", "gear.rudder_angle -> sink.angle_in"]
         [simulation]
