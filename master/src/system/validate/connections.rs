@@ -162,9 +162,10 @@ impl<'a> Checker<'a> {
     /// offset without gain/offset is a warning that gives them; `convert = true` skips the check.
     /// Exponents that differ are an error when [`System::strict_units`](crate::system::System)
     /// is set (the native TOML) and a warning otherwise (OSP files, which libcosim runs without
-    /// a unit check). Exponents that differ only in `rad` are a warning either way: FMI 2.0
-    /// makes `rad` a base-unit exponent only to tell `rad/s` from `Hz`, and FMUs declare angles
-    /// with it (`rad`, rad = 1) and without it (PythonFMU's `radian`, rad = 0).
+    /// a unit check). Exponents that differ only in `rad` are a warning either way: the SI
+    /// defines the radian as m/m, of dimension one, FMI 2.0 lists `rad` as an exponent of its
+    /// own (sec. 2.2.2, `BaseUnit`), and FMUs declare angles with it (`rad`, rad = 1) and
+    /// without it (PythonFMU's `radian`, rad = 0).
     fn check_units(&mut self, c: &Ends) -> bool {
         let (ft, tt) = self.types(c);
         if ft != VarType::Real || tt != VarType::Real || c.spec.convert {
