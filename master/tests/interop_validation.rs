@@ -166,8 +166,11 @@ fn export_osp_leaves_enumeration_values_out() {
         &[("modelDescription.xml", md_text("Feedthrough").into_bytes())],
     );
     let toml_path = dir.path().join("ft.toml");
-    let text = "[simulation]\nstop_time = 1.0\nstep_size = 0.0625\n[[instances]]\nname = \"m\"\n\
-                fmu = \"Feedthrough.fmu\"\nparameters = { enumeration_input = 2, integer_input = 3 }\n";
+    let text = "connections = [\"m.enumeration_output -> n.enumeration_input\", \
+                \"m.integer_output -> n.integer_input\"]\n\
+                [simulation]\nstop_time = 1.0\nstep_size = 0.0625\n[[instances]]\nname = \"m\"\n\
+                fmu = \"Feedthrough.fmu\"\nparameters = { enumeration_input = 2, integer_input = 3 }\n\
+                [[instances]]\nname = \"n\"\nfmu = \"Feedthrough.fmu\"\n";
     let sys = toml::parse(&toml_path, text).unwrap();
     let out = dir.path().join("osp/OspSystemStructure.xml");
     let warnings = osp::write(&sys, &out).unwrap();
@@ -185,10 +188,13 @@ fn export_osp_leaves_enumeration_values_out() {
         .collect();
     assert_eq!(w.len(), 1, "{warnings:?}");
     assert!(
-        w[0].contains("the value of m.enumeration_input"),
+        w[0].contains("the value of m.enumeration_input, the connection m.enumeration_output -> n.enumeration_input"),
         "{}",
         w[0]
     );
+    // The Integer connection stays, the Enumeration one is left out.
+    assert!(xml.contains(r#"<Variable simulator="m" name="integer_output" causality="output"/>"#));
+    assert!(!xml.contains("enumeration_output"), "{xml}");
     // What is left reads back as the same system without the Enumeration value.
     let back = osp::parse(&out, &xml).unwrap();
     let values: Vec<_> = back.instances[0]

@@ -38,7 +38,7 @@ from fmpy import simulate_fmu
 from fmpy.validation import validate_fmu
 
 import fixtures
-from test_master_interop import our_fmu, read_csv, shipsim
+from test_master_interop import libcosim_rows, our_fmu, read_csv, shipsim
 
 H = 0.0625
 
@@ -315,6 +315,28 @@ def test_shared_guid_warns_in_check_and_export(built, tmp_path):
         (tmp_path / "same.toml").write_text(system(a, b))
         r = shipsim("check", tmp_path / "same.toml")
         assert "GUID" not in r.stderr, r.stderr
+
+
+def test_why_shared_guids_warn_libcosim_runs_one_model_for_both(built, tmp_path):
+    """The reason for the warning, reproduced with the libcosim of the test environment: in the
+    exported file of SharedGuidA and SharedGuidB, libcosim gives instance b the results of
+    SharedGuidA (y = t) instead of its own (y = -t^2), which shipsim gives."""
+    copy_fmus(built, ["SharedGuidA", "SharedGuidB"], tmp_path)
+    (tmp_path / "two.toml").write_text(one_instance_toml("SharedGuidA", 1.0, {}) + textwrap.dedent("""
+        [[instances]]
+        name = "b"
+        fmu = "SharedGuidB.fmu"
+        [output]
+        variables = ["m.y", "b.y"]
+    """))
+    shipsim("run", tmp_path / "two.toml", "-o", tmp_path / "two.csv")
+    shipsim("export-osp", tmp_path / "two.toml", "-o", tmp_path / "OspSystemStructure.xml")
+    header, rows = read_csv(tmp_path / "two.csv")
+    assert header == ["time", "m.y", "b.y"]
+    for t, a, b in rows:
+        assert (a, b) == (t, -t * t)
+    theirs = libcosim_rows(tmp_path / "OspSystemStructure.xml", header, len(rows) - 1)
+    assert [b for _, b in theirs] == [t for t, _, _ in rows[1:]]
 
 
 def test_integer_declared_continuous_warns_and_runs(built, tmp_path):
