@@ -123,8 +123,12 @@ fn in_range(
         return Ok(());
     }
     let shown = written.to_string();
-    let converted = match md.real_unit(sv) {
-        Some(u) if shown != x.to_string() => format!(" (= {x} {u})"),
+    let typed_unit = match written {
+        Value::Text(s) | Value::String(s) => Quantity::parse(s).ok().and_then(|q| q.unit),
+        _ => None,
+    };
+    let converted = match (md.real_unit(sv), typed_unit) {
+        (Some(u), Some(t)) if t != u => format!(" (= {x} {u})"),
         _ => String::new(),
     };
     let lo = min.map_or("-inf".to_string(), |v| v.to_string());
