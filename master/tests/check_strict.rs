@@ -5,19 +5,23 @@
 
 mod common;
 
-use common::{fmu_dir, our_fmu};
+use common::our_fmu;
 use shipsim::model_description::ModelDescription;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-/// rrs.toml with its FMUs taken from $SHIPSIM_FMU_DIR, written into `dir`.
-fn rrs_system(dir: &Path) -> PathBuf {
-    our_fmu("RrsAutopilot");
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
-    let text = std::fs::read_to_string(root.join("systems/rrs.toml")).unwrap();
-    let p = dir.join("rrs.toml");
-    let fmus = format!("{}/", fmu_dir().display());
-    std::fs::write(&p, text.replace("../target/fmu/", &fmus)).unwrap();
+/// Waves and the RRS autopilot, unconnected (the autopilot's inputs keep their start values).
+fn system(dir: &Path) -> PathBuf {
+    let (waves, autopilot) = (our_fmu("Waves"), our_fmu("RrsAutopilot"));
+    let text = format!(
+        "[simulation]\nstop_time = 1.0\nstep_size = 0.1\n\n\
+         [[instances]]\nname = \"waves\"\nfmu = \"{}\"\n\n\
+         [[instances]]\nname = \"autopilot\"\nfmu = \"{}\"\n",
+        waves.display(),
+        autopilot.display()
+    );
+    let p = dir.join("sys.toml");
+    std::fs::write(&p, text).unwrap();
     p
 }
 
@@ -33,7 +37,7 @@ fn shipsim(args: &[&str], system: &Path, extra: &[&str]) -> Output {
 #[test]
 fn check_and_run_refuse_values_outside_the_declared_range() {
     let dir = tempfile::tempdir().unwrap();
-    let sys = rrs_system(dir.path());
+    let sys = system(dir.path());
     let csv = dir.path().join("out.csv");
     let csv_arg = csv.to_str().unwrap();
     // (set, the range the FMU declares: RrsAutopilot roll_mode 0..2, Waves H_s 0..30 m)

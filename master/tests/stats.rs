@@ -28,6 +28,16 @@ fn stats(csv: &Path, args: &[&str]) -> Output {
         .unwrap()
 }
 
+/// `shipsim stats` fails with a message containing every part.
+fn refused(csv: &Path, args: &[&str], parts: &[&str]) {
+    let out = stats(csv, args);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{args:?} passed");
+    for part in parts {
+        assert!(err.contains(part), "{part} not in: {err}");
+    }
+}
+
 fn json(csv: &Path, args: &[&str]) -> serde_json::Value {
     let mut a = args.to_vec();
     a.push("--json");
@@ -163,22 +173,13 @@ fn columns_by_name_and_glob_and_the_table() {
     );
 
     // Errors: an unknown column (with a suggestion), an empty window, a bad window.
-    let out = stats(&csv, &["--columns", "ship.aa"]);
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert!(
-        !out.status.success()
-            && err.contains("no column matches 'ship.aa'")
-            && err.contains("'ship.a'"),
-        "{err}"
+    refused(
+        &csv,
+        &["--columns", "ship.aa"],
+        &["no column matches 'ship.aa'", "'ship.a'"],
     );
-    let out = stats(&csv, &["--window", "20:30"]);
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert!(
-        !out.status.success()
-            && err.contains("no sample in the window [20, 30]")
-            && err.contains("t = 0 .. 10"),
-        "{err}"
-    );
+    let empty = ["no sample in the window [20, 30]", "t = 0 .. 10"];
+    refused(&csv, &["--window", "20:30"], &empty);
     assert!(!stats(&csv, &["--window", "5"]).status.success());
     assert!(!stats(&csv, &["--window", "6:5"]).status.success());
 }

@@ -320,12 +320,12 @@ fn rrs_system(dir: &Path) -> std::path::PathBuf {
 }
 
 fn run(system: &Path, csv: &Path, sets: &[&str]) -> std::process::Output {
-    let mut cmd = Command::new(env!("CARGO_BIN_EXE_shipsim"));
-    cmd.arg("run").arg(system).arg("-q").arg("-o").arg(csv);
+    let csv = csv.to_str().unwrap();
+    let mut args = vec!["-q", "-o", csv];
     for s in sets {
-        cmd.arg("--set").arg(s);
+        args.extend(["--set", s]);
     }
-    cmd.output().unwrap()
+    shipsim("run", system, &args)
 }
 
 #[test]
@@ -430,12 +430,7 @@ fn a_system_file_with_knots_and_an_event_in_degrees_runs() {
         &format!("{:?}", 10.0 * (PI / 180.0)),
     );
     for s in [&with_units, &si] {
-        let out = Command::new(env!("CARGO_BIN_EXE_shipsim"))
-            .arg("run")
-            .arg(s)
-            .arg("-q")
-            .output()
-            .unwrap();
+        let out = shipsim("run", s, &["-q"]);
         assert!(
             out.status.success(),
             "{}",
@@ -454,36 +449,37 @@ fn a_system_file_with_knots_and_an_event_in_degrees_runs() {
 
     // A wrong unit fails with file:line, instance, variable, value and both units.
     let bad = small_system(d, "bad", r#""15 kg""#, "0.0", "0.1", "0.0");
-    let out = Command::new(env!("CARGO_BIN_EXE_shipsim"))
-        .arg("check")
-        .arg(&bad)
-        .output()
-        .unwrap();
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert!(!out.status.success());
     let at = format!("{}:8:", bad.display());
-    for part in [
-        at.as_str(),
-        "instance 'waves'",
-        "'ship_speed'",
-        "15 kg",
-        "'kg'",
-        "'m/s'",
-    ] {
+    let parts = ["instance 'waves'", "'ship_speed'", "15 kg", "'kg'", "'m/s'"];
+    refused(
+        &shipsim("check", &bad, &[]),
+        &[&[at.as_str()], &parts[..]].concat(),
+    );
+    let bad_event = small_system(d, "bad_event", "1.0", "0.0", "0.1", r#""10 m/s""#);
+    let at = format!("{}:15:", bad_event.display());
+    let parts = ["'gear.rudder_command'", "10 m/s", "'m/s'", "'rad'"];
+    refused(
+        &shipsim("run", &bad_event, &[]),
+        &[&[at.as_str()], &parts[..]].concat(),
+    );
+    assert!(!d.join("bad_event.csv").exists());
+}
+
+/// `shipsim COMMAND SYSTEM ARGS...`.
+fn shipsim(command: &str, system: &Path, args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_shipsim"))
+        .arg(command)
+        .arg(system)
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+/// The command failed with a message containing every part.
+fn refused(out: &std::process::Output, parts: &[&str]) {
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "passed: {err}");
+    for part in parts {
         assert!(err.contains(part), "{part} not in: {err}");
     }
-    let bad_event = small_system(d, "bad_event", "1.0", "0.0", "0.1", r#""10 m/s""#);
-    let out = Command::new(env!("CARGO_BIN_EXE_shipsim"))
-        .arg("run")
-        .arg(&bad_event)
-        .output()
-        .unwrap();
-    let err = String::from_utf8_lossy(&out.stderr);
-    let at = format!("{}:15:", bad_event.display());
-    assert!(
-        !out.status.success() && err.contains(&at) && err.contains("'gear.rudder_command'"),
-        "{err}"
-    );
-    assert!(err.contains("'m/s'") && err.contains("'rad'"), "{err}");
-    assert!(!d.join("bad_event.csv").exists());
 }
