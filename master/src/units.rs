@@ -19,8 +19,8 @@
 //! **The `rad` exponent** ([`RadRule`]). FMI 2.0 (sec. 2.2.2) lets a model description omit
 //! `rad`: the radian is the SI derived unit 1, so PythonFMU declares its `radian` with rad = 0
 //! where our FMUs declare rad = 1. Other tools differ: OMSimulator and FMPy do not compare
-//! units of connections at all, and SSP 1.0 (sec. 5.4, `Unit`) compares the exponents, rad
-//! included. Here [`RadRule::Strict`] compares all eight exponents (SSP); with
+//! units of connections at all, and SSP 1.0 (its `Unit`/`BaseUnit` elements) compares the
+//! exponents, rad included. Here [`RadRule::Strict`] compares all eight exponents (SSP); with
 //! [`RadRule::Omittable`] a rad exponent of 0 on a side that may omit it matches any rad
 //! exponent when the seven others agree (so 90 deg converts to PythonFMU's `radian`, and
 //! rad/s to a `1/s` declared by an FMU). The built-in units always carry their true rad
@@ -258,8 +258,8 @@ impl Unit {
         })
     }
 
-    /// The exponents as text, e.g. `kg.m2.s-2`, `rad/s` style without a slash: `s-1.rad`;
-    /// `1` when dimensionless.
+    /// The exponents as text in the order of [`BASE_UNITS`], e.g. `kg.m2.s-2` for N.m and
+    /// `s-1.rad` for rad/s; `1` when dimensionless.
     pub fn dimension(&self) -> String {
         let parts: Vec<String> = BASE_UNITS
             .iter()

@@ -303,6 +303,14 @@ fn wrong_units_are_errors_naming_line_instance_variable_value_and_units() {
         "{e}"
     );
     assert!(e.contains("'deg' (rad)") && e.contains("'m/s'"), "{e}");
+    // The FMU's rpm omits rad (s-1, factor 1/60) where the table's rpm is 2 pi/60 rad/s:
+    // rad/s onto it would be off by 2 pi, so it is refused; Hz (s-1) converts exactly.
+    let e = validate(r#"shaft = "8 rad/s""#, "").unwrap_err();
+    assert!(
+        e.contains("ambiguous") && e.contains("write the value in rpm"),
+        "{e}"
+    );
+    assert!(close(real(r#"shaft = "2 Hz""#), 120.0, 2.3e-16));
     // The declared type's range applies to converted values: 50 kn = 25.7 m/s > 20.
     let e = validate(r#"speed = "50 kn""#, "").unwrap_err();
     assert!(e.contains("outside the declared range [0, 20]"), "{e}");

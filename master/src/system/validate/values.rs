@@ -79,7 +79,27 @@ fn real(text: &str, md: &ModelDescription, sv: &ScalarVariable) -> Result<f64, S
             to.dimension()
         )
     })?;
+    if to_fmu && from.exponents[7] != to.exponents[7] {
+        ambiguous_rad(text, declared, &to)?;
+    }
     Ok(c.apply(q.value))
+}
+
+/// A declared unit that omits rad (rad = 0) under a name the built-in table knows with
+/// another factor, e.g. an FMU's `rpm` as s-1 with factor 1/60 where the table's `rpm` is
+/// 2 pi/60 rad/s: a value converted to it through the rad rule would be off by 2 pi, so it must
+/// be written in the declared unit itself.
+fn ambiguous_rad(text: &str, declared: &str, to: &Unit) -> Result<(), String> {
+    match Unit::parse(declared) {
+        Ok(b) if b.factor != to.factor || b.offset != to.offset => Err(format!(
+            "value {text:?} is ambiguous: the FMU declares '{declared}' without rad ({}, factor {}) where the built-in '{declared}' is {} with factor {}; write the value in {declared}",
+            to.dimension(),
+            to.factor,
+            b.dimension(),
+            b.factor
+        )),
+        _ => Ok(()),
+    }
 }
 
 /// The declared min and max of a variable (a Real's own, else its declared type's).
