@@ -157,8 +157,15 @@ fn event_values_and_one_sided_ranges_are_checked() {
         e.contains("event at t = 0.5") && e.contains("[-1, 1]"),
         "{e}"
     );
-    // NaN is in no range.
-    assert!(validate(&ev("nan")).unwrap_err().contains("[-1, 1]"));
+    // NaN is refused, with or without a range (our FMUs' fmi2SetReal refuses it too).
+    assert!(validate(&ev("nan"))
+        .unwrap_err()
+        .contains("value NaN is not a number"));
+    let e = validate("parameters = { u = \"nan\" }").unwrap_err();
+    assert!(
+        e.contains("sys.toml:8") && e.contains("is not a number"),
+        "{e}"
+    );
     // min only: the open side is shown as inf.
     let e = validate("parameters = { n = 0 }").unwrap_err();
     assert!(

@@ -123,7 +123,7 @@ fn range(md: &ModelDescription, sv: &ScalarVariable) -> (Option<f64>, Option<f64
     }
 }
 
-/// The value lies in the declared range (NaN lies in no range).
+/// The value is a number (not NaN) and lies in the declared range.
 fn in_range(
     tv: &TypedValue,
     written: &Value,
@@ -135,6 +135,9 @@ fn in_range(
         TypedValue::Integer(i) => f64::from(*i),
         _ => return Ok(()),
     };
+    if x.is_nan() {
+        return Err(format!("value {written} is not a number (NaN)"));
+    }
     let (min, max) = range(md, sv);
     if min.is_none() && max.is_none() {
         return Ok(());
