@@ -35,8 +35,8 @@ use std::fmt;
 /// The base units of FMI 2.0 sec. 2.2.2, in the order of [`Unit::exponents`].
 pub const BASE_UNITS: [&str; 8] = ["kg", "m", "s", "A", "K", "mol", "cd", "rad"];
 
-/// Index of `rad` in the exponents.
-const RAD: usize = 7;
+/// Index of `rad` in [`Unit::exponents`].
+pub const RAD: usize = 7;
 
 /// A unit: `value_SI = factor * value + offset`, with SI exponents (kg, m, s, A, K, mol, cd,
 /// rad).

@@ -79,7 +79,7 @@ fn real(text: &str, md: &ModelDescription, sv: &ScalarVariable) -> Result<f64, S
             to.dimension()
         )
     })?;
-    if to_fmu && from.exponents[7] != to.exponents[7] {
+    if to_fmu && from.exponents[units::RAD] != to.exponents[units::RAD] {
         ambiguous_rad(text, declared, &to)?;
     }
     Ok(c.apply(q.value))
