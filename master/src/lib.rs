@@ -35,6 +35,7 @@ pub mod model_description;
 pub mod plot;
 pub mod run;
 pub mod system;
+pub mod units;
 
 pub use error::{Error, Result};
 pub use fmu::Fmu;

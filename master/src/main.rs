@@ -86,9 +86,13 @@ enum Command {
         #[arg(long, value_name = "FILE")]
         resume: Option<PathBuf>,
     },
-    /// Validate a system without running it.
+    /// Validate a system without running it: everything `run` checks before the first step
+    /// (names, types, units, declared ranges, connections, events, outputs).
     Check {
+        /// The system file (native .toml or OSP OspSystemStructure.xml).
         system: PathBuf,
+        /// Set a parameter or start value, as `run --set` does: --set instance.variable=value
+        /// (repeatable; a value may carry a unit: 90deg, "15 kn", pi/2).
         #[arg(long = "set", value_name = "INST.VAR=VALUE")]
         set: Vec<String>,
         /// Make a unit mismatch on a connection an error in any system file (an OSP
@@ -118,6 +122,9 @@ enum Command {
         #[arg(long, short)]
         output: PathBuf,
     },
+    /// Statistics of a recorded CSV per column over a time window: mean, variance, std, RMS,
+    /// min, max and max |x|.
+    Stats(cli::stats::StatsArgs),
     /// Campaigns: many runs over factors, seeds and arms, one KPI row per run.
     Campaign {
         #[command(subcommand)]
@@ -210,6 +217,7 @@ fn dispatch(cmd: Command) -> shipsim::Result<()> {
         }
         Command::ExportOsp { system, output } => export_osp(&system, output),
         Command::Campaign { command } => cli::campaign::dispatch(command, ctrl_c_flag),
+        Command::Stats(args) => cli::stats::run(&args),
     }
 }
 

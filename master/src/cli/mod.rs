@@ -1,1 +1,2 @@
 pub mod campaign;
+pub mod stats;

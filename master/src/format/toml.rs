@@ -14,7 +14,7 @@
 //! name = "gear"
 //! fmu = "SteeringGear.fmu"  # relative to this file
 //! step_multiple = 1         # this instance steps every n base steps
-//! parameters = { time_constant = 2.0 }
+//! parameters = { time_constant = 2.0, rate_max = "10 deg/s" }
 //!
 //! [[connections]]            # or: connections = ["a.y -> b.u", ...]
 //! from = "autopilot.rudder_command"
@@ -26,13 +26,18 @@
 //! [[events]]
 //! time = 10.0
 //! set = "autopilot.heading_setpoint"
-//! value = 0.35
+//! value = 0.35              # or "20 deg", "pi/9"
 //!
 //! [output]
 //! file = "out.csv"
 //! variables = ["gear.rudder_angle", "ship.*"]   # default: every output
 //! decimation = 1
 //! ```
+//!
+//! A value is a number, a boolean or a string. For a Real variable a string is a number or a
+//! `pi` expression with an optional unit (`"90 deg"`, `"15 kn"`, `"pi/2"`), converted to the
+//! variable's declared unit when the system is validated ([`crate::units`], `docs/units.md`);
+//! a plain number is used as written.
 //!
 //! Errors name the file and line; all errors of a file are reported together.
 

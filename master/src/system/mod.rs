@@ -35,7 +35,10 @@ pub enum Value {
     Integer(i64),
     Boolean(bool),
     String(String),
-    /// Unparsed text (from `--set`), converted by the variable's type during validation.
+    /// Unparsed text (from `--set`), converted by the variable's type during validation; for
+    /// a Real it may be a `pi` expression and carry a unit (`90deg`, `15 kn`, `pi/2`),
+    /// converted to the variable's declared unit ([`crate::units`]). A `String` value on a
+    /// Real variable (a TOML string) is read the same way.
     Text(String),
 }
 
@@ -182,7 +185,9 @@ impl System {
             .collect()
     }
 
-    /// Applies `--set inst.var=value` overrides (they replace values from the file).
+    /// Applies `--set inst.var=value` overrides (they replace values from the file). The value
+    /// is kept as text and checked against the variable (type, unit, declared range) when the
+    /// system is validated.
     pub fn apply_overrides(&mut self, sets: &[String]) -> Result<()> {
         for s in sets {
             let parsed = s

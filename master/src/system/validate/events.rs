@@ -25,6 +25,17 @@ impl Checker<'_> {
             .map_err(|err| self.errors.push(err))
             .ok()?;
         let sv = &self.mds[i].model_variables.variables[vi];
+        if sv.variability == crate::model_description::Variability::Constant {
+            let err = self.err(
+                e.line,
+                format!(
+                    "event at t = {}: '{}' is a constant and cannot be set (value {})",
+                    e.time, e.target, e.value
+                ),
+            );
+            self.errors.push(err);
+            return None;
+        }
         if !sv.settable_in_step_mode() {
             let err = self.err(e.line, format!(
                 "event at t = {}: '{}' is {} {}; only inputs and tunable parameters can change during a run",
@@ -32,7 +43,7 @@ impl Checker<'_> {
             self.errors.push(err);
             return None;
         }
-        let tv = match convert(&e.value, sv.var_type().unwrap()) {
+        let tv = match convert(&e.value, self.mds[i], sv) {
             Ok(v) => v,
             Err(m) => {
                 let err = self.err(

@@ -1,0 +1,185 @@
+//! `shipsim stats`: window statistics of a CSV's columns. The CSV is written here with values
+//! whose statistics are known in closed form.
+
+use std::f64::consts::TAU;
+use std::path::Path;
+use std::process::{Command, Output};
+
+/// t = k/100 for k = 0..=1000 (0 .. 10 s);
+/// ship.a = 2 + 3 sin(2 pi t) (period 1 s), ship.b = 0 before t = 5 s and 1 from it,
+/// gear.c = t.
+fn write_csv(path: &Path) {
+    let mut s = String::from("time,ship.a,ship.b,gear.c\n");
+    for k in 0..=1000 {
+        let t = k as f64 / 100.0;
+        let a = 2.0 + 3.0 * (TAU * t).sin();
+        let b = if k >= 500 { 1.0 } else { 0.0 };
+        s.push_str(&format!("{t},{a},{b},{t}\n"));
+    }
+    std::fs::write(path, s).unwrap();
+}
+
+fn stats(csv: &Path, args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_shipsim"))
+        .arg("stats")
+        .arg(csv)
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+/// `shipsim stats` fails with a message containing every part.
+fn refused(csv: &Path, args: &[&str], parts: &[&str]) {
+    let out = stats(csv, args);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{args:?} passed");
+    for part in parts {
+        assert!(err.contains(part), "{part} not in: {err}");
+    }
+}
+
+fn json(csv: &Path, args: &[&str]) -> serde_json::Value {
+    let mut a = args.to_vec();
+    a.push("--json");
+    let out = stats(csv, &a);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
+fn column<'a>(j: &'a serde_json::Value, name: &str) -> &'a serde_json::Value {
+    j["columns"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|c| c["name"] == name)
+        .unwrap_or_else(|| panic!("no {name} in {j}"))
+}
+
+fn assert_close(j: &serde_json::Value, stat: &str, expected: f64, tol: f64) {
+    let x = j[stat].as_f64().unwrap();
+    assert!((x - expected).abs() <= tol, "{stat}: {x} vs {expected}");
+}
+
+#[test]
+fn a_sine_over_whole_periods_and_a_ramp() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("x.csv");
+    write_csv(&csv);
+    // Window 2 .. 4.99 s: 300 samples, three whole periods of the sine.
+    let j = json(&csv, &["--window", "2:4.99"]);
+    assert_eq!(j["samples"], 300);
+    assert_eq!(
+        (j["t0"].as_f64(), j["t1"].as_f64()),
+        (Some(2.0), Some(4.99))
+    );
+    // Sampled sine (100 points per period): mean 2, population variance 3^2/2 = 4.5,
+    // RMS sqrt(2^2 + 4.5); the samples include the peaks (t = k + 1/4, k + 3/4): min -1, max 5.
+    let a = column(&j, "ship.a");
+    assert_close(a, "mean", 2.0, 1e-12);
+    assert_close(a, "variance", 4.5, 1e-12);
+    assert_close(a, "std", 4.5f64.sqrt(), 1e-12);
+    assert_close(a, "rms", 8.5f64.sqrt(), 1e-12);
+    assert_close(a, "min", -1.0, 1e-12);
+    assert_close(a, "max", 5.0, 1e-12);
+    assert_close(a, "max_abs", 5.0, 1e-12);
+    // The ramp t over 300 points spaced h = 0.01 from 2: mean (2 + 4.99)/2 = 3.495, variance
+    // h^2 (n^2 - 1)/12 (discrete uniform), RMS sqrt(variance + mean^2).
+    let c = column(&j, "gear.c");
+    let var = 1e-4 * (300.0 * 300.0 - 1.0) / 12.0;
+    assert_close(c, "mean", 3.495, 1e-12);
+    assert_close(c, "variance", var, 1e-12);
+    assert_close(c, "rms", (var + 3.495 * 3.495).sqrt(), 1e-12);
+    assert_close(c, "min", 2.0, 0.0);
+    assert_close(c, "max", 4.99, 0.0);
+    // ship.b is 0 over the window.
+    assert_close(column(&j, "ship.b"), "max_abs", 0.0, 0.0);
+
+    // Without a window: all 1001 samples; b = 1 on 501 of them: mean p = 501/1001,
+    // variance p (1 - p).
+    let j = json(&csv, &[]);
+    assert_eq!(j["samples"], 1001);
+    let p = 501.0 / 1001.0;
+    let b = column(&j, "ship.b");
+    assert_close(b, "mean", p, 1e-14);
+    assert_close(b, "variance", p * (1.0 - p), 1e-14);
+    assert_close(b, "rms", p.sqrt(), 1e-14);
+    // Open-ended windows: from 5 s on, b is 1 everywhere.
+    let j = json(&csv, &["--window", "5:"]);
+    assert_eq!(j["samples"], 501);
+    assert_close(column(&j, "ship.b"), "min", 1.0, 0.0);
+    let j = json(&csv, &["--window", ":0.5"]);
+    assert_eq!(j["samples"], 51);
+}
+
+#[test]
+fn columns_by_name_and_glob_and_the_table() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("x.csv");
+    write_csv(&csv);
+    let names = |j: &serde_json::Value| -> Vec<String> {
+        j["columns"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|c| c["name"].as_str().unwrap().to_string())
+            .collect()
+    };
+    assert_eq!(names(&json(&csv, &[])), ["ship.a", "ship.b", "gear.c"]);
+    assert_eq!(
+        names(&json(&csv, &["--columns", "ship.*"])),
+        ["ship.a", "ship.b"]
+    );
+    assert_eq!(
+        names(&json(&csv, &["--columns", "gear.c,ship.?"])),
+        ["gear.c", "ship.a", "ship.b"]
+    );
+    assert_eq!(
+        names(&json(&csv, &["--columns", "*.a, ship.*"])),
+        ["ship.a", "ship.b"]
+    );
+
+    // The table: a header with every statistic, one row per column, aligned.
+    let out = stats(&csv, &["--window", "2:4.99", "--columns", "ship.a,gear.c"]);
+    assert!(out.status.success());
+    let text = String::from_utf8(out.stdout).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    assert!(lines[0].contains("300 samples, t = 2 .. 4.99 s"), "{text}");
+    let header: Vec<&str> = lines[1].split_whitespace().collect();
+    assert_eq!(
+        header,
+        ["column", "mean", "variance", "std", "rms", "min", "max", "max_abs"]
+    );
+    assert_eq!(lines.len(), 4, "{text}");
+    assert!(
+        lines[2].starts_with("ship.a") && lines[3].starts_with("gear.c"),
+        "{text}"
+    );
+    assert!(
+        lines[1..].iter().all(|l| l.len() == lines[1].len()),
+        "not aligned:\n{text}"
+    );
+    let row: Vec<f64> = lines[2]
+        .split_whitespace()
+        .skip(1)
+        .map(|x| x.parse().unwrap())
+        .collect();
+    assert!(
+        (row[0] - 2.0).abs() < 1e-6 && (row[1] - 4.5).abs() < 1e-5,
+        "{text}"
+    );
+
+    // Errors: an unknown column (with a suggestion), an empty window, a bad window.
+    refused(
+        &csv,
+        &["--columns", "ship.aa"],
+        &["no column matches 'ship.aa'", "'ship.a'"],
+    );
+    let empty = ["no sample in the window [20, 30]", "t = 0 .. 10"];
+    refused(&csv, &["--window", "20:30"], &empty);
+    assert!(!stats(&csv, &["--window", "5"]).status.success());
+    assert!(!stats(&csv, &["--window", "6:5"]).status.success());
+}
