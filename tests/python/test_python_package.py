@@ -261,3 +261,15 @@ def test_osp_xml_system_equals_toml(tmp_path):
     ra, rb = a.run(stop_time=120, variables=every), b.run(stop_time=120, variables=every)
     assert len(ra) > 100 and len(ra.columns) > 5
     pd.testing.assert_frame_equal(ra, rb, check_exact=True)
+
+
+def test_set_accepts_values_with_units():
+    """Values with units (docs/units.md) work from Python as in --set: "90 deg" is the same
+    double as pi/2 rad, and a wrong unit is refused with both units named."""
+    s = shipsim.System.load(RRS)
+    a = s.set("waves.wave_direction", "90 deg").run(stop_time=30, variables=["ship.roll"])
+    b = s.set("waves.wave_direction", 1.5707963267948966).run(stop_time=30, variables=["ship.roll"])
+    assert np.array_equal(a["ship.roll"].to_numpy(), b["ship.roll"].to_numpy())
+    s.set("waves.wave_direction", "15 kn")
+    with pytest.raises(shipsim.SystemFileError, match="kn"):
+        s.run(stop_time=1)
