@@ -25,6 +25,7 @@
 //! * NaN/infinite Real values are refused with a message naming the variable.
 
 pub mod api;
+mod fast;
 pub mod fragments;
 mod instance;
 pub mod table;
