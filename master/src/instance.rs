@@ -163,6 +163,9 @@ struct Core {
 }
 
 impl Core {
+    /// Ok for fmi2OK and fmi2Warning, else the error of `function` (the phase follows the
+    /// status). Inlined into every call wrapper: the success path is one comparison.
+    #[inline(always)]
     fn check(
         &mut self,
         function: &'static str,
@@ -170,8 +173,20 @@ impl Core {
         time: Option<f64>,
     ) -> Result<()> {
         if status == fmi2OK || status == fmi2Warning {
-            return Ok(());
+            Ok(())
+        } else {
+            self.failed(function, status, time)
         }
+    }
+
+    #[cold]
+    #[inline(never)]
+    fn failed(
+        &mut self,
+        function: &'static str,
+        status: fmi2Status,
+        time: Option<f64>,
+    ) -> Result<()> {
         if status == fmi2Fatal {
             self.phase = Phase::Fatal;
         } else if status == fmi2Error || !(0..=5).contains(&status) {
@@ -342,6 +357,7 @@ impl<S> Instance<S> {
     }
 
     /// `fmi2SetReal`, batched.
+    #[inline]
     pub fn set_real(&mut self, vrs: &[VR], values: &[f64]) -> Result<()> {
         debug_assert_eq!(vrs.len(), values.len());
         if vrs.is_empty() {
@@ -359,6 +375,7 @@ impl<S> Instance<S> {
     }
 
     /// `fmi2SetInteger`, batched.
+    #[inline]
     pub fn set_integer(&mut self, vrs: &[VR], values: &[i32]) -> Result<()> {
         if vrs.is_empty() {
             return Ok(());
@@ -375,6 +392,7 @@ impl<S> Instance<S> {
     }
 
     /// `fmi2SetBoolean`, batched (values are fmi2Boolean, 0 or 1).
+    #[inline]
     pub fn set_boolean(&mut self, vrs: &[VR], values: &[i32]) -> Result<()> {
         if vrs.is_empty() {
             return Ok(());
@@ -414,6 +432,7 @@ impl<S> Instance<S> {
 
 impl<S: Readable> Instance<S> {
     /// `fmi2GetReal`, batched into a caller-provided buffer (no allocation).
+    #[inline]
     pub fn get_real(&mut self, vrs: &[VR], out: &mut [f64]) -> Result<()> {
         debug_assert_eq!(vrs.len(), out.len());
         if vrs.is_empty() {
@@ -431,6 +450,7 @@ impl<S: Readable> Instance<S> {
     }
 
     /// `fmi2GetInteger`, batched.
+    #[inline]
     pub fn get_integer(&mut self, vrs: &[VR], out: &mut [i32]) -> Result<()> {
         if vrs.is_empty() {
             return Ok(());
@@ -447,6 +467,7 @@ impl<S: Readable> Instance<S> {
     }
 
     /// `fmi2GetBoolean`, batched.
+    #[inline]
     pub fn get_boolean(&mut self, vrs: &[VR], out: &mut [i32]) -> Result<()> {
         if vrs.is_empty() {
             return Ok(());
@@ -522,15 +543,21 @@ impl Instance<Stepping> {
     /// fmi2Discard with `fmi2Terminated` = true is an early end, reported as
     /// [`StepOutcome::Terminated`]; any other status worse than fmi2Warning is an error naming
     /// the instance, the time and the status, with the FMU's last log lines.
-    #[inline]
+    #[inline(always)]
     pub fn do_step(&mut self, t: f64, h: f64) -> Result<StepOutcome> {
-        let api: *const crate::fmu::Api = &self.core.lib.api;
-        // SAFETY: the Arc'd library outlives this call; a raw pointer avoids an Arc clone per step.
-        let api = unsafe { &*api };
-        let s = unsafe { (api.fmi2DoStep)(self.core.comp, t, h, fmi2True) };
+        let s = unsafe { (self.core.lib.api.fmi2DoStep)(self.core.comp, t, h, fmi2True) };
         if s == fmi2OK || s == fmi2Warning {
             return Ok(StepOutcome::Ok);
         }
+        self.step_not_ok(t, s)
+    }
+
+    /// fmi2DoStep returned `s`, worse than fmi2Warning: an early end (fmi2Discard with
+    /// `fmi2Terminated`) or an error.
+    #[cold]
+    #[inline(never)]
+    fn step_not_ok(&mut self, t: f64, s: fmi2Status) -> Result<StepOutcome> {
+        let api = &self.core.lib.api;
         if s == fmi2Discard {
             let mut terminated: fmi2Boolean = fmi2False;
             let st = unsafe {

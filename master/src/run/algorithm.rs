@@ -87,18 +87,20 @@ impl Algorithm for Jacobi {
     ) -> Result<()> {
         let k = step.k;
         probe.lap(Lap::Master);
+        // Inputs, events and step of one instance after another: `values` changes only when
+        // the outputs are published below, so every instance sees the same calls, with the same
+        // values, as with all inputs first and all steps after (one pass over the slots).
         for (i, s) in slots.iter_mut().enumerate() {
-            if s.steps_at(k) {
+            let due = s.steps_at(k);
+            if due {
                 s.set_inputs(values)?;
                 probe.lap(Lap::Exchange(i));
             }
-        }
-        for e in step.events {
-            slots[e.instance].apply(e, step.t)?;
-            probe.lap(Lap::Exchange(e.instance));
-        }
-        for (i, s) in slots.iter_mut().enumerate() {
-            if s.steps_at(k) {
+            for e in step.events.iter().filter(|e| e.instance == i) {
+                s.apply(e, step.t)?;
+                probe.lap(Lap::Exchange(i));
+            }
+            if due {
                 s.do_step(k, step.t, grid, count)?;
                 probe.lap(Lap::DoStep(i));
             }

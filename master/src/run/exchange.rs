@@ -66,9 +66,11 @@ impl Kind for Real {
     fn map(value: f64, m: Linear) -> f64 {
         m.gain * value + m.offset
     }
+    #[inline]
     fn set<S>(inst: &mut Instance<S>, vrs: &[VR], values: &[f64]) -> Result<()> {
         inst.set_real(vrs, values)
     }
+    #[inline]
     fn get<S: Readable>(inst: &mut Instance<S>, vrs: &[VR], out: &mut [f64]) -> Result<()> {
         inst.get_real(vrs, out)
     }
@@ -87,9 +89,11 @@ impl Kind for Integer {
     fn map(value: i32, _: ()) -> i32 {
         value
     }
+    #[inline]
     fn set<S>(inst: &mut Instance<S>, vrs: &[VR], values: &[i32]) -> Result<()> {
         inst.set_integer(vrs, values)
     }
+    #[inline]
     fn get<S: Readable>(inst: &mut Instance<S>, vrs: &[VR], out: &mut [i32]) -> Result<()> {
         inst.get_integer(vrs, out)
     }
@@ -108,9 +112,11 @@ impl Kind for Boolean {
     fn map(value: i32, _: ()) -> i32 {
         value
     }
+    #[inline]
     fn set<S>(inst: &mut Instance<S>, vrs: &[VR], values: &[i32]) -> Result<()> {
         inst.set_boolean(vrs, values)
     }
+    #[inline]
     fn get<S: Readable>(inst: &mut Instance<S>, vrs: &[VR], out: &mut [i32]) -> Result<()> {
         inst.get_boolean(vrs, out)
     }
@@ -157,7 +163,7 @@ impl<K: Kind> Port<K> {
         self.scratch.push(K::Value::default());
     }
 
-    #[inline]
+    #[inline(always)]
     fn set_inputs<S>(&mut self, inst: &mut Instance<S>, values: &Values) -> Result<()> {
         if self.input_vrs.is_empty() {
             return Ok(());
@@ -169,7 +175,7 @@ impl<K: Kind> Port<K> {
         K::set(inst, &self.input_vrs, &self.scratch)
     }
 
-    #[inline]
+    #[inline(always)]
     fn get_outputs<S: Readable>(&self, inst: &mut Instance<S>, values: &mut Values) -> Result<()> {
         let Observed { vrs, at } = &self.observed;
         if vrs.is_empty() {
@@ -189,7 +195,7 @@ pub struct Ports {
 
 impl Ports {
     /// Writes the instance's connected inputs from `values` (Real, then Integer, then Boolean).
-    #[inline]
+    #[inline(always)]
     pub fn set_inputs<S>(&mut self, inst: &mut Instance<S>, values: &Values) -> Result<()> {
         self.real.set_inputs(inst, values)?;
         self.integer.set_inputs(inst, values)?;
@@ -197,7 +203,7 @@ impl Ports {
     }
 
     /// Reads the instance's observed variables into `values` (Real, then Integer, then Boolean).
-    #[inline]
+    #[inline(always)]
     pub fn get_outputs<S: Readable>(
         &self,
         inst: &mut Instance<S>,
