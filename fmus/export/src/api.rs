@@ -1087,15 +1087,17 @@ pub unsafe fn do_step<M: FmuModel>(
     with_instance::<M>(c, "fmi2DoStep", mask::DO_STEP, |inst| {
         let now = inst.core.time;
         // h finite and > 0 (h * 0 is 0 exactly for finite h, NaN otherwise), t finite and at
-        // `now`; written so that NaN fails each comparison.
+        // `now` within a relative 1e-10; written so that NaN fails each comparison. A master on
+        // the FMU's own grid hands `t == now` exactly, which needs no tolerance.
         if !(h > 0.0 && h * 0.0 == 0.0) {
             return fail(
                 inst,
                 format_args!("fmi2DoStep: communicationStepSize = {h} must be > 0"),
             );
         }
-        let tol = 1e-10 * now.abs().max(1.0);
-        if !(t.abs() < f64::INFINITY && (t - now).abs() <= tol) {
+        let on_time = t.abs() < f64::INFINITY
+            && (t == now || (t - now).abs() <= 1e-10 * now.abs().max(1.0));
+        if !on_time {
             return fail(
                 inst,
                 format_args!(
@@ -1104,7 +1106,9 @@ pub unsafe fn do_step<M: FmuModel>(
             );
         }
         if let Some(stop) = inst.core.stop_time {
-            if t + h > stop + 1e-10 * stop.abs().max(1.0) {
+            // Past stopTime by more than a relative 1e-10 (first: past it at all).
+            let end = t + h;
+            if end > stop && end > stop + 1e-10 * stop.abs().max(1.0) {
                 return fail(
                     inst,
                     format_args!("fmi2DoStep: step to {} passes stopTime = {stop}", t + h),

@@ -96,9 +96,8 @@ impl Algorithm for Jacobi {
                 s.set_inputs(values)?;
                 probe.lap(Lap::Exchange(i));
             }
-            for e in step.events.iter().filter(|e| e.instance == i) {
-                s.apply(e, step.t)?;
-                probe.lap(Lap::Exchange(i));
+            if !step.events.is_empty() {
+                apply_events(s, i, step, probe)?;
             }
             if due {
                 s.do_step(k, step.t, grid, count)?;
@@ -151,9 +150,8 @@ impl Algorithm for GaussSeidel<'_> {
                 s.set_inputs(values)?;
                 probe.lap(Lap::Exchange(i));
             }
-            for e in step.events.iter().filter(|e| e.instance == i) {
-                s.apply(e, step.t)?;
-                probe.lap(Lap::Exchange(i));
+            if !step.events.is_empty() {
+                apply_events(s, i, step, probe)?;
             }
             if s.steps_at(k) {
                 s.do_step(k, step.t, grid, count)?;
@@ -164,4 +162,20 @@ impl Algorithm for GaussSeidel<'_> {
         }
         Ok(())
     }
+}
+
+/// Applies the step's events of instance `i` to its slot, in their order (FMI 2.0: inputs and
+/// tunable parameters). Out of line: most macro steps have no events.
+#[inline(never)]
+fn apply_events<P: Probe>(
+    s: &mut Slot<Stepping>,
+    i: usize,
+    step: &MacroStep,
+    probe: &mut P,
+) -> Result<()> {
+    for e in step.events.iter().filter(|e| e.instance == i) {
+        s.apply(e, step.t)?;
+        probe.lap(Lap::Exchange(i));
+    }
+    Ok(())
 }

@@ -157,6 +157,11 @@ impl<K: Kind> Default for Port<K> {
 }
 
 impl<K: Kind> Port<K> {
+    /// No connected inputs and no observed variables.
+    fn is_empty(&self) -> bool {
+        self.input_vrs.is_empty() && self.observed.vrs.is_empty()
+    }
+
     fn connect(&mut self, vr: VR, source: usize, map: K::Map) {
         self.input_vrs.push(vr);
         self.links.push(Link { source, map });
@@ -191,6 +196,9 @@ pub struct Ports {
     real: Port<Real>,
     integer: Port<Integer>,
     boolean: Port<Boolean>,
+    /// The Integer or the Boolean port has inputs or observed variables (one test per call
+    /// for the many instances that exchange only Real values).
+    discrete: bool,
 }
 
 impl Ports {
@@ -198,8 +206,11 @@ impl Ports {
     #[inline(always)]
     pub fn set_inputs<S>(&mut self, inst: &mut Instance<S>, values: &Values) -> Result<()> {
         self.real.set_inputs(inst, values)?;
-        self.integer.set_inputs(inst, values)?;
-        self.boolean.set_inputs(inst, values)
+        if self.discrete {
+            self.integer.set_inputs(inst, values)?;
+            self.boolean.set_inputs(inst, values)?;
+        }
+        Ok(())
     }
 
     /// Reads the instance's observed variables into `values` (Real, then Integer, then Boolean).
@@ -210,8 +221,11 @@ impl Ports {
         values: &mut Values,
     ) -> Result<()> {
         self.real.get_outputs(inst, values)?;
-        self.integer.get_outputs(inst, values)?;
-        self.boolean.get_outputs(inst, values)
+        if self.discrete {
+            self.integer.get_outputs(inst, values)?;
+            self.boolean.get_outputs(inst, values)?;
+        }
+        Ok(())
     }
 
     /// The observed variables of exchange type `t` (Real, Integer or Boolean).
@@ -308,6 +322,9 @@ impl Exchange {
                 VarType::Boolean => p.boolean.connect(c.to_vr, g, ()),
                 _ => p.integer.connect(c.to_vr, g, ()),
             }
+        }
+        for p in ports.iter_mut() {
+            p.discrete = !(p.integer.is_empty() && p.boolean.is_empty());
         }
         Exchange {
             ports,
