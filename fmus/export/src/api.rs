@@ -691,7 +691,7 @@ pub unsafe fn set_real<M: FmuModel>(
         n,
         values,
         |inst, r, x| match inst.fast.set_real.get(r as usize) {
-            Some(Some(input)) if input.lo <= x && x <= input.hi => {
+            Some(input) if input.accepts(x) => {
                 (input.set)(&mut inst.model, x);
                 true
             }
@@ -1095,8 +1095,8 @@ pub unsafe fn do_step<M: FmuModel>(
                 format_args!("fmi2DoStep: communicationStepSize = {h} must be > 0"),
             );
         }
-        let on_time = t.abs() < f64::INFINITY
-            && (t == now || (t - now).abs() <= 1e-10 * now.abs().max(1.0));
+        let on_time =
+            t.abs() < f64::INFINITY && (t == now || (t - now).abs() <= 1e-10 * now.abs().max(1.0));
         if !on_time {
             return fail(
                 inst,

@@ -24,18 +24,28 @@
 use crate::variables::{Access, Causality, Variable};
 use crate::FmuDescription;
 
-/// A Real input's setter and the interval of values it accepts (finite, within the range).
+/// A Real input's setter and the interval `[lo, hi]` of values it accepts (finite, within the
+/// range). Every other value reference has the empty interval `[+inf, -inf]`, which no value
+/// passes, so the fast path needs no second test to hand it to the table path.
 pub struct RealInput<M> {
     pub set: fn(&mut M, f64),
     pub lo: f64,
     pub hi: f64,
 }
 
+impl<M> RealInput<M> {
+    /// Whether the fast path writes `x` (NaN fails both comparisons).
+    #[inline(always)]
+    pub fn accepts(&self, x: f64) -> bool {
+        self.lo <= x && x <= self.hi
+    }
+}
+
 /// The Real accessors of a model type, indexed by value reference (see the module
 /// documentation).
 pub struct FastAccess<M> {
     pub get_real: Box<[Option<fn(&M) -> f64>]>,
-    pub set_real: Box<[Option<RealInput<M>>]>,
+    pub set_real: Box<[RealInput<M>]>,
 }
 
 impl<M: FmuDescription> FastAccess<M> {
@@ -56,18 +66,22 @@ fn real_getter<M>(v: &Variable<M>) -> Option<fn(&M) -> f64> {
     }
 }
 
-fn real_input<M>(v: &Variable<M>) -> Option<RealInput<M>> {
+fn real_input<M>(v: &Variable<M>) -> RealInput<M> {
     match v.access {
         Access::Real {
             set: Some(set),
             min,
             max,
             ..
-        } if v.causality == Causality::Input => Some(RealInput {
+        } if v.causality == Causality::Input => RealInput {
             set,
             lo: min.map_or(f64::MIN, |lo| lo.max(f64::MIN)),
             hi: max.map_or(f64::MAX, |hi| hi.min(f64::MAX)),
-        }),
-        _ => None,
+        },
+        _ => RealInput {
+            set: |_, _| {},
+            lo: f64::INFINITY,
+            hi: f64::NEG_INFINITY,
+        },
     }
 }

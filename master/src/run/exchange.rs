@@ -168,11 +168,10 @@ impl<K: Kind> Port<K> {
         self.scratch.push(K::Value::default());
     }
 
+    /// (An instance without inputs of this type: the gather does nothing and
+    /// [`Instance::set_real`] and its siblings make no call.)
     #[inline(always)]
     fn set_inputs<S>(&mut self, inst: &mut Instance<S>, values: &Values) -> Result<()> {
-        if self.input_vrs.is_empty() {
-            return Ok(());
-        }
         let shared = K::values(values);
         for (x, l) in self.scratch.iter_mut().zip(&self.links) {
             *x = K::map(shared[l.source], l.map);
