@@ -41,10 +41,13 @@ impl<M> RealInput<M> {
     }
 }
 
+/// A Real variable's getter.
+pub type RealGetter<M> = fn(&M) -> f64;
+
 /// The Real accessors of a model type, indexed by value reference (see the module
 /// documentation).
 pub struct FastAccess<M> {
-    pub get_real: Box<[Option<fn(&M) -> f64>]>,
+    pub get_real: Box<[Option<RealGetter<M>>]>,
     pub set_real: Box<[RealInput<M>]>,
 }
 
@@ -59,7 +62,7 @@ impl<M: FmuDescription> FastAccess<M> {
     }
 }
 
-fn real_getter<M>(v: &Variable<M>) -> Option<fn(&M) -> f64> {
+fn real_getter<M>(v: &Variable<M>) -> Option<RealGetter<M>> {
     match v.access {
         Access::Real { get, .. } => Some(get),
         _ => None,
