@@ -78,6 +78,14 @@ fn fail<M: FmuModel>(inst: &Instance<M>, message: std::fmt::Arguments) -> fmi2St
     inst.error(&message.to_string())
 }
 
+/// `function` got NULL for an array of `n` > 0 values. (The failures of the calls a step loop
+/// makes take their arguments by value, so that the success path keeps them in registers.)
+#[cold]
+#[inline(never)]
+fn null_array<M: FmuModel>(inst: &Instance<M>, function: &str, n: usize) -> fmi2Status {
+    fail(inst, format_args!("{function}: NULL array with nvr = {n}"))
+}
+
 /// `fmi2GetTypesPlatform`.
 pub fn get_types_platform<M: FmuModel>() -> *const c_char {
     c"default".as_ptr()
@@ -429,7 +437,7 @@ unsafe fn get_values<M: FmuModel, T>(
             return fmi2OK;
         }
         if vr.is_null() || out.is_null() {
-            return fail(inst, format_args!("{function}: NULL array with nvr = {n}"));
+            return null_array(inst, function, n);
         }
         if inst.dirty {
             update_outputs(inst);
@@ -579,7 +587,7 @@ unsafe fn set_values<M: FmuModel, T: Copy>(
             return fmi2OK;
         }
         if vr.is_null() || values.is_null() {
-            return fail(inst, format_args!("{function}: NULL array with nvr = {n}"));
+            return null_array(inst, function, n);
         }
         let vrs = std::slice::from_raw_parts(vr, n);
         let vals = std::slice::from_raw_parts(values, n);
@@ -1090,29 +1098,18 @@ pub unsafe fn do_step<M: FmuModel>(
         // `now` within a relative 1e-10; written so that NaN fails each comparison. A master on
         // the FMU's own grid hands `t == now` exactly, which needs no tolerance.
         if !(h > 0.0 && h * 0.0 == 0.0) {
-            return fail(
-                inst,
-                format_args!("fmi2DoStep: communicationStepSize = {h} must be > 0"),
-            );
+            return step_size_refused(inst, h);
         }
         let on_time =
             t.abs() < f64::INFINITY && (t == now || (t - now).abs() <= 1e-10 * now.abs().max(1.0));
         if !on_time {
-            return fail(
-                inst,
-                format_args!(
-                    "fmi2DoStep: currentCommunicationPoint = {t} does not match the FMU's time {now}"
-                ),
-            );
+            return off_time(inst, t, now);
         }
         if let Some(stop) = inst.core.stop_time {
             // Past stopTime by more than a relative 1e-10 (first: past it at all).
             let end = t + h;
             if end > stop && end > stop + 1e-10 * stop.abs().max(1.0) {
-                return fail(
-                    inst,
-                    format_args!("fmi2DoStep: step to {} passes stopTime = {stop}", t + h),
-                );
+                return past_stop(inst, end, stop);
             }
         }
         match inst.model.do_step(t, h) {
@@ -1124,6 +1121,35 @@ pub unsafe fn do_step<M: FmuModel>(
             Err(msg) => step_failed(inst, t, h, &msg),
         }
     })
+}
+
+#[cold]
+#[inline(never)]
+fn step_size_refused<M: FmuModel>(inst: &Instance<M>, h: f64) -> fmi2Status {
+    fail(
+        inst,
+        format_args!("fmi2DoStep: communicationStepSize = {h} must be > 0"),
+    )
+}
+
+#[cold]
+#[inline(never)]
+fn off_time<M: FmuModel>(inst: &Instance<M>, t: f64, now: f64) -> fmi2Status {
+    fail(
+        inst,
+        format_args!(
+            "fmi2DoStep: currentCommunicationPoint = {t} does not match the FMU's time {now}"
+        ),
+    )
+}
+
+#[cold]
+#[inline(never)]
+fn past_stop<M: FmuModel>(inst: &Instance<M>, end: f64, stop: f64) -> fmi2Status {
+    fail(
+        inst,
+        format_args!("fmi2DoStep: step to {end} passes stopTime = {stop}"),
+    )
 }
 
 /// The model refused a step: the instance moves to the Error state.
