@@ -456,8 +456,9 @@ unsafe fn get_values<M: FmuModel, T>(
     })
 }
 
-/// One value of a getter through the variable table (its type checked). Out of line, so that
-/// the fast path's loop stays small.
+/// One value of a getter through the variable table (its type checked). Out of line and
+/// `#[cold]`, so that the fast path's loop stays small and keeps its values in registers.
+#[cold]
 #[inline(never)]
 fn get_by_table<M: FmuModel, T>(
     inst: &Instance<M>,
@@ -607,7 +608,9 @@ unsafe fn set_values<M: FmuModel, T: Copy>(
 
 /// One value of a setter through the variable table: type, causality and state checked, the
 /// value validated and written by `apply`, a tunable parameter changed in StepComplete checked
-/// by `parameters_changed`. Out of line, so that the fast path's loop stays small.
+/// by `parameters_changed`. Out of line and `#[cold]`, so that the fast path's loop stays small
+/// and keeps its values in registers.
+#[cold]
 #[inline(never)]
 fn set_by_table<M: FmuModel, T: Copy>(
     inst: &mut Instance<M>,
