@@ -168,8 +168,9 @@ impl<K: Kind> Port<K> {
         self.scratch.push(K::Value::default());
     }
 
-    /// (An instance without inputs of this type: the gather does nothing and
-    /// [`Instance::set_real`] and its siblings make no call.)
+    /// Gathers the connected inputs into the scratch buffer and writes them with one batched
+    /// call (none for an instance without inputs of this type: [`Instance::set_real`] and its
+    /// siblings skip an empty batch).
     #[inline(always)]
     fn set_inputs<S>(&mut self, inst: &mut Instance<S>, values: &Values) -> Result<()> {
         let shared = K::values(values);

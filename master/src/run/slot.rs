@@ -36,7 +36,7 @@ impl<S> Slot<S> {
 
     /// Steps at base step k (the rate rule of [`super::time_grid`]). A step multiple that is a
     /// power of two (1, 2, 4, ...: every system so far) is tested with a mask instead of a
-    /// division, three times per instance and macro step.
+    /// division (the algorithms ask twice per instance and macro step).
     #[inline(always)]
     pub fn steps_at(&self, k: u64) -> bool {
         let m = self.step_multiple;
