@@ -11,7 +11,7 @@
 //! calls), so every path, including errors and Ctrl-C, cleans up.
 
 use crate::error::{Error, Result};
-use crate::fmu::{Fmu, FmuLibrary, VR};
+use crate::fmu::{Api, Fmu, FmuLibrary, VR};
 use crate::model_description::CoSimulation;
 use fmi2::*;
 use std::collections::VecDeque;
@@ -163,6 +163,9 @@ struct Core {
 }
 
 impl Core {
+    /// Ok for fmi2OK and fmi2Warning, else the error of `function` (the phase follows the
+    /// status). Inlined into every call wrapper: the success path is one comparison.
+    #[inline(always)]
     fn check(
         &mut self,
         function: &'static str,
@@ -170,8 +173,20 @@ impl Core {
         time: Option<f64>,
     ) -> Result<()> {
         if status == fmi2OK || status == fmi2Warning {
-            return Ok(());
+            Ok(())
+        } else {
+            self.failed(function, status, time)
         }
+    }
+
+    #[cold]
+    #[inline(never)]
+    fn failed(
+        &mut self,
+        function: &'static str,
+        status: fmi2Status,
+        time: Option<f64>,
+    ) -> Result<()> {
         if status == fmi2Fatal {
             self.phase = Phase::Fatal;
         } else if status == fmi2Error || !(0..=5).contains(&status) {
@@ -213,6 +228,10 @@ impl Drop for Core {
 /// A co-simulation slave instance in type state `S`.
 pub struct Instance<S> {
     core: Box<Core>,
+    /// `core.comp` and the library's function table, kept next to the instance: a call in the
+    /// step loop loads them without going through the box and the `Arc`.
+    comp: fmi2Component,
+    api: *const Api,
     _s: PhantomData<S>,
 }
 
@@ -291,6 +310,8 @@ impl Fmu {
             ));
         }
         Ok(Instance {
+            comp,
+            api: &self.lib.api,
             core: Box::new(Core {
                 name: name.to_string(),
                 lib: self.lib.clone(),
@@ -327,8 +348,18 @@ impl<S> Instance<S> {
     fn transition<T>(self) -> Instance<T> {
         Instance {
             core: self.core,
+            comp: self.comp,
+            api: self.api,
             _s: PhantomData,
         }
+    }
+
+    /// The library's function table.
+    #[inline(always)]
+    fn api(&self) -> &Api {
+        // SAFETY: `api` points into the `FmuLibrary` that `core.lib` (an `Arc`) keeps alive for
+        // as long as this instance exists.
+        unsafe { &*self.api }
     }
 
     /// The last few log messages of this instance (for error reports).
@@ -342,50 +373,38 @@ impl<S> Instance<S> {
     }
 
     /// `fmi2SetReal`, batched.
+    #[inline]
     pub fn set_real(&mut self, vrs: &[VR], values: &[f64]) -> Result<()> {
         debug_assert_eq!(vrs.len(), values.len());
         if vrs.is_empty() {
             return Ok(());
         }
         let s = unsafe {
-            (self.core.lib.api.fmi2SetReal)(
-                self.core.comp,
-                vrs.as_ptr(),
-                vrs.len(),
-                values.as_ptr(),
-            )
+            (self.api().fmi2SetReal)(self.comp, vrs.as_ptr(), vrs.len(), values.as_ptr())
         };
         self.core.check("fmi2SetReal", s, None)
     }
 
     /// `fmi2SetInteger`, batched.
+    #[inline]
     pub fn set_integer(&mut self, vrs: &[VR], values: &[i32]) -> Result<()> {
         if vrs.is_empty() {
             return Ok(());
         }
         let s = unsafe {
-            (self.core.lib.api.fmi2SetInteger)(
-                self.core.comp,
-                vrs.as_ptr(),
-                vrs.len(),
-                values.as_ptr(),
-            )
+            (self.api().fmi2SetInteger)(self.comp, vrs.as_ptr(), vrs.len(), values.as_ptr())
         };
         self.core.check("fmi2SetInteger", s, None)
     }
 
     /// `fmi2SetBoolean`, batched (values are fmi2Boolean, 0 or 1).
+    #[inline]
     pub fn set_boolean(&mut self, vrs: &[VR], values: &[i32]) -> Result<()> {
         if vrs.is_empty() {
             return Ok(());
         }
         let s = unsafe {
-            (self.core.lib.api.fmi2SetBoolean)(
-                self.core.comp,
-                vrs.as_ptr(),
-                vrs.len(),
-                values.as_ptr(),
-            )
+            (self.api().fmi2SetBoolean)(self.comp, vrs.as_ptr(), vrs.len(), values.as_ptr())
         };
         self.core.check("fmi2SetBoolean", s, None)
     }
@@ -401,12 +420,7 @@ impl<S> Instance<S> {
             .collect::<Result<_>>()?;
         let ptrs: Vec<fmi2String> = cs.iter().map(|c| c.as_ptr()).collect();
         let s = unsafe {
-            (self.core.lib.api.fmi2SetString)(
-                self.core.comp,
-                vrs.as_ptr(),
-                vrs.len(),
-                ptrs.as_ptr(),
-            )
+            (self.api().fmi2SetString)(self.comp, vrs.as_ptr(), vrs.len(), ptrs.as_ptr())
         };
         self.core.check("fmi2SetString", s, None)
     }
@@ -414,50 +428,38 @@ impl<S> Instance<S> {
 
 impl<S: Readable> Instance<S> {
     /// `fmi2GetReal`, batched into a caller-provided buffer (no allocation).
+    #[inline]
     pub fn get_real(&mut self, vrs: &[VR], out: &mut [f64]) -> Result<()> {
         debug_assert_eq!(vrs.len(), out.len());
         if vrs.is_empty() {
             return Ok(());
         }
         let s = unsafe {
-            (self.core.lib.api.fmi2GetReal)(
-                self.core.comp,
-                vrs.as_ptr(),
-                vrs.len(),
-                out.as_mut_ptr(),
-            )
+            (self.api().fmi2GetReal)(self.comp, vrs.as_ptr(), vrs.len(), out.as_mut_ptr())
         };
         self.core.check("fmi2GetReal", s, None)
     }
 
     /// `fmi2GetInteger`, batched.
+    #[inline]
     pub fn get_integer(&mut self, vrs: &[VR], out: &mut [i32]) -> Result<()> {
         if vrs.is_empty() {
             return Ok(());
         }
         let s = unsafe {
-            (self.core.lib.api.fmi2GetInteger)(
-                self.core.comp,
-                vrs.as_ptr(),
-                vrs.len(),
-                out.as_mut_ptr(),
-            )
+            (self.api().fmi2GetInteger)(self.comp, vrs.as_ptr(), vrs.len(), out.as_mut_ptr())
         };
         self.core.check("fmi2GetInteger", s, None)
     }
 
     /// `fmi2GetBoolean`, batched.
+    #[inline]
     pub fn get_boolean(&mut self, vrs: &[VR], out: &mut [i32]) -> Result<()> {
         if vrs.is_empty() {
             return Ok(());
         }
         let s = unsafe {
-            (self.core.lib.api.fmi2GetBoolean)(
-                self.core.comp,
-                vrs.as_ptr(),
-                vrs.len(),
-                out.as_mut_ptr(),
-            )
+            (self.api().fmi2GetBoolean)(self.comp, vrs.as_ptr(), vrs.len(), out.as_mut_ptr())
         };
         self.core.check("fmi2GetBoolean", s, None)
     }
@@ -466,12 +468,7 @@ impl<S: Readable> Instance<S> {
     pub fn get_string(&mut self, vrs: &[VR]) -> Result<Vec<String>> {
         let mut ptrs: Vec<fmi2String> = vec![std::ptr::null(); vrs.len()];
         let s = unsafe {
-            (self.core.lib.api.fmi2GetString)(
-                self.core.comp,
-                vrs.as_ptr(),
-                vrs.len(),
-                ptrs.as_mut_ptr(),
-            )
+            (self.api().fmi2GetString)(self.comp, vrs.as_ptr(), vrs.len(), ptrs.as_mut_ptr())
         };
         self.core.check("fmi2GetString", s, None)?;
         Ok(ptrs.iter().map(|p| unsafe { lossy_str(*p) }).collect())
@@ -490,7 +487,7 @@ impl Instance<Instantiated> {
         let api = &lib.api;
         let s = unsafe {
             (api.fmi2SetupExperiment)(
-                self.core.comp,
+                self.comp,
                 tolerance.is_some() as fmi2Boolean,
                 tolerance.unwrap_or(0.0),
                 start_time,
@@ -500,7 +497,7 @@ impl Instance<Instantiated> {
         };
         self.core
             .check("fmi2SetupExperiment", s, Some(start_time))?;
-        let s = unsafe { (api.fmi2EnterInitializationMode)(self.core.comp) };
+        let s = unsafe { (api.fmi2EnterInitializationMode)(self.comp) };
         self.core
             .check("fmi2EnterInitializationMode", s, Some(start_time))?;
         self.core.phase = Phase::Initialized;
@@ -511,7 +508,7 @@ impl Instance<Instantiated> {
 impl Instance<Initializing> {
     /// `fmi2ExitInitializationMode`: the slave is then at its first communication point.
     pub fn exit_initialization_mode(mut self) -> Result<Instance<Stepping>> {
-        let s = unsafe { (self.core.lib.api.fmi2ExitInitializationMode)(self.core.comp) };
+        let s = unsafe { (self.api().fmi2ExitInitializationMode)(self.comp) };
         self.core.check("fmi2ExitInitializationMode", s, None)?;
         Ok(self.transition())
     }
@@ -522,24 +519,29 @@ impl Instance<Stepping> {
     /// fmi2Discard with `fmi2Terminated` = true is an early end, reported as
     /// [`StepOutcome::Terminated`]; any other status worse than fmi2Warning is an error naming
     /// the instance, the time and the status, with the FMU's last log lines.
-    #[inline]
+    #[inline(always)]
     pub fn do_step(&mut self, t: f64, h: f64) -> Result<StepOutcome> {
-        let api: *const crate::fmu::Api = &self.core.lib.api;
-        // SAFETY: the Arc'd library outlives this call; a raw pointer avoids an Arc clone per step.
-        let api = unsafe { &*api };
-        let s = unsafe { (api.fmi2DoStep)(self.core.comp, t, h, fmi2True) };
+        let s = unsafe { (self.api().fmi2DoStep)(self.comp, t, h, fmi2True) };
         if s == fmi2OK || s == fmi2Warning {
             return Ok(StepOutcome::Ok);
         }
+        self.step_not_ok(t, s)
+    }
+
+    /// fmi2DoStep returned `s`, worse than fmi2Warning: an early end (fmi2Discard with
+    /// `fmi2Terminated`) or an error.
+    #[cold]
+    #[inline(never)]
+    fn step_not_ok(&mut self, t: f64, s: fmi2Status) -> Result<StepOutcome> {
+        let api = self.api();
         if s == fmi2Discard {
             let mut terminated: fmi2Boolean = fmi2False;
-            let st = unsafe {
-                (api.fmi2GetBooleanStatus)(self.core.comp, fmi2Terminated, &mut terminated)
-            };
+            let st =
+                unsafe { (api.fmi2GetBooleanStatus)(self.comp, fmi2Terminated, &mut terminated) };
             if st <= fmi2Warning && terminated != fmi2False {
                 let mut last = t;
                 let st = unsafe {
-                    (api.fmi2GetRealStatus)(self.core.comp, fmi2LastSuccessfulTime, &mut last)
+                    (api.fmi2GetRealStatus)(self.comp, fmi2LastSuccessfulTime, &mut last)
                 };
                 if st > fmi2Warning {
                     last = t;
@@ -562,7 +564,7 @@ impl Instance<Stepping> {
     pub fn serialize_state(&mut self) -> Result<Vec<u8>> {
         self.require_state_support()?;
         let mut state: fmi2FMUstate = std::ptr::null_mut();
-        let s = unsafe { (self.core.lib.api.fmi2GetFMUstate)(self.core.comp, &mut state) };
+        let s = unsafe { (self.api().fmi2GetFMUstate)(self.comp, &mut state) };
         if let Err(e) = self.core.check("fmi2GetFMUstate", s, None) {
             let _ = self.free_state(&mut state);
             return Err(e);
@@ -580,8 +582,8 @@ impl Instance<Stepping> {
         self.require_state_support()?;
         let mut state: fmi2FMUstate = std::ptr::null_mut();
         let s = unsafe {
-            (self.core.lib.api.fmi2DeSerializeFMUstate)(
-                self.core.comp,
+            (self.api().fmi2DeSerializeFMUstate)(
+                self.comp,
                 bytes.as_ptr() as *const fmi2Byte,
                 bytes.len(),
                 &mut state,
@@ -591,7 +593,7 @@ impl Instance<Stepping> {
             let _ = self.free_state(&mut state);
             return Err(e);
         }
-        let s = unsafe { (self.core.lib.api.fmi2SetFMUstate)(self.core.comp, state) };
+        let s = unsafe { (self.api().fmi2SetFMUstate)(self.comp, state) };
         let set = self.core.check("fmi2SetFMUstate", s, None);
         let freed = self.free_state(&mut state);
         set?;
@@ -613,9 +615,7 @@ impl Instance<Stepping> {
     /// Serializes a state got by `fmi2GetFMUstate`.
     fn serialize_held(&mut self, state: fmi2FMUstate) -> Result<Vec<u8>> {
         let mut size = 0usize;
-        let s = unsafe {
-            (self.core.lib.api.fmi2SerializedFMUstateSize)(self.core.comp, state, &mut size)
-        };
+        let s = unsafe { (self.api().fmi2SerializedFMUstateSize)(self.comp, state, &mut size) };
         self.core.check("fmi2SerializedFMUstateSize", s, None)?;
         if size > MAX_STATE_BYTES {
             return Err(Error::Other(format!(
@@ -625,8 +625,8 @@ impl Instance<Stepping> {
         }
         let mut bytes = vec![0u8; size];
         let s = unsafe {
-            (self.core.lib.api.fmi2SerializeFMUstate)(
-                self.core.comp,
+            (self.api().fmi2SerializeFMUstate)(
+                self.comp,
                 state,
                 bytes.as_mut_ptr() as *mut fmi2Byte,
                 size,
@@ -641,13 +641,13 @@ impl Instance<Stepping> {
         if state.is_null() || self.core.phase == Phase::Fatal {
             return Ok(());
         }
-        let s = unsafe { (self.core.lib.api.fmi2FreeFMUstate)(self.core.comp, state) };
+        let s = unsafe { (self.api().fmi2FreeFMUstate)(self.comp, state) };
         self.core.check("fmi2FreeFMUstate", s, None)
     }
 
     /// `fmi2Terminate` then `fmi2FreeInstance`.
     pub fn terminate(mut self) -> Result<()> {
-        let s = unsafe { (self.core.lib.api.fmi2Terminate)(self.core.comp) };
+        let s = unsafe { (self.api().fmi2Terminate)(self.comp) };
         self.core.phase = Phase::Terminated;
         self.core.check("fmi2Terminate", s, None)
     }

@@ -78,6 +78,14 @@ fn fail<M: FmuModel>(inst: &Instance<M>, message: std::fmt::Arguments) -> fmi2St
     inst.error(&message.to_string())
 }
 
+/// `function` got NULL for an array of `n` > 0 values. (The failures of the calls a step loop
+/// makes take their arguments by value, so that the success path keeps them in registers.)
+#[cold]
+#[inline(never)]
+fn null_array<M: FmuModel>(inst: &Instance<M>, function: &str, n: usize) -> fmi2Status {
+    fail(inst, format_args!("{function}: NULL array with nvr = {n}"))
+}
+
 /// `fmi2GetTypesPlatform`.
 pub fn get_types_platform<M: FmuModel>() -> *const c_char {
     c"default".as_ptr()
@@ -396,8 +404,24 @@ fn initial_outputs<M: FmuModel>(inst: &mut Instance<M>) {
     inst.dirty = false;
 }
 
-/// Shared body of the typed getters.
+/// Brings the outputs up to date for a getter after an input or parameter changed: from the
+/// parameters and start values in Initialization Mode ([`initial_outputs`]), else by
+/// `calculate_outputs`. Out of line: a master's step sets inputs and steps before it reads, and
+/// `fmi2DoStep` leaves the outputs current.
+#[inline(never)]
+fn update_outputs<M: FmuModel>(inst: &mut Instance<M>) {
+    if inst.core.state == LifeState::InitializationMode {
+        initial_outputs(inst);
+    } else {
+        inst.refresh_outputs();
+    }
+}
+
+/// Shared body of the typed getters. `fast` reads a value reference that the fast path knows
+/// (Real variables, [`crate::fast`]); any other goes through the table, which checks its type and
+/// names a wrong one, and `read` reads it.
 #[inline(always)]
+#[allow(clippy::too_many_arguments)]
 unsafe fn get_values<M: FmuModel, T>(
     c: fmi2Component,
     function: &str,
@@ -405,6 +429,7 @@ unsafe fn get_values<M: FmuModel, T>(
     vr: *const fmi2ValueReference,
     n: usize,
     out: *mut T,
+    fast: impl Fn(&Instance<M>, fmi2ValueReference) -> Option<T>,
     read: impl Fn(&Variable<M>, &M) -> T,
 ) -> fmi2Status {
     with_instance::<M>(c, function, mask::GET, |inst| {
@@ -412,21 +437,37 @@ unsafe fn get_values<M: FmuModel, T>(
             return fmi2OK;
         }
         if vr.is_null() || out.is_null() {
-            return fail(inst, format_args!("{function}: NULL array with nvr = {n}"));
+            return null_array(inst, function, n);
         }
-        if inst.core.state == LifeState::InitializationMode && inst.dirty {
-            initial_outputs(inst);
+        if inst.dirty {
+            update_outputs(inst);
         }
-        inst.refresh_outputs();
         let vrs = std::slice::from_raw_parts(vr, n);
         for (i, &r) in vrs.iter().enumerate() {
-            match lookup(inst, function, r, base) {
-                Ok(v) => *out.add(i) = read(v, &inst.model),
-                Err(s) => return s,
-            }
+            *out.add(i) = match fast(inst, r) {
+                Some(x) => x,
+                None => match get_by_table(inst, function, base, r, &read) {
+                    Ok(x) => x,
+                    Err(s) => return s,
+                },
+            };
         }
         fmi2OK
     })
+}
+
+/// One value of a getter through the variable table (its type checked). Out of line and
+/// `#[cold]`, so that the fast path's loop stays small and keeps its values in registers.
+#[cold]
+#[inline(never)]
+fn get_by_table<M: FmuModel, T>(
+    inst: &Instance<M>,
+    function: &str,
+    base: crate::BaseType,
+    r: fmi2ValueReference,
+    read: &impl Fn(&Variable<M>, &M) -> T,
+) -> Result<T, fmi2Status> {
+    lookup(inst, function, r, base).map(|v| read(v, &inst.model))
 }
 
 /// # Safety
@@ -444,6 +485,10 @@ pub unsafe fn get_real<M: FmuModel>(
         vr,
         n,
         out,
+        |inst, r| {
+            let get = inst.fast.get_real.get(r as usize).copied().flatten()?;
+            Some(get(&inst.model))
+        },
         |v, m| match v.access {
             Access::Real { get, .. } => get(m),
             _ => unreachable!("type checked by lookup"),
@@ -466,6 +511,7 @@ pub unsafe fn get_integer<M: FmuModel>(
         vr,
         n,
         out,
+        |_, _| None,
         |v, m| match v.access {
             Access::Integer { get, .. } => get(m),
             _ => unreachable!("type checked by lookup"),
@@ -488,6 +534,7 @@ pub unsafe fn get_boolean<M: FmuModel>(
         vr,
         n,
         out,
+        |_, _| None,
         |v, m| match v.access {
             Access::Boolean { get, .. } => get(m) as fmi2Boolean,
             _ => unreachable!("type checked by lookup"),
@@ -517,10 +564,12 @@ pub unsafe fn get_string<M: FmuModel>(
     })
 }
 
-/// Shared body of the typed setters. `apply` validates the value and writes it; it returns the
-/// old value of a parameter (`None` for an input, which is never restored) or an error message
-/// naming the variable on refusal. A tunable parameter changed in StepComplete is checked by
-/// `parameters_changed` and restored on refusal.
+/// Shared body of the typed setters. `fast` writes a value that the fast path accepts (a Real
+/// input within its range, [`crate::fast`]) and says whether it did; any other value goes
+/// through the table: its type and causality are checked, and `apply` validates the value and
+/// writes it; it returns the old value of a parameter (`None` for an input, which is never
+/// restored) or an error message naming the variable on refusal. A tunable parameter changed in
+/// StepComplete is checked by `parameters_changed` and restored on refusal.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
 unsafe fn set_values<M: FmuModel, T: Copy>(
@@ -531,6 +580,7 @@ unsafe fn set_values<M: FmuModel, T: Copy>(
     vr: *const fmi2ValueReference,
     n: usize,
     values: *const T,
+    fast: impl Fn(&mut Instance<M>, fmi2ValueReference, T) -> bool,
     apply: impl Fn(&Variable<M>, &mut M, T) -> Result<Option<T>, String>,
 ) -> fmi2Status {
     with_instance::<M>(c, function, legal, |inst| {
@@ -538,34 +588,15 @@ unsafe fn set_values<M: FmuModel, T: Copy>(
             return fmi2OK;
         }
         if vr.is_null() || values.is_null() {
-            return fail(inst, format_args!("{function}: NULL array with nvr = {n}"));
+            return null_array(inst, function, n);
         }
         let vrs = std::slice::from_raw_parts(vr, n);
         let vals = std::slice::from_raw_parts(values, n);
         for (&r, &x) in vrs.iter().zip(vals) {
-            let v = match lookup(inst, function, r, base) {
-                Ok(v) => v,
-                Err(s) => return s,
-            };
-            let s = check_settable(inst, function, v);
-            if s != fmi2OK {
-                return s;
-            }
-            let old = match apply(v, &mut inst.model, x) {
-                Ok(old) => old,
-                Err(msg) => {
-                    return fail(
-                        inst,
-                        format_args!(
-                            "{function}: instance {:?}: {msg}",
-                            inst.name.to_string_lossy()
-                        ),
-                    )
-                }
-            };
-            inst.dirty = true;
-            if inst.core.state == LifeState::StepComplete && v.causality == Causality::Parameter {
-                let s = tunable_changed(inst, function, v, old, &apply);
+            if fast(inst, r, x) {
+                inst.dirty = true;
+            } else {
+                let s = set_by_table(inst, function, base, r, x, &apply);
                 if s != fmi2OK {
                     return s;
                 }
@@ -573,6 +604,47 @@ unsafe fn set_values<M: FmuModel, T: Copy>(
         }
         fmi2OK
     })
+}
+
+/// One value of a setter through the variable table: type, causality and state checked, the
+/// value validated and written by `apply`, a tunable parameter changed in StepComplete checked
+/// by `parameters_changed`. Out of line and `#[cold]`, so that the fast path's loop stays small
+/// and keeps its values in registers.
+#[cold]
+#[inline(never)]
+fn set_by_table<M: FmuModel, T: Copy>(
+    inst: &mut Instance<M>,
+    function: &str,
+    base: crate::BaseType,
+    r: fmi2ValueReference,
+    x: T,
+    apply: &impl Fn(&Variable<M>, &mut M, T) -> Result<Option<T>, String>,
+) -> fmi2Status {
+    let v = match lookup(inst, function, r, base) {
+        Ok(v) => v,
+        Err(s) => return s,
+    };
+    let s = check_settable(inst, function, v);
+    if s != fmi2OK {
+        return s;
+    }
+    let old = match apply(v, &mut inst.model, x) {
+        Ok(old) => old,
+        Err(msg) => {
+            return fail(
+                inst,
+                format_args!(
+                    "{function}: instance {:?}: {msg}",
+                    inst.name.to_string_lossy()
+                ),
+            )
+        }
+    };
+    inst.dirty = true;
+    if inst.core.state == LifeState::StepComplete && v.causality == Causality::Parameter {
+        return tunable_changed(inst, function, v, old, apply);
+    }
+    fmi2OK
 }
 
 /// A tunable parameter changed in StepComplete: `parameters_changed` checks it; on refusal the
@@ -629,6 +701,13 @@ pub unsafe fn set_real<M: FmuModel>(
         vr,
         n,
         values,
+        |inst, r, x| match inst.fast.set_real.get(r as usize) {
+            Some(input) if input.accepts(x) => {
+                (input.set)(&mut inst.model, x);
+                true
+            }
+            _ => false,
+        },
         |v, m, x| match v.access {
             Access::Real {
                 get, set, min, max, ..
@@ -672,6 +751,7 @@ pub unsafe fn set_integer<M: FmuModel>(
         vr,
         n,
         values,
+        |_, _, _| false,
         |v, m, x| match v.access {
             Access::Integer { get, set, min, max } => {
                 if min.is_some_and(|lo| x < lo) || max.is_some_and(|hi| x > hi) {
@@ -707,6 +787,7 @@ pub unsafe fn set_boolean<M: FmuModel>(
         vr,
         n,
         values,
+        |_, _, _| false,
         |v, m, x| match v.access {
             Access::Boolean { get, set } => {
                 let old = old_value(v, m, get).map(|b| b as fmi2Boolean);
@@ -1016,27 +1097,21 @@ pub unsafe fn do_step<M: FmuModel>(
 ) -> fmi2Status {
     with_instance::<M>(c, "fmi2DoStep", mask::DO_STEP, |inst| {
         let now = inst.core.time;
-        if !(h.is_finite() && h > 0.0) {
-            return fail(
-                inst,
-                format_args!("fmi2DoStep: communicationStepSize = {h} must be > 0"),
-            );
+        // h finite and > 0 (h * 0 is 0 exactly for finite h, NaN otherwise; a NaN h fails
+        // `h > 0`); t finite and not off `now` by more than a relative 1e-10. A master on the
+        // FMU's own grid hands `t == now` exactly, which needs no tolerance.
+        if !(h > 0.0 && h * 0.0 == 0.0) {
+            return step_size_refused(inst, h);
         }
-        let tol = 1e-10 * now.abs().max(1.0);
-        if !t.is_finite() || (t - now).abs() > tol {
-            return fail(
-                inst,
-                format_args!(
-                    "fmi2DoStep: currentCommunicationPoint = {t} does not match the FMU's time {now}"
-                ),
-            );
+        let off = || (t - now).abs() > 1e-10 * now.abs().max(1.0);
+        if !(t.abs() < f64::INFINITY && (t == now || !off())) {
+            return off_time(inst, t, now);
         }
         if let Some(stop) = inst.core.stop_time {
-            if t + h > stop + 1e-10 * stop.abs().max(1.0) {
-                return fail(
-                    inst,
-                    format_args!("fmi2DoStep: step to {} passes stopTime = {stop}", t + h),
-                );
+            // Past stopTime by more than a relative 1e-10 (first: past it at all).
+            let end = t + h;
+            if end > stop && end > stop + 1e-10 * stop.abs().max(1.0) {
+                return past_stop(inst, end, stop);
             }
         }
         match inst.model.do_step(t, h) {
@@ -1048,6 +1123,35 @@ pub unsafe fn do_step<M: FmuModel>(
             Err(msg) => step_failed(inst, t, h, &msg),
         }
     })
+}
+
+#[cold]
+#[inline(never)]
+fn step_size_refused<M: FmuModel>(inst: &Instance<M>, h: f64) -> fmi2Status {
+    fail(
+        inst,
+        format_args!("fmi2DoStep: communicationStepSize = {h} must be > 0"),
+    )
+}
+
+#[cold]
+#[inline(never)]
+fn off_time<M: FmuModel>(inst: &Instance<M>, t: f64, now: f64) -> fmi2Status {
+    fail(
+        inst,
+        format_args!(
+            "fmi2DoStep: currentCommunicationPoint = {t} does not match the FMU's time {now}"
+        ),
+    )
+}
+
+#[cold]
+#[inline(never)]
+fn past_stop<M: FmuModel>(inst: &Instance<M>, end: f64, stop: f64) -> fmi2Status {
+    fail(
+        inst,
+        format_args!("fmi2DoStep: step to {end} passes stopTime = {stop}"),
+    )
 }
 
 /// The model refused a step: the instance moves to the Error state.

@@ -1,5 +1,6 @@
 //! One FMU instance: the model, the lifecycle state, the logger, and the FMU-state snapshot.
 
+use crate::fast::FastAccess;
 use crate::{FmuModel, LOG_CATEGORIES};
 use fmi2::*;
 use serde::{Deserialize, Serialize};
@@ -90,6 +91,8 @@ pub struct Instance<M> {
     pub enabled: [bool; LOG_CATEGORIES.len()],
     /// FNV-1a of the GUID: tags FMU states and serialized states of this model.
     pub magic: u64,
+    /// The Real accessors by value reference, for `fmi2GetReal` and `fmi2SetReal`.
+    pub fast: FastAccess<M>,
 }
 
 pub const CAT_EVENTS: usize = 0;
@@ -137,6 +140,7 @@ impl<M: FmuModel> Instance<M> {
             env,
             enabled,
             magic,
+            fast: FastAccess::new(),
         }
     }
 

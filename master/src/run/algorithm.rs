@@ -87,18 +87,19 @@ impl Algorithm for Jacobi {
     ) -> Result<()> {
         let k = step.k;
         probe.lap(Lap::Master);
+        // Inputs, events and step of one instance after another: `values` changes only when
+        // the outputs are published below, so every instance sees the same calls, with the same
+        // values, as with all inputs first and all steps after (one pass over the slots).
         for (i, s) in slots.iter_mut().enumerate() {
-            if s.steps_at(k) {
+            let due = s.steps_at(k);
+            if due {
                 s.set_inputs(values)?;
                 probe.lap(Lap::Exchange(i));
             }
-        }
-        for e in step.events {
-            slots[e.instance].apply(e, step.t)?;
-            probe.lap(Lap::Exchange(e.instance));
-        }
-        for (i, s) in slots.iter_mut().enumerate() {
-            if s.steps_at(k) {
+            if !step.events.is_empty() {
+                apply_events(s, i, step, probe)?;
+            }
+            if due {
                 s.do_step(k, step.t, grid, count)?;
                 probe.lap(Lap::DoStep(i));
             }
@@ -149,9 +150,8 @@ impl Algorithm for GaussSeidel<'_> {
                 s.set_inputs(values)?;
                 probe.lap(Lap::Exchange(i));
             }
-            for e in step.events.iter().filter(|e| e.instance == i) {
-                s.apply(e, step.t)?;
-                probe.lap(Lap::Exchange(i));
+            if !step.events.is_empty() {
+                apply_events(s, i, step, probe)?;
             }
             if s.steps_at(k) {
                 s.do_step(k, step.t, grid, count)?;
@@ -162,4 +162,20 @@ impl Algorithm for GaussSeidel<'_> {
         }
         Ok(())
     }
+}
+
+/// Applies the step's events of instance `i` to its slot, in their order (FMI 2.0: inputs and
+/// tunable parameters). Out of line: most macro steps have no events.
+#[inline(never)]
+fn apply_events<P: Probe>(
+    s: &mut Slot<Stepping>,
+    i: usize,
+    step: &MacroStep,
+    probe: &mut P,
+) -> Result<()> {
+    for e in step.events.iter().filter(|e| e.instance == i) {
+        s.apply(e, step.t)?;
+        probe.lap(Lap::Exchange(i));
+    }
+    Ok(())
 }

@@ -66,9 +66,11 @@ impl Kind for Real {
     fn map(value: f64, m: Linear) -> f64 {
         m.gain * value + m.offset
     }
+    #[inline]
     fn set<S>(inst: &mut Instance<S>, vrs: &[VR], values: &[f64]) -> Result<()> {
         inst.set_real(vrs, values)
     }
+    #[inline]
     fn get<S: Readable>(inst: &mut Instance<S>, vrs: &[VR], out: &mut [f64]) -> Result<()> {
         inst.get_real(vrs, out)
     }
@@ -87,9 +89,11 @@ impl Kind for Integer {
     fn map(value: i32, _: ()) -> i32 {
         value
     }
+    #[inline]
     fn set<S>(inst: &mut Instance<S>, vrs: &[VR], values: &[i32]) -> Result<()> {
         inst.set_integer(vrs, values)
     }
+    #[inline]
     fn get<S: Readable>(inst: &mut Instance<S>, vrs: &[VR], out: &mut [i32]) -> Result<()> {
         inst.get_integer(vrs, out)
     }
@@ -108,9 +112,11 @@ impl Kind for Boolean {
     fn map(value: i32, _: ()) -> i32 {
         value
     }
+    #[inline]
     fn set<S>(inst: &mut Instance<S>, vrs: &[VR], values: &[i32]) -> Result<()> {
         inst.set_boolean(vrs, values)
     }
+    #[inline]
     fn get<S: Readable>(inst: &mut Instance<S>, vrs: &[VR], out: &mut [i32]) -> Result<()> {
         inst.get_boolean(vrs, out)
     }
@@ -151,17 +157,22 @@ impl<K: Kind> Default for Port<K> {
 }
 
 impl<K: Kind> Port<K> {
+    /// No connected inputs and no observed variables.
+    fn is_empty(&self) -> bool {
+        self.input_vrs.is_empty() && self.observed.vrs.is_empty()
+    }
+
     fn connect(&mut self, vr: VR, source: usize, map: K::Map) {
         self.input_vrs.push(vr);
         self.links.push(Link { source, map });
         self.scratch.push(K::Value::default());
     }
 
-    #[inline]
+    /// Gathers the connected inputs into the scratch buffer and writes them with one batched
+    /// call (none for an instance without inputs of this type: [`Instance::set_real`] and its
+    /// siblings skip an empty batch).
+    #[inline(always)]
     fn set_inputs<S>(&mut self, inst: &mut Instance<S>, values: &Values) -> Result<()> {
-        if self.input_vrs.is_empty() {
-            return Ok(());
-        }
         let shared = K::values(values);
         for (x, l) in self.scratch.iter_mut().zip(&self.links) {
             *x = K::map(shared[l.source], l.map);
@@ -169,7 +180,7 @@ impl<K: Kind> Port<K> {
         K::set(inst, &self.input_vrs, &self.scratch)
     }
 
-    #[inline]
+    #[inline(always)]
     fn get_outputs<S: Readable>(&self, inst: &mut Instance<S>, values: &mut Values) -> Result<()> {
         let Observed { vrs, at } = &self.observed;
         if vrs.is_empty() {
@@ -185,27 +196,36 @@ pub struct Ports {
     real: Port<Real>,
     integer: Port<Integer>,
     boolean: Port<Boolean>,
+    /// The Integer or the Boolean port has inputs or observed variables (one test per call
+    /// for the many instances that exchange only Real values).
+    discrete: bool,
 }
 
 impl Ports {
     /// Writes the instance's connected inputs from `values` (Real, then Integer, then Boolean).
-    #[inline]
+    #[inline(always)]
     pub fn set_inputs<S>(&mut self, inst: &mut Instance<S>, values: &Values) -> Result<()> {
         self.real.set_inputs(inst, values)?;
-        self.integer.set_inputs(inst, values)?;
-        self.boolean.set_inputs(inst, values)
+        if self.discrete {
+            self.integer.set_inputs(inst, values)?;
+            self.boolean.set_inputs(inst, values)?;
+        }
+        Ok(())
     }
 
     /// Reads the instance's observed variables into `values` (Real, then Integer, then Boolean).
-    #[inline]
+    #[inline(always)]
     pub fn get_outputs<S: Readable>(
         &self,
         inst: &mut Instance<S>,
         values: &mut Values,
     ) -> Result<()> {
         self.real.get_outputs(inst, values)?;
-        self.integer.get_outputs(inst, values)?;
-        self.boolean.get_outputs(inst, values)
+        if self.discrete {
+            self.integer.get_outputs(inst, values)?;
+            self.boolean.get_outputs(inst, values)?;
+        }
+        Ok(())
     }
 
     /// The observed variables of exchange type `t` (Real, Integer or Boolean).
@@ -302,6 +322,9 @@ impl Exchange {
                 VarType::Boolean => p.boolean.connect(c.to_vr, g, ()),
                 _ => p.integer.connect(c.to_vr, g, ()),
             }
+        }
+        for p in ports.iter_mut() {
+            p.discrete = !(p.integer.is_empty() && p.boolean.is_empty());
         }
         Exchange {
             ports,
