@@ -182,6 +182,7 @@ fn dispatch(cmd: Command) -> shipsim::Result<()> {
             if let Some(t) = stop_time {
                 sys.stop_time = Some(t);
             }
+            shipsim::format::osp::require_end_time(&sys)?;
             if let Some(a) = algorithm {
                 sys.algorithm = parse_algorithm(&a)?;
             }
@@ -355,6 +356,9 @@ fn run_cli(sys: &System, flags: &RunFlags, checkpoints: Checkpoints) -> shipsim:
     };
     let (plan, fmus) = prepare(sys)?;
     print_warnings(&plan.warnings);
+    if !quiet && !flags.no_output {
+        output_note(sys, out_file.as_deref());
+    }
     if let Some((t, file)) = &checkpoints.at {
         let step = checkpoint_step(&plan, *t)
             .map_err(|e| Error::Other(format!("--checkpoint-at: {e}")))?;
@@ -387,6 +391,23 @@ fn run_cli(sys: &System, flags: &RunFlags, checkpoints: Checkpoints) -> shipsim:
         _ => {}
     }
     Ok(())
+}
+
+/// One line on stderr about the output before a run: that nothing will be written and how to
+/// ask for a file, or that an existing file is about to be replaced (the system files of the
+/// repository all write into target/demo/, so consecutive runs replace each other's CSVs).
+fn output_note(sys: &System, file: Option<&Path>) {
+    match file {
+        Some(f) if f.exists() => eprintln!("overwriting {}", f.display()),
+        Some(_) => {}
+        None => {
+            let how = match shipsim::format::osp::is_osp(sys) {
+                true => "pass -o FILE.csv",
+                false => "pass -o FILE.csv or add [output] file = \"FILE.csv\" to the system file",
+            };
+            eprintln!("no output requested, nothing will be written: {how}");
+        }
+    }
 }
 
 /// `--profile=json`: the summary's figures and the profile, one line.
