@@ -88,10 +88,19 @@ enum Command {
         #[arg(long = "set", value_name = "INST.VAR=VALUE")]
         set: Vec<String>,
     },
-    /// Show an FMU's variables, units and capabilities.
+    /// Show an FMU's variables by causality (type, start, unit and display unit, range,
+    /// description) and capabilities, or with --doc its documentation.
     Inspect {
         /// The .fmu file.
         fmu: PathBuf,
+        /// Print the FMU's documentation/index.html as plain text instead (conventions such as
+        /// angle origins and the meaning of gains are documented there).
+        #[arg(long)]
+        doc: bool,
+        /// With --doc: copy the FMU's documentation/ folder (the HTML page and its files) into
+        /// DIR instead, to open index.html in a browser.
+        #[arg(long, value_name = "DIR", requires = "doc")]
+        html: Option<PathBuf>,
     },
     /// Plot recorded columns of a CSV against time into a PNG.
     Plot {
@@ -154,10 +163,7 @@ fn dispatch(cmd: Command) -> shipsim::Result<()> {
             title,
             output,
         } => plot(&csv, &panels, scale, title, &output),
-        Command::Inspect { fmu } => {
-            print!("{}", shipsim::inspect::inspect(&fmu)?);
-            Ok(())
-        }
+        Command::Inspect { fmu, doc, html } => inspect(&fmu, doc, html.as_deref()),
         Command::Check { system, set } => check(&system, &set),
         Command::Run {
             system,
@@ -198,6 +204,23 @@ fn dispatch(cmd: Command) -> shipsim::Result<()> {
         Command::ExportOsp { system, output } => export_osp(&system, output),
         Command::Campaign { command } => cli::campaign::dispatch(command, ctrl_c_flag),
     }
+}
+
+/// `shipsim inspect [--doc [--html DIR]]`.
+fn inspect(fmu: &Path, doc: bool, html: Option<&Path>) -> shipsim::Result<()> {
+    match (doc, html) {
+        (false, _) => print!("{}", shipsim::inspect::inspect(fmu)?),
+        (true, None) => print!("{}", shipsim::inspect::doc_text(fmu)?),
+        (true, Some(dir)) => {
+            let files = shipsim::inspect::extract_doc(fmu, dir)?;
+            let index = dir.join("index.html");
+            match index.is_file() {
+                true => println!("wrote {} files; open {}", files.len(), index.display()),
+                false => println!("wrote {} files into {}", files.len(), dir.display()),
+            }
+        }
+    }
+    Ok(())
 }
 
 /// A flag that the first Ctrl-C sets (to stop cleanly); a second one exits at once.
