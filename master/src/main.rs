@@ -102,17 +102,31 @@ enum Command {
         #[arg(long, value_name = "DIR", requires = "doc")]
         html: Option<PathBuf>,
     },
-    /// Plot recorded columns of a CSV against time into a PNG.
+    /// Plot recorded columns of one CSV, or of several overlaid, against time (and x-y tracks
+    /// with equal axes) into a PNG.
     Plot {
-        /// The CSV written by `shipsim run`.
-        csv: PathBuf,
-        /// A panel: "Y LABEL=column,column,..." (repeatable; panels stack vertically).
-        #[arg(long = "panel", value_name = "LABEL=COL[,COL...]", required = true)]
+        /// The CSV files written by `shipsim run`; several are overlaid, each column once per
+        /// file (see --label).
+        #[arg(required = true, num_args = 1..)]
+        csv: Vec<PathBuf>,
+        /// A time panel: "Y LABEL=COL[*F],COL[*F],..." (repeatable; panels stack vertically).
+        /// COL*F multiplies that column by F, e.g. "roll [deg]=ship.roll*57.29578".
+        #[arg(long = "panel", value_name = "LABEL=COL[*F][,COL...]")]
         panels: Vec<String>,
-        /// Factor applied to every plotted value (e.g. 57.29578 for rad -> deg).
+        /// An x-y panel with equal scales on both axes, e.g. a track: "ship.y,ship.x" draws
+        /// north (x) up over east (y) (repeatable; below the time panels).
+        #[arg(long = "xy", value_name = "XCOL[*F],YCOL[*F]")]
+        xy: Vec<String>,
+        /// Factor applied to every column that has no *F of its own.
         #[arg(long, default_value_t = 1.0)]
         scale: f64,
-        /// Figure title (default: the CSV file name).
+        /// Names of the CSV files in the legends, in order (default: the file names).
+        #[arg(long, value_delimiter = ',', value_name = "NAME,NAME...")]
+        label: Vec<String>,
+        /// Only the rows with T0 <= t <= T1 [s]; either may be left out ("200:", ":600").
+        #[arg(long, value_name = "T0:T1", allow_hyphen_values = true)]
+        window: Option<String>,
+        /// Figure title (default: the CSV file, or the files' labels joined by "vs").
         #[arg(long)]
         title: Option<String>,
         /// PNG output file.
@@ -159,10 +173,23 @@ fn dispatch(cmd: Command) -> shipsim::Result<()> {
         Command::Plot {
             csv,
             panels,
+            xy,
             scale,
+            label,
+            window,
             title,
             output,
-        } => plot(&csv, &panels, scale, title, &output),
+        } => {
+            let args = PlotArgs {
+                panels,
+                xy,
+                scale,
+                label,
+                window,
+                title,
+            };
+            plot(&csv, args, &output)
+        }
         Command::Inspect { fmu, doc, html } => inspect(&fmu, doc, html.as_deref()),
         Command::Check { system, set } => check(&system, &set),
         Command::Run {
@@ -235,35 +262,58 @@ fn ctrl_c_flag() -> Arc<AtomicBool> {
     flag
 }
 
-/// `shipsim plot`: one panel per --panel, columns against time.
-fn plot(
-    csv: &Path,
-    panels: &[String],
+/// The options of `shipsim plot`.
+struct PlotArgs {
+    panels: Vec<String>,
+    xy: Vec<String>,
     scale: f64,
+    label: Vec<String>,
+    window: Option<String>,
     title: Option<String>,
-    output: &Path,
-) -> shipsim::Result<()> {
-    let table = shipsim::plot::Table::read(csv)?;
-    let mut out = Vec::new();
-    for spec in panels {
-        let (label, cols) = spec.split_once('=').ok_or_else(|| {
-            Error::Other(format!("--panel {spec:?}: expected LABEL=COL[,COL...]"))
-        })?;
-        let mut series = Vec::new();
-        for col in cols.split(',').map(str::trim).filter(|c| !c.is_empty()) {
-            series.push(shipsim::plot::Series {
-                label: col.to_string(),
-                t: table.time().to_vec(),
-                y: table.column(col)?.iter().map(|v| v * scale).collect(),
-            });
-        }
-        out.push(shipsim::plot::Panel {
-            y_label: label.to_string(),
-            series,
-        });
+}
+
+/// `shipsim plot`: one time panel per --panel and one x-y panel per --xy, each series once per
+/// CSV file.
+fn plot(csvs: &[PathBuf], a: PlotArgs, output: &Path) -> shipsim::Result<()> {
+    use shipsim::plot::{parse_window, plot_figure, Request, Table};
+    if a.panels.is_empty() && a.xy.is_empty() {
+        return Err(Error::Other("nothing to plot: give --panel or --xy".into()));
     }
-    let title = title.unwrap_or_else(|| csv.display().to_string());
-    shipsim::plot::plot_panels(output, &title, &out)?;
+    if !a.label.is_empty() && a.label.len() != csvs.len() {
+        return Err(Error::Other(format!(
+            "--label has {} names for {} CSV files",
+            a.label.len(),
+            csvs.len()
+        )));
+    }
+    let mut files = Vec::new();
+    for (i, csv) in csvs.iter().enumerate() {
+        let name = match a.label.get(i) {
+            Some(l) => l.clone(),
+            None => csv
+                .file_name()
+                .unwrap_or(csv.as_os_str())
+                .to_string_lossy()
+                .into_owned(),
+        };
+        files.push((name, Table::read(csv)?));
+    }
+    let request = Request {
+        files: &files,
+        panels: &a.panels,
+        tracks: &a.xy,
+        scale: a.scale,
+        window: a.window.as_deref().map(parse_window).transpose()?,
+    };
+    let (panels, tracks) = request.figure()?;
+    let title = a.title.unwrap_or_else(|| {
+        let names: Vec<&str> = files.iter().map(|(name, _)| name.as_str()).collect();
+        match csvs {
+            [one] => one.display().to_string(),
+            _ => names.join(" vs "),
+        }
+    });
+    plot_figure(output, &title, &panels, &tracks)?;
     println!("wrote {}", output.display());
     Ok(())
 }
