@@ -104,35 +104,7 @@ enum Command {
     },
     /// Plot recorded columns of one CSV, or of several overlaid, against time (and x-y tracks
     /// with equal axes) into a PNG.
-    Plot {
-        /// The CSV files written by `shipsim run`; several are overlaid, each column once per
-        /// file (see --label).
-        #[arg(required = true, num_args = 1..)]
-        csv: Vec<PathBuf>,
-        /// A time panel: "Y LABEL=COL[*F],COL[*F],..." (repeatable; panels stack vertically).
-        /// COL*F multiplies that column by F, e.g. "roll [deg]=ship.roll*57.29578".
-        #[arg(long = "panel", value_name = "LABEL=COL[*F][,COL...]")]
-        panels: Vec<String>,
-        /// An x-y panel with equal scales on both axes, e.g. a track: "ship.y,ship.x" draws
-        /// north (x) up over east (y) (repeatable; below the time panels).
-        #[arg(long = "xy", value_name = "XCOL[*F],YCOL[*F]")]
-        xy: Vec<String>,
-        /// Factor applied to every column that has no *F of its own.
-        #[arg(long, default_value_t = 1.0)]
-        scale: f64,
-        /// Names of the CSV files in the legends, in order (default: the file names).
-        #[arg(long, value_delimiter = ',', value_name = "NAME,NAME...")]
-        label: Vec<String>,
-        /// Only the rows with T0 <= t <= T1 [s]; either may be left out ("200:", ":600").
-        #[arg(long, value_name = "T0:T1", allow_hyphen_values = true)]
-        window: Option<String>,
-        /// Figure title (default: the CSV file, or the files' labels joined by "vs").
-        #[arg(long)]
-        title: Option<String>,
-        /// PNG output file.
-        #[arg(long, short)]
-        output: PathBuf,
-    },
+    Plot(PlotArgs),
     /// Campaigns: many runs over factors, seeds and arms, one KPI row per run.
     Campaign {
         #[command(subcommand)]
@@ -170,26 +142,7 @@ fn main() -> ExitCode {
 
 fn dispatch(cmd: Command) -> shipsim::Result<()> {
     match cmd {
-        Command::Plot {
-            csv,
-            panels,
-            xy,
-            scale,
-            label,
-            window,
-            title,
-            output,
-        } => {
-            let args = PlotArgs {
-                panels,
-                xy,
-                scale,
-                label,
-                window,
-                title,
-            };
-            plot(&csv, args, &output)
-        }
+        Command::Plot(args) => plot(args),
         Command::Inspect { fmu, doc, html } => inspect(&fmu, doc, html.as_deref()),
         Command::Check { system, set } => check(&system, &set),
         Command::Run {
@@ -262,20 +215,43 @@ fn ctrl_c_flag() -> Arc<AtomicBool> {
     flag
 }
 
-/// The options of `shipsim plot`.
+/// The arguments of `shipsim plot`.
+#[derive(clap::Args)]
 struct PlotArgs {
+    /// The CSV files written by `shipsim run`; several are overlaid, each column once per
+    /// file (see --label).
+    #[arg(required = true, num_args = 1..)]
+    csv: Vec<PathBuf>,
+    /// A time panel: "Y LABEL=COL[*F],COL[*F],..." (repeatable; panels stack vertically).
+    /// COL*F multiplies that column by F, e.g. "roll [deg]=ship.roll*57.29578".
+    #[arg(long = "panel", value_name = "LABEL=COL[*F][,COL...]")]
     panels: Vec<String>,
+    /// An x-y panel with equal scales on both axes, e.g. a track: "ship.y,ship.x" draws
+    /// north (x) up over east (y) (repeatable; below the time panels).
+    #[arg(long = "xy", value_name = "XCOL[*F],YCOL[*F]")]
     xy: Vec<String>,
+    /// Factor applied to every column that has no *F of its own.
+    #[arg(long, default_value_t = 1.0)]
     scale: f64,
+    /// Names of the CSV files in the legends, in order (default: the file names).
+    #[arg(long, value_delimiter = ',', value_name = "NAME,NAME...")]
     label: Vec<String>,
+    /// Only the rows with T0 <= t <= T1 [s]; either may be left out ("200:", ":600").
+    #[arg(long, value_name = "T0:T1", allow_hyphen_values = true)]
     window: Option<String>,
+    /// Figure title (default: the CSV file, or the files' labels joined by "vs").
+    #[arg(long)]
     title: Option<String>,
+    /// PNG output file.
+    #[arg(long, short)]
+    output: PathBuf,
 }
 
 /// `shipsim plot`: one time panel per --panel and one x-y panel per --xy, each series once per
 /// CSV file.
-fn plot(csvs: &[PathBuf], a: PlotArgs, output: &Path) -> shipsim::Result<()> {
+fn plot(a: PlotArgs) -> shipsim::Result<()> {
     use shipsim::plot::{parse_window, plot_figure, Request, Table};
+    let (csvs, output) = (a.csv.as_slice(), a.output.as_path());
     if a.panels.is_empty() && a.xy.is_empty() {
         return Err(Error::Other("nothing to plot: give --panel or --xy".into()));
     }

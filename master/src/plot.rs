@@ -270,6 +270,10 @@ pub(crate) fn create_parent_dir(path: &Path) -> Result<()> {
 /// to be drawn whole: plotters centres a tick label on its tick, so half of it lies right of
 /// the plotting area.
 const RIGHT_MARGIN: u32 = 30;
+/// The other margins of a chart, and the heights and widths of its axis label areas [px].
+const MARGIN: u32 = 10;
+const X_LABEL_AREA: u32 = 35;
+const Y_LABEL_AREA: u32 = 70;
 
 /// Draws the panels one above the other against time and writes a PNG.
 pub fn plot_panels(path: &Path, title: &str, panels: &[Panel]) -> Result<()> {
@@ -371,21 +375,42 @@ fn draw_time_panel(
         (lo, hi) = (-1.0, 1.0);
     }
     let pad = ((hi - lo) * 0.08).max(1e-9);
+    let desc = ("time [s]", panel.y_label.as_str());
+    draw_chart(
+        area,
+        (t0, t1),
+        (lo - pad, hi + pad),
+        desc,
+        &panel.series,
+        err,
+    )
+}
+
+/// One chart: the mesh with the axis descriptions, the series as lines in [`COLORS`] order,
+/// the legend.
+fn draw_chart(
+    area: &Area,
+    (x0, x1): (f64, f64),
+    (y0, y1): (f64, f64),
+    (x_desc, y_desc): (&str, &str),
+    series: &[Series],
+    err: &impl Fn(DrawError) -> Error,
+) -> Result<()> {
     let mut chart = ChartBuilder::on(area)
-        .margin(10)
+        .margin(MARGIN)
         .margin_right(RIGHT_MARGIN)
-        .x_label_area_size(35)
-        .y_label_area_size(70)
-        .build_cartesian_2d(t0..t1, (lo - pad)..(hi + pad))
+        .x_label_area_size(X_LABEL_AREA)
+        .y_label_area_size(Y_LABEL_AREA)
+        .build_cartesian_2d(x0..x1, y0..y1)
         .map_err(err)?;
     chart
         .configure_mesh()
-        .x_desc("time [s]")
-        .y_desc(panel.y_label.as_str())
+        .x_desc(x_desc)
+        .y_desc(y_desc)
         .label_style(("sans-serif", 14))
         .draw()
         .map_err(err)?;
-    for (i, s) in panel.series.iter().enumerate() {
+    for (i, s) in series.iter().enumerate() {
         let c = color(i);
         chart
             .draw_series(LineSeries::new(
@@ -419,46 +444,14 @@ pub fn equal_axes(x: (f64, f64), y: (f64, f64), w: u32, h: u32) -> ((f64, f64), 
 }
 
 fn draw_track(area: &Area, track: &Track, err: &impl Fn(DrawError) -> Error) -> Result<()> {
-    let (margin, x_area, y_area) = (10u32, 35u32, 70u32);
     let (w, h) = area.dim_in_pixel();
-    let plot_w = w.saturating_sub(margin + RIGHT_MARGIN + y_area);
-    let plot_h = h.saturating_sub(2 * margin + x_area);
+    let plot_w = w.saturating_sub(MARGIN + RIGHT_MARGIN + Y_LABEL_AREA);
+    let plot_h = h.saturating_sub(2 * MARGIN + X_LABEL_AREA);
     let xs = bounds(track.series.iter().flat_map(|s| &s.t));
     let ys = bounds(track.series.iter().flat_map(|s| &s.y));
-    let ((x0, x1), (y0, y1)) = equal_axes(xs, ys, plot_w, plot_h);
-    let mut chart = ChartBuilder::on(area)
-        .margin(margin)
-        .margin_right(RIGHT_MARGIN)
-        .x_label_area_size(x_area)
-        .y_label_area_size(y_area)
-        .build_cartesian_2d(x0..x1, y0..y1)
-        .map_err(err)?;
-    chart
-        .configure_mesh()
-        .x_desc(track.x_label.as_str())
-        .y_desc(track.y_label.as_str())
-        .label_style(("sans-serif", 14))
-        .draw()
-        .map_err(err)?;
-    for (i, s) in track.series.iter().enumerate() {
-        let c = color(i);
-        chart
-            .draw_series(LineSeries::new(
-                s.t.iter().copied().zip(s.y.iter().copied()),
-                c.stroke_width(2),
-            ))
-            .map_err(err)?
-            .label(s.label.as_str())
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2)));
-    }
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .label_font(("sans-serif", 14))
-        .draw()
-        .map_err(err)?;
-    Ok(())
+    let (x, y) = equal_axes(xs, ys, plot_w, plot_h);
+    let desc = (track.x_label.as_str(), track.y_label.as_str());
+    draw_chart(area, x, y, desc, &track.series, err)
 }
 
 #[cfg(test)]
