@@ -306,7 +306,13 @@ pub fn plot_figure(path: &Path, title: &str, panels: &[Panel], tracks: &[Track])
     let err = draw_err(path);
     root.fill(&WHITE).map_err(&err)?;
     let root = root.titled(title, ("sans-serif", 22)).map_err(&err)?;
-    let split = PANEL_HEIGHT * panels.len() as u32;
+    // The height below the title, shared in proportion (all of it without tracks).
+    let (time_px, track_px) = (
+        PANEL_HEIGHT * panels.len() as u32,
+        TRACK_HEIGHT * tracks.len() as u32,
+    );
+    let below_title = root.dim_in_pixel().1;
+    let split = below_title * time_px / (time_px + track_px);
     let (time_area, track_area) = root.split_vertically(split);
     if !panels.is_empty() {
         let areas = time_area.split_evenly((panels.len(), 1));
