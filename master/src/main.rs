@@ -100,31 +100,26 @@ enum Command {
         #[arg(long)]
         strict_units: bool,
     },
-    /// Show an FMU's variables, units and capabilities.
+    /// Show an FMU's variables by causality (type, start, unit and display unit, range,
+    /// description) and capabilities, or with --doc its documentation.
     Inspect {
         /// The .fmu file.
         fmu: PathBuf,
-    },
-    /// Plot recorded columns of a CSV against time into a PNG.
-    Plot {
-        /// The CSV written by `shipsim run`.
-        csv: PathBuf,
-        /// A panel: "Y LABEL=column,column,..." (repeatable; panels stack vertically).
-        #[arg(long = "panel", value_name = "LABEL=COL[,COL...]", required = true)]
-        panels: Vec<String>,
-        /// Factor applied to every plotted value (e.g. 57.29578 for rad -> deg).
-        #[arg(long, default_value_t = 1.0)]
-        scale: f64,
-        /// Figure title (default: the CSV file name).
+        /// Print the FMU's documentation/index.html as plain text instead (conventions such as
+        /// angle origins and the meaning of gains are documented there).
         #[arg(long)]
-        title: Option<String>,
-        /// PNG output file.
-        #[arg(long, short)]
-        output: PathBuf,
+        doc: bool,
+        /// With --doc: copy the FMU's documentation/ folder (the HTML page and its files) into
+        /// DIR instead, to open index.html in a browser.
+        #[arg(long, value_name = "DIR", requires = "doc")]
+        html: Option<PathBuf>,
     },
     /// Statistics of a recorded CSV per column over a time window: mean, variance, std, RMS,
     /// min, max and max |x|.
     Stats(cli::stats::StatsArgs),
+    /// Plot recorded columns of one CSV, or of several overlaid, against time (and x-y tracks
+    /// with equal axes) into a PNG.
+    Plot(PlotArgs),
     /// Campaigns: many runs over factors, seeds and arms, one KPI row per run.
     Campaign {
         #[command(subcommand)]
@@ -162,17 +157,8 @@ fn main() -> ExitCode {
 
 fn dispatch(cmd: Command) -> shipsim::Result<()> {
     match cmd {
-        Command::Plot {
-            csv,
-            panels,
-            scale,
-            title,
-            output,
-        } => plot(&csv, &panels, scale, title, &output),
-        Command::Inspect { fmu } => {
-            print!("{}", shipsim::inspect::inspect(&fmu)?);
-            Ok(())
-        }
+        Command::Plot(args) => plot(args),
+        Command::Inspect { fmu, doc, html } => inspect(&fmu, doc, html.as_deref()),
         Command::Check {
             system,
             set,
@@ -202,6 +188,7 @@ fn dispatch(cmd: Command) -> shipsim::Result<()> {
             if let Some(t) = stop_time {
                 sys.stop_time = Some(t);
             }
+            shipsim::format::osp::require_end_time(&sys)?;
             if let Some(a) = algorithm {
                 sys.algorithm = parse_algorithm(&a)?;
             }
@@ -221,6 +208,23 @@ fn dispatch(cmd: Command) -> shipsim::Result<()> {
     }
 }
 
+/// `shipsim inspect [--doc [--html DIR]]`.
+fn inspect(fmu: &Path, doc: bool, html: Option<&Path>) -> shipsim::Result<()> {
+    match (doc, html) {
+        (false, _) => print!("{}", shipsim::inspect::inspect(fmu)?),
+        (true, None) => print!("{}", shipsim::inspect::doc_text(fmu)?),
+        (true, Some(dir)) => {
+            let files = shipsim::inspect::extract_doc(fmu, dir)?;
+            let index = dir.join("index.html");
+            match index.is_file() {
+                true => println!("wrote {} files; open {}", files.len(), index.display()),
+                false => println!("wrote {} files into {}", files.len(), dir.display()),
+            }
+        }
+    }
+    Ok(())
+}
+
 /// A flag that the first Ctrl-C sets (to stop cleanly); a second one exits at once.
 fn ctrl_c_flag() -> Arc<AtomicBool> {
     let flag = Arc::new(AtomicBool::new(false));
@@ -233,35 +237,81 @@ fn ctrl_c_flag() -> Arc<AtomicBool> {
     flag
 }
 
-/// `shipsim plot`: one panel per --panel, columns against time.
-fn plot(
-    csv: &Path,
-    panels: &[String],
+/// The arguments of `shipsim plot`.
+#[derive(clap::Args)]
+struct PlotArgs {
+    /// The CSV files written by `shipsim run`; several are overlaid, each column once per
+    /// file (see --label).
+    #[arg(required = true, num_args = 1..)]
+    csv: Vec<PathBuf>,
+    /// A time panel: "Y LABEL=COL[*F],COL[*F],..." (repeatable; panels stack vertically).
+    /// COL*F multiplies that column by F, e.g. "roll [deg]=ship.roll*57.29578".
+    #[arg(long = "panel", value_name = "LABEL=COL[*F][,COL...]")]
+    panels: Vec<String>,
+    /// An x-y panel with equal scales on both axes, e.g. a track: "ship.y,ship.x" draws
+    /// north (x) up over east (y) (repeatable; below the time panels).
+    #[arg(long = "xy", value_name = "XCOL[*F],YCOL[*F]")]
+    xy: Vec<String>,
+    /// Factor applied to every column that has no *F of its own.
+    #[arg(long, default_value_t = 1.0)]
     scale: f64,
+    /// Names of the CSV files in the legends, in order (default: the file names).
+    #[arg(long, value_delimiter = ',', value_name = "NAME,NAME...")]
+    label: Vec<String>,
+    /// Only the rows with T0 <= t <= T1 [s]; either may be left out ("200:", ":600").
+    #[arg(long, value_name = "T0:T1", allow_hyphen_values = true)]
+    window: Option<String>,
+    /// Figure title (default: the CSV file, or the files' labels joined by "vs").
+    #[arg(long)]
     title: Option<String>,
-    output: &Path,
-) -> shipsim::Result<()> {
-    let table = shipsim::plot::Table::read(csv)?;
-    let mut out = Vec::new();
-    for spec in panels {
-        let (label, cols) = spec.split_once('=').ok_or_else(|| {
-            Error::Other(format!("--panel {spec:?}: expected LABEL=COL[,COL...]"))
-        })?;
-        let mut series = Vec::new();
-        for col in cols.split(',').map(str::trim).filter(|c| !c.is_empty()) {
-            series.push(shipsim::plot::Series {
-                label: col.to_string(),
-                t: table.time().to_vec(),
-                y: table.column(col)?.iter().map(|v| v * scale).collect(),
-            });
-        }
-        out.push(shipsim::plot::Panel {
-            y_label: label.to_string(),
-            series,
-        });
+    /// PNG output file.
+    #[arg(long, short)]
+    output: PathBuf,
+}
+
+/// `shipsim plot`: one time panel per --panel and one x-y panel per --xy, each series once per
+/// CSV file.
+fn plot(a: PlotArgs) -> shipsim::Result<()> {
+    use shipsim::plot::{parse_window, plot_figure, Request, Table};
+    let (csvs, output) = (a.csv.as_slice(), a.output.as_path());
+    if a.panels.is_empty() && a.xy.is_empty() {
+        return Err(Error::Other("nothing to plot: give --panel or --xy".into()));
     }
-    let title = title.unwrap_or_else(|| csv.display().to_string());
-    shipsim::plot::plot_panels(output, &title, &out)?;
+    if !a.label.is_empty() && a.label.len() != csvs.len() {
+        return Err(Error::Other(format!(
+            "--label has {} names for {} CSV files",
+            a.label.len(),
+            csvs.len()
+        )));
+    }
+    let mut files = Vec::new();
+    for (i, csv) in csvs.iter().enumerate() {
+        let name = match a.label.get(i) {
+            Some(l) => l.clone(),
+            None => csv
+                .file_name()
+                .unwrap_or(csv.as_os_str())
+                .to_string_lossy()
+                .into_owned(),
+        };
+        files.push((name, Table::read(csv)?));
+    }
+    let request = Request {
+        files: &files,
+        panels: &a.panels,
+        tracks: &a.xy,
+        scale: a.scale,
+        window: a.window.as_deref().map(parse_window).transpose()?,
+    };
+    let (panels, tracks) = request.figure()?;
+    let title = a.title.unwrap_or_else(|| {
+        let names: Vec<&str> = files.iter().map(|(name, _)| name.as_str()).collect();
+        match csvs {
+            [one] => one.display().to_string(),
+            _ => names.join(" vs "),
+        }
+    });
+    plot_figure(output, &title, &panels, &tracks)?;
     println!("wrote {}", output.display());
     Ok(())
 }
@@ -378,6 +428,9 @@ fn run_cli(sys: &System, flags: &RunFlags, checkpoints: Checkpoints) -> shipsim:
     };
     let (plan, fmus) = prepare(sys)?;
     print_warnings(&plan.warnings);
+    if !quiet && !flags.no_output {
+        output_note(sys, out_file.as_deref());
+    }
     if let Some((t, file)) = &checkpoints.at {
         let step = checkpoint_step(&plan, *t)
             .map_err(|e| Error::Other(format!("--checkpoint-at: {e}")))?;
@@ -410,6 +463,23 @@ fn run_cli(sys: &System, flags: &RunFlags, checkpoints: Checkpoints) -> shipsim:
         _ => {}
     }
     Ok(())
+}
+
+/// One line on stderr about the output before a run: that nothing will be written and how to
+/// ask for a file, or that an existing file is about to be replaced (the system files of the
+/// repository all write into target/demo/, so consecutive runs replace each other's CSVs).
+fn output_note(sys: &System, file: Option<&Path>) {
+    match file {
+        Some(f) if f.exists() => eprintln!("overwriting {}", f.display()),
+        Some(_) => {}
+        None => {
+            let how = match shipsim::format::osp::is_osp(sys) {
+                true => "pass -o FILE.csv",
+                false => "pass -o FILE.csv or add [output] file = \"FILE.csv\" to the system file",
+            };
+            eprintln!("no output requested, nothing will be written: {how}");
+        }
+    }
 }
 
 /// `--profile=json`: the summary's figures and the profile, one line.

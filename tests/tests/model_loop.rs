@@ -106,7 +106,7 @@ fn the_binary_writes_shipsims_csv_byte_for_byte() {
     let d = tempfile::tempdir().unwrap();
     let (ours, theirs) = (d.path().join("loop.csv"), d.path().join("shipsim.csv"));
     let out = std::process::Command::new(env!("CARGO_BIN_EXE_rrs-model-loop"))
-        .args(["--stop-time", "60", "--roll-mode", "0", "--csv"])
+        .args(["--stop-time", "1200", "--roll-mode", "0", "--csv"])
         .arg(&ours)
         .output()
         .unwrap();
@@ -117,11 +117,11 @@ fn the_binary_writes_shipsims_csv_byte_for_byte() {
     );
     let line = String::from_utf8(out.stdout).unwrap();
     assert!(
-        line.starts_with("{\"stop_time\":60,\"macro_steps\":1200,\"wall_s\":")
+        line.starts_with("{\"stop_time\":1200,\"macro_steps\":24000,\"wall_s\":")
             && line.ends_with("}\n"),
         "{line}"
     );
-    let (plan, fmus) = prepare(&shipsim_run(&["autopilot.roll_mode=0"], 60.0)).unwrap();
+    let (plan, fmus) = prepare(&shipsim_run(&["autopilot.roll_mode=0"], 1200.0)).unwrap();
     run(
         &plan,
         &fmus,
@@ -135,4 +135,6 @@ fn the_binary_writes_shipsims_csv_byte_for_byte() {
     );
     assert_eq!(a.len(), b.len(), "file sizes");
     assert!(a == b, "the CSV files differ");
+    // The full run records values below 1e-6, written with an exponent by both.
+    assert!(a.windows(2).any(|w| w == b"e-"), "no exponent-form field");
 }

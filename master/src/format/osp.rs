@@ -204,6 +204,28 @@ pub fn parse(path: &Path, text: &str) -> Result<System> {
     })
 }
 
+/// Was the system read from an OSP file (`.xml`, as [`System::load`] decides)?
+pub fn is_osp(sys: &System) -> bool {
+    sys.source
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("xml"))
+}
+
+/// An OSP file may leave out `<EndTime>` (libcosim then runs until it is stopped); shipsim
+/// needs an end. A system read from such a file (`.xml`, [`parse`]) whose stop time was not set
+/// since (`shipsim run --stop-time`) is an error naming the file, instead of the one-second run
+/// that the validation's default stop time (start + 1 s) would give. Other systems pass.
+pub fn require_end_time(sys: &System) -> Result<()> {
+    if is_osp(sys) && sys.stop_time.is_none() {
+        return Err(Error::system(
+            &sys.source,
+            None,
+            "the file has no <EndTime>; pass the stop time with --stop-time SECONDS",
+        ));
+    }
+    Ok(())
+}
+
 /// A LinearTransformation's endpoints: its "in" variable and its "out" variables.
 #[derive(Default)]
 struct Signals {

@@ -107,9 +107,13 @@ impl Summary {
 impl std::fmt::Display for Summary {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         let w = self.wall_time.as_secs_f64();
+        let early = match self.terminated_by {
+            Some(_) => " (ended early)",
+            None => "",
+        };
         writeln!(
             f,
-            "simulated {} s .. {} s: {} macro steps, {} FMU steps",
+            "simulated {} s .. {} s{early}: {} macro steps, {} FMU steps",
             self.start_time, self.end_time, self.macro_steps, self.fmu_steps
         )?;
         write!(
@@ -122,7 +126,15 @@ impl std::fmt::Display for Summary {
             w * 1e6 / self.fmu_steps.max(1) as f64
         )?;
         if let Some(t) = &self.terminated_by {
-            write!(f, "\n{t}")?;
+            // The instance's time is its own last successful time (FMI 2.0, sec. 4.2.3), which
+            // lies in its last step; the master ends that macro step for the other instances
+            // and stops at the step's end, t_(k+1): the end of the run and its last row. With
+            // a step multiple, or an FMU that reports the end of its step, the two differ.
+            write!(
+                f,
+                "\n{t}; the master stopped at the end of that macro step, at t = {} s (its last communication point)",
+                self.end_time
+            )?;
         }
         if let Some(p) = &self.output_file {
             write!(f, "\n{} rows written to {}", self.rows, p.display())?;

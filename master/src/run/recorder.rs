@@ -90,7 +90,8 @@ pub trait Recorder {
 }
 
 /// The CSV file of `shipsim run`: header `time,instance.variable,...`, one line per row.
-/// Numbers are written in Rust's shortest round-trip form, so values survive the file exactly;
+/// Numbers are written in Rust's shortest round-trip digits, so values survive the file exactly
+/// ([`write_real`]: plain decimal, with an exponent for very small and very large magnitudes);
 /// Booleans are written 0 or 1.
 pub struct CsvRecorder {
     out: Box<dyn Write>,
@@ -99,6 +100,28 @@ pub struct CsvRecorder {
 impl CsvRecorder {
     pub fn new(out: Box<dyn Write>) -> CsvRecorder {
         CsvRecorder { out }
+    }
+}
+
+/// Below this magnitude (and above zero) a number is written with an exponent.
+const EXP_BELOW: f64 = 1e-6;
+/// From this magnitude on a number is written with an exponent.
+const EXP_FROM: f64 = 1e21;
+
+/// Writes `x` in its shortest round-trip digits: as plain decimal (`{}`: `0.25`, `-1500`)
+/// when 1e-6 <= |x| < 1e21 or x is 0, NaN or infinite, else with an exponent (`{:e}`:
+/// `2.2250738585072014e-308`, `1e21`). Both forms parse back to the same `f64`. The
+/// thresholds are those of ECMAScript's Number::toString (ECMA-262, sec. 6.1.6.1.20): inside
+/// them the decimal form is at most 25 characters, outside them the exponent form is shorter
+/// (`DBL_MIN` in decimal is 326 characters). Values in between keep the decimal form the
+/// recorder always wrote, so such fields of existing CSVs do not change.
+#[inline]
+pub fn write_real(out: &mut impl Write, x: f64) -> std::io::Result<()> {
+    let a = x.abs();
+    if (a < EXP_BELOW && a != 0.0) || (a >= EXP_FROM && a.is_finite()) {
+        write!(out, "{x:e}")
+    } else {
+        write!(out, "{x}")
     }
 }
 
@@ -121,10 +144,13 @@ impl Recorder for CsvRecorder {
 
     #[inline]
     fn record(&mut self, time: f64, row: &Row<'_>) -> Result<()> {
-        write!(self.out, "{time}").map_err(write_error)?;
+        write_real(&mut self.out, time).map_err(write_error)?;
         for v in row.iter() {
             match v {
-                Sample::Real(x) => write!(self.out, ",{x}"),
+                Sample::Real(x) => self
+                    .out
+                    .write_all(b",")
+                    .and_then(|()| write_real(&mut self.out, x)),
                 Sample::Integer(i) => write!(self.out, ",{i}"),
                 Sample::Boolean(b) => write!(self.out, ",{}", b as i32),
             }
@@ -188,5 +214,68 @@ impl Recorder for MemoryRecorder {
             column.push(v.as_f64());
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::write_real;
+
+    fn text(x: f64) -> String {
+        let mut b = Vec::new();
+        write_real(&mut b, x).unwrap();
+        String::from_utf8(b).unwrap()
+    }
+
+    /// The forms chosen at and around the thresholds, written out by hand.
+    #[test]
+    fn decimal_inside_exponent_outside() {
+        assert_eq!(text(f64::MIN_POSITIVE), "2.2250738585072014e-308");
+        assert_eq!(text(-5e-324), "-5e-324");
+        assert_eq!(text(9.99e-7), "9.99e-7");
+        assert_eq!(text(1e-6), "0.000001");
+        assert_eq!(text(-1.25e-5), "-0.0000125");
+        assert_eq!(text(0.1 + 0.2), "0.30000000000000004");
+        assert_eq!(text(-1500.0), "-1500");
+        assert_eq!(text(999999999999999900000.0), "999999999999999900000");
+        assert_eq!(text(1e21), "1e21");
+        assert_eq!(text(f64::MAX), "1.7976931348623157e308");
+        assert_eq!(text(0.0), "0");
+        assert_eq!(text(-0.0), "-0");
+        assert_eq!(text(f64::NAN), "NaN");
+        assert_eq!(text(f64::NEG_INFINITY), "-inf");
+    }
+
+    /// Every written value parses back to the same bits (NaN to a NaN), and no field is longer
+    /// than 25 characters: 200,000 bit patterns spread over the whole range of f64 (a fixed
+    /// xorshift sequence), plus the powers of ten around the thresholds.
+    #[test]
+    fn round_trips_and_stays_short() {
+        let mut state = 0x9E37_79B9_7F4A_7C15_u64;
+        let mut values: Vec<f64> = (0..200_000)
+            .map(|_| {
+                state ^= state << 13;
+                state ^= state >> 7;
+                state ^= state << 17;
+                f64::from_bits(state)
+            })
+            .collect();
+        for e in -330..330 {
+            let p: f64 = format!("1e{e}").parse().unwrap();
+            values.extend([p, -p, p.next_up(), p.next_down()]);
+        }
+        for x in values {
+            let t = text(x);
+            let back: f64 = t.parse().unwrap();
+            assert!(
+                back.to_bits() == x.to_bits() || (x.is_nan() && back.is_nan()),
+                "{x:e} written as {t}"
+            );
+            assert!(
+                t.len() <= 25,
+                "{x:e} written as {t} ({} characters)",
+                t.len()
+            );
+        }
     }
 }

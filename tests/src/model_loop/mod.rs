@@ -25,6 +25,7 @@
 
 pub mod rrs;
 
+use shipsim::run::recorder::write_real;
 use std::io::Write;
 use std::time::Duration;
 
@@ -95,10 +96,12 @@ impl<W: Write> CsvWriter<W> {
         }
     }
 
+    /// One line, numbers as `shipsim run` writes them ([`write_real`]).
     fn write_row(&mut self, time: f64, values: &[f64]) -> std::io::Result<()> {
-        write!(self.out, "{time}")?;
+        write_real(&mut self.out, time)?;
         for x in values {
-            write!(self.out, ",{x}")?;
+            self.out.write_all(b",")?;
+            write_real(&mut self.out, *x)?;
         }
         self.out.write_all(b"\n")
     }
