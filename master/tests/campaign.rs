@@ -258,7 +258,7 @@ name = "fmu_error"
 set = {{ "m.fail_at_step" = 5 }}
 [[arms]]
 name = "nan"
-set = {{ "m.k" = nan }}
+set = {{ "m.k" = inf, "m.u" = 0.0 }}  # y2 = k*u = inf*0 = NaN (a NaN parameter is refused by validation)
 [[arms]]
 name = "terminated"
 set = {{ "m.terminate_at_step" = 50 }}
