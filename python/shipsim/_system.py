@@ -146,6 +146,17 @@ class System:
         return self._native.algorithm
 
     @property
+    def strict_units(self) -> bool:
+        """Unit mismatches across connections are errors (True, the default for native TOML)
+        or warnings (False, the default for OSP XML, as libcosim does not check units), like
+        ``shipsim run --strict-units``."""
+        return self._native.strict_units
+
+    @strict_units.setter
+    def strict_units(self, strict: bool) -> None:
+        self._native.strict_units = bool(strict)
+
+    @property
     def instances(self) -> Dict[str, str]:
         """Instance name -> FMU path, in system order."""
         return {name: os.fspath(p) for name, p in self._native.instances}

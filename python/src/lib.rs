@@ -453,6 +453,16 @@ impl PySystem {
     fn step_size(&self) -> f64 {
         self.system.step_size
     }
+    /// Unit mismatches across connections are errors (true: native TOML files) or warnings
+    /// (false: OSP files, as libcosim does not check units); `--strict-units` sets it.
+    #[getter]
+    fn strict_units(&self) -> bool {
+        self.system.strict_units
+    }
+    #[setter]
+    fn set_strict_units(&mut self, strict: bool) {
+        self.system.strict_units = strict;
+    }
     #[getter]
     fn algorithm(&self) -> String {
         format!("{:?}", self.system.algorithm)

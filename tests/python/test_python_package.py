@@ -273,3 +273,20 @@ def test_set_accepts_values_with_units():
     s.set("waves.wave_direction", "15 kn")
     with pytest.raises(shipsim.SystemFileError, match="kn"):
         s.run(stop_time=1)
+
+
+def test_strict_units_of_an_osp_file(tmp_path):
+    """An OSP file's unit mismatches are warnings (ShipsimWarning), as libcosim runs such files;
+    strict_units = True makes them errors, like --strict-units. The RRS export maps wave moments
+    [N.m] onto rudder-equivalent disturbances [rad] (convert = true in the TOML)."""
+    xml = tmp_path / "OspSystemStructure.xml"
+    subprocess.run([BIN, "export-osp", str(RRS), "-o", str(xml)], check=True, capture_output=True)
+    s = shipsim.System.load(xml)
+    assert s.strict_units is False and shipsim.System.load(RRS).strict_units is True
+    with pytest.warns(shipsim.ShipsimWarning, match="incompatible units"):
+        df = s.run(stop_time=20, variables=["ship.roll"])
+    ref = shipsim.System.load(RRS).run(stop_time=20, variables=["ship.roll"])
+    pd.testing.assert_frame_equal(df, ref, check_exact=True)
+    s.strict_units = True
+    with pytest.raises(shipsim.SystemFileError, match="incompatible units"):
+        s.run(stop_time=20)
