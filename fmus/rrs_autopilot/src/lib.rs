@@ -4,7 +4,9 @@
 //! physics here: the variable table maps the model onto FMI variables.
 
 use fmi2_export::FmuModel;
-use models::controllers::rrs::{AgcTarget, RollMode, RrsAutopilot, RrsAutopilotParams, RrsInputs};
+use models::controllers::rrs::{
+    AgcTarget, RollMode, RrsAutopilot, RrsAutopilotParams, RrsInputs, RrsOutputs,
+};
 use serde::{Deserialize, Serialize};
 
 /// Parameters, inputs and state of one autopilot instance.
@@ -13,6 +15,23 @@ pub struct RrsAutopilotFmu {
     params: RrsAutopilotParams,
     inputs: RrsInputs,
     autopilot: RrsAutopilot,
+    /// `autopilot.outputs(&inputs)`, computed once wherever the autopilot or its inputs change
+    /// (initialize, parameters_changed, calculate_outputs, do_step) instead of in each of the
+    /// four getters that read it; `None` (after a deserialized restore) means compute it. Not
+    /// part of the state.
+    #[serde(skip)]
+    outputs: Option<RrsOutputs>,
+}
+
+impl RrsAutopilotFmu {
+    fn out(&self) -> RrsOutputs {
+        self.outputs
+            .unwrap_or_else(|| self.autopilot.outputs(&self.inputs))
+    }
+
+    fn keep_outputs(&mut self) {
+        self.outputs = Some(self.autopilot.outputs(&self.inputs));
+    }
 }
 
 impl Default for RrsAutopilotFmu {
@@ -25,6 +44,7 @@ impl Default for RrsAutopilotFmu {
             },
             autopilot: RrsAutopilot::new(params).expect("default parameters are valid"),
             params,
+            outputs: None,
         }
     }
 }
@@ -107,13 +127,13 @@ fmi2_export::fmu! {
             "Manual steering wheel rudder (course_auto = false)";
         input real "rudder_angle" ["rad"] (inputs.rudder),
             "Measured rudder angle (criterion rule 6)";
-        output real "rudder_command" ["rad"] (|m| m.autopilot.outputs(&m.inputs).rudder_command),
+        output real "rudder_command" ["rad"] (|m| m.out().rudder_command),
             "Rudder set point delta_g to the steering machine (course + AGC-attenuated roll rudder, limited to angle_max)";
-        output real "roll_rudder" ["rad"] (|m| m.autopilot.outputs(&m.inputs).roll_rudder),
+        output real "roll_rudder" ["rad"] (|m| m.out().roll_rudder),
             "Roll-controller rudder delta_phi = -(k1 phi + k2 phi_dot + k3 v_delta) before the AGC (0 with RRS off)";
-        output real "course_rudder" ["rad"] (|m| m.autopilot.outputs(&m.inputs).course_rudder),
+        output real "course_rudder" ["rad"] (|m| m.out().course_rudder),
             "Course-controller rudder delta_psi (or the wheel in manual)";
-        output real "attenuation" (|m| m.autopilot.outputs(&m.inputs).attenuation),
+        output real "attenuation" (|m| m.out().attenuation),
             "AGC attenuation A = rate_max / max(rate_max, |du/dt|, memory), 0 < A <= 1";
         output real "q_phi" (|m| m.autopilot.q_phi()), "Current roll weight q_phi (criterion adaptation)";
         output real "roll_variance" (|m| m.autopilot.roll_variance()),
@@ -133,18 +153,94 @@ fmi2_export::fmu! {
 
 impl FmuModel for RrsAutopilotFmu {
     fn initialize(&mut self, _start_time: f64) -> Result<(), String> {
+        self.outputs = None;
         self.autopilot = RrsAutopilot::new(self.params).map_err(|e| e.to_string())?;
+        self.keep_outputs();
         Ok(())
     }
 
     fn parameters_changed(&mut self) -> Result<(), String> {
-        self.autopilot
-            .set_params(self.params)
-            .map_err(|e| e.to_string())
+        let changed = self.autopilot.set_params(self.params);
+        self.keep_outputs();
+        changed.map_err(|e| e.to_string())
+    }
+
+    fn calculate_outputs(&mut self) {
+        self.keep_outputs();
     }
 
     fn do_step(&mut self, _t: f64, h: f64) -> Result<(), String> {
         self.autopilot.step(&self.inputs, h);
+        self.keep_outputs();
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use fmi2_export::testing::real_of as output;
+
+    /// The four outputs read from the kept outputs equal `RrsAutopilot::outputs` for the
+    /// current inputs bit for bit: before the first sample (where they follow the inputs, kept
+    /// by `calculate_outputs`), after each step, after a parameter change, and when nothing is
+    /// kept (a deserialized state).
+    #[test]
+    fn outputs_from_the_kept_outputs_equal_the_model() {
+        let mut m = RrsAutopilotFmu::default();
+        m.initialize(0.0).unwrap();
+        let check = |m: &RrsAutopilotFmu, at: &str| {
+            let o = m.autopilot.outputs(&m.inputs);
+            for (name, want) in [
+                ("rudder_command", o.rudder_command),
+                ("roll_rudder", o.roll_rudder),
+                ("course_rudder", o.course_rudder),
+                ("attenuation", o.attenuation),
+            ] {
+                assert_eq!(output(m, name).to_bits(), want.to_bits(), "{name} {at}");
+            }
+            let mut restored = m.clone();
+            restored.outputs = None;
+            for name in [
+                "rudder_command",
+                "roll_rudder",
+                "course_rudder",
+                "attenuation",
+            ] {
+                assert_eq!(
+                    output(&restored, name).to_bits(),
+                    output(m, name).to_bits(),
+                    "{name} {at}, restored"
+                );
+            }
+        };
+        check(&m, "initialized");
+        // before the first sample the outputs are the control law at the current inputs
+        m.inputs.roll = 0.05;
+        m.inputs.heading_error = -0.02;
+        m.calculate_outputs();
+        check(&m, "inputs set");
+        // (the roll gains start at 0: the innovation process starts from P = 0)
+        assert!(m.out().course_rudder != 0.0 && m.out().rudder_command != 0.0);
+        let mut commands = Vec::new();
+        for k in 0..300 {
+            let t = 0.1 * k as f64;
+            m.inputs.roll = 0.1 * (0.63 * t).sin();
+            m.inputs.roll_rate = 0.063 * (0.63 * t).cos();
+            m.inputs.heading_error = 0.02 * (0.05 * t).sin();
+            m.calculate_outputs();
+            check(&m, &format!("step {k}, inputs set"));
+            m.do_step(t, 0.1).unwrap();
+            check(&m, &format!("step {k}"));
+            commands.push(m.out().rudder_command);
+            if k == 150 {
+                m.params.angle_max = 0.2;
+                m.parameters_changed().unwrap();
+                check(&m, "angle_max changed");
+            }
+        }
+        // the held outputs change from sample to sample, the roll rudder among them
+        assert!(commands.windows(2).filter(|w| w[0] != w[1]).count() > 250);
+        assert!(m.out().roll_rudder != 0.0);
     }
 }

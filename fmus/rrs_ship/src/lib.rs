@@ -4,7 +4,7 @@
 
 use fmi2_export::FmuModel;
 use models::error::check_positive;
-use models::hull::rrs_ship::{RrsShip, RrsShipInputs, RrsShipOutputs, U_22KN};
+use models::hull::rrs_ship::{RrsShip, RrsShipInputs, RrsShipOutputs, NX, U_22KN};
 use models::hull::DEG;
 use serde::{Deserialize, Serialize};
 
@@ -22,11 +22,6 @@ pub struct RrsShipFmu {
     wind_roll: f64,
     wind_yaw: f64,
     ship: RrsShip,
-    /// The model's outputs, computed once wherever the model changes (initialize, do_step,
-    /// calculate_outputs) instead of in every getter; `None` (after a deserialized restore)
-    /// means compute them. Not part of the state.
-    #[serde(skip)]
-    outputs: Option<RrsShipOutputs>,
 }
 
 /// Start value of `rudder_angle`: a small rudder so that the default experiment turns and rolls.
@@ -47,23 +42,21 @@ impl Default for RrsShipFmu {
             wind_roll: 0.0,
             wind_yaw: 0.0,
             ship,
-            outputs: None,
         }
     }
 }
 
 impl RrsShipFmu {
-    fn model_outputs(&self) -> RrsShipOutputs {
-        self.ship.outputs()
+    /// State variable `i` of the model, `[φ, p, v, r, ψ, a1, a2, b1, b2, c1, c2, x, y]`: the
+    /// outputs that are states are read straight from it, the value `RrsShip::outputs` copies
+    /// (a step loop reads roll, heading and yaw rate, and no output needs computing after a step).
+    fn state(&self, i: usize) -> f64 {
+        self.ship.state()[i]
     }
 
+    /// The outputs that are not states (wrapped heading, wave contributions), computed when read.
     fn out(&self) -> RrsShipOutputs {
-        self.outputs.unwrap_or_else(|| self.model_outputs())
-    }
-
-    /// Keeps the outputs of the model as it is now (the getters read them).
-    fn keep_outputs(&mut self) {
-        self.outputs = Some(self.model_outputs());
+        self.ship.outputs()
     }
 
     fn check(&self) -> Result<(), String> {
@@ -107,16 +100,19 @@ fmi2_export::fmu! {
             "Rudder-equivalent yaw disturbance w_psi (eq. 3.29), entering as w_psi/tau_r";
         input real "wave_elevation" ["m"] (inputs.wave_elevation),
             "Wave height w driving the Table 2.2 filters (model 1 only; e.g. Waves.wave_elevation)";
-        output real "roll" ["rad"] (|m| m.out().roll), "Roll angle phi";
-        output real "roll_rate" ["rad/s"] (|m| m.out().roll_rate), "Roll rate p";
-        output real "sway" (|m| m.out().sway),
+        output real "roll" ["rad"] (|m| m.state(0)), "Roll angle phi";
+        output real "roll_rate" ["rad/s"] (|m| m.state(1)), "Roll rate p";
+        output real "sway" (|m| m.state(2)),
             "Sway state v (model 1) or v' (models 2, 3: the sway due to the rudder, x3 of eq. 3.29), in \
              the model's own scale, not m/s (Table 2.4 fixes K_dv0 = 0.01)";
-        output real "yaw_rate" ["rad/s"] (|m| m.out().yaw_rate), "Yaw rate r";
-        heading!(out());
-        output real "x" ["m"] (|m| m.out().x),
+        output real "yaw_rate" ["rad/s"] (|m| m.state(3)), "Yaw rate r";
+        output real "heading" ["rad"] (|m| m.state(4)),
+            "Heading psi from north, clockwise, continuous (not wrapped)";
+        output real "heading_wrapped" ["rad"] (|m| m.out().heading_wrapped),
+            "Heading wrapped to (-pi, pi]";
+        output real "x" ["m"] (|m| m.state(NX)),
             "North position, x' = U cos(psi) (sway neglected: the thesis has no position)";
-        output real "y" ["m"] (|m| m.out().y), "East position, y' = U sin(psi)";
+        output real "y" ["m"] (|m| m.state(NX + 1)), "East position, y' = U sin(psi)";
         output real "wave_sway" (|m| m.out().wave_sway),
             "Wave-induced sway contribution y_wv (model 1; model units)";
         output real "wave_yaw" (|m| m.out().wave_yaw),
@@ -134,7 +130,6 @@ fmi2_export::fmu! {
 
 impl FmuModel for RrsShipFmu {
     fn initialize(&mut self, _start_time: f64) -> Result<(), String> {
-        self.outputs = None;
         self.check()?;
         let mut ship = match self.model {
             1 => RrsShip::simulation_22kn(),
@@ -145,19 +140,13 @@ impl FmuModel for RrsShipFmu {
         ship.min_speed = self.min_speed;
         ship.max_substep = self.max_substep;
         self.ship = ship;
-        self.keep_outputs();
         Ok(())
     }
 
     fn parameters_changed(&mut self) -> Result<(), String> {
-        self.outputs = None;
         self.check()?;
         self.ship.min_speed = self.min_speed;
         Ok(())
-    }
-
-    fn calculate_outputs(&mut self) {
-        self.keep_outputs();
     }
 
     fn do_step(&mut self, _t: f64, h: f64) -> Result<(), String> {
@@ -165,7 +154,6 @@ impl FmuModel for RrsShipFmu {
         inputs.roll_disturbance += self.wind_roll;
         inputs.yaw_disturbance += self.wind_yaw;
         self.ship.step(&inputs, h);
-        self.keep_outputs();
         Ok(())
     }
 }

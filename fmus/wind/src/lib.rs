@@ -13,20 +13,38 @@ pub struct WindFmu {
     speed: f64,
     heading: f64,
     model: Wind,
-    /// `model.relative()`, computed once wherever the model changes (do_step, calculate_outputs,
-    /// initialize, parameters_changed) instead of in each of the four getters that need it;
-    /// `None` (after a deserialized restore) means compute it. Not part of the state.
+    /// The relative wind and the moments, computed once wherever the model changes (do_step,
+    /// calculate_outputs, initialize, parameters_changed) instead of in each getter; `None`
+    /// (after a deserialized restore) means compute them. Not part of the state.
     #[serde(skip)]
-    relative: Option<(f64, f64)>,
+    kept: Option<Relative>,
+}
+
+/// The outputs derived from the relative wind.
+#[derive(Clone, Copy, Debug)]
+struct Relative {
+    /// `Wind::relative`: (V_w, gamma).
+    wind: (f64, f64),
+    roll_moment: f64,
+    yaw_moment: f64,
 }
 
 impl WindFmu {
-    fn relative(&self) -> (f64, f64) {
-        self.relative.unwrap_or_else(|| self.model.relative())
+    fn relative(&self) -> Relative {
+        let wind = self.model.relative();
+        Relative {
+            wind,
+            roll_moment: self.model.roll_moment_at(wind),
+            yaw_moment: self.model.yaw_moment_at(wind),
+        }
+    }
+
+    fn out(&self) -> Relative {
+        self.kept.unwrap_or_else(|| self.relative())
     }
 
     fn keep_relative(&mut self) {
-        self.relative = Some(self.model.relative());
+        self.kept = Some(self.relative());
     }
 }
 
@@ -38,7 +56,7 @@ impl Default for WindFmu {
             params,
             speed: 0.0,
             heading: 0.0,
-            relative: None,
+            kept: None,
         }
     }
 }
@@ -76,13 +94,13 @@ fmi2_export::fmu! {
             "Mean plus gust wind speed";
         output real "true_wind_direction" ["rad"] (|m| m.model.true_direction()),
             "Mean plus varying direction (towards)";
-        output real "relative_wind_speed" ["m/s"] (|m| m.relative().0),
+        output real "relative_wind_speed" ["m/s"] (|m| m.out().wind.0),
             "V_w: relative wind speed as measured on board";
-        output real "relative_wind_angle" ["rad"] (|m| m.relative().1),
+        output real "relative_wind_angle" ["rad"] (|m| m.out().wind.1),
             "gamma in (-pi, pi]: 0 wind from astern, +pi/2 blowing towards starboard, pi head wind";
-        output real "roll_moment" ["N.m"] (|m| m.model.roll_moment_at(m.relative())),
+        output real "roll_moment" ["N.m"] (|m| m.out().roll_moment),
             "K = c_w_phi V_w^2 sin(gamma) (003 eq. 2.19)";
-        output real "yaw_moment" ["N.m"] (|m| m.model.yaw_moment_at(m.relative())),
+        output real "yaw_moment" ["N.m"] (|m| m.out().yaw_moment),
             "N = c_wR V_w^2 sin(2 gamma) (003 eq. 2.20)";
     }
 }
@@ -126,7 +144,7 @@ mod tests {
     use super::*;
     use fmi2_export::testing::real_of as output;
 
-    /// The outputs read from the relative wind kept at each change equal the model's own
+    /// The outputs read from the relative wind and moments kept at each change equal the model's own
     /// functions bit for bit, and so do they when nothing is kept (a deserialized state).
     #[test]
     fn outputs_from_the_kept_relative_wind_equal_the_model() {
@@ -160,7 +178,7 @@ mod tests {
                 check(&m);
             }
             let mut restored = m.clone();
-            restored.relative = None;
+            restored.kept = None;
             check(&restored);
         }
     }
