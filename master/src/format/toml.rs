@@ -9,6 +9,8 @@
 //! stop_time = 100.0
 //! step_size = 0.01          # base step h; t_k = start_time + k*h
 //! algorithm = "jacobi"      # or "gauss-seidel"
+//! last_step = "drop"        # stop_time off the grid: "drop" stops at the grid point before
+//!                           # it, "short" takes a shorter last step to it
 //!
 //! [[instances]]
 //! name = "gear"
@@ -43,6 +45,7 @@
 
 use super::{collected, line_of};
 use crate::error::{Error, Result};
+use crate::run::LastStep;
 use crate::system::{
     Algorithm, ConnectionSpec, EventSpec, InstanceSpec, OutputSpec, System, Value, ValueSpec,
     VarRef,
@@ -75,6 +78,9 @@ struct RawSimulation {
     step_size: f64,
     #[serde(default)]
     algorithm: Option<Spanned<String>>,
+    /// `"drop"` (default) or `"short"`: a stop time off the base-step grid ([`LastStep`]).
+    #[serde(default)]
+    last_step: Option<Spanned<String>>,
 }
 
 #[derive(Deserialize)]
@@ -160,6 +166,7 @@ pub fn parse(path: &Path, text: &str) -> Result<System> {
     };
     let sim = raw.simulation;
     let algorithm = r.algorithm(sim.algorithm.as_ref());
+    let last_step = r.last_step(sim.last_step.as_ref());
     let instances = raw.instances.into_iter().map(|i| r.instance(i)).collect();
     let connections = raw
         .connections
@@ -180,10 +187,30 @@ pub fn parse(path: &Path, text: &str) -> Result<System> {
         events,
         output,
         strict_units: true,
+        last_step,
     })
 }
 
 impl Reader<'_> {
+    /// `[simulation] last_step`: "drop" (the default) or "short".
+    fn last_step(&mut self, s: Option<&Spanned<String>>) -> LastStep {
+        let Some(s) = s else {
+            return LastStep::default();
+        };
+        LastStep::parse(s.get_ref()).unwrap_or_else(|| {
+            let e = Error::system(
+                self.path,
+                self.line(s.span()),
+                format!(
+                    "last_step = \"{}\": expected \"drop\" (stop at the last base-step point before an off-grid stop_time) or \"short\" (a shorter last step to it)",
+                    s.get_ref()
+                ),
+            );
+            self.errors.push(e);
+            LastStep::default()
+        })
+    }
+
     fn line(&self, span: std::ops::Range<usize>) -> Option<usize> {
         Some(line_of(self.text, span.start))
     }
