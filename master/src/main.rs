@@ -71,6 +71,11 @@ enum Command {
         /// OspSystemStructure.xml only warns, as libcosim runs it; the native TOML always errs).
         #[arg(long)]
         strict_units: bool,
+        /// A stop time off the base-step grid: `drop` stops at the last grid point before it
+        /// (the default), `short` takes a shorter last step to it (every FMU must declare
+        /// canHandleVariableCommunicationStepSize). Overrides the system's `last_step`.
+        #[arg(long, value_name = "short|drop", value_parser = ["short", "drop"])]
+        last_step: Option<String>,
         /// Show all FMU log messages and switch FMU debug logging on.
         #[arg(long, short)]
         verbose: bool,
@@ -174,6 +179,7 @@ fn dispatch(cmd: Command) -> shipsim::Result<()> {
             set,
             algorithm,
             strict_units,
+            last_step,
             verbose,
             quiet,
             checkpoint_at,
@@ -193,6 +199,9 @@ fn dispatch(cmd: Command) -> shipsim::Result<()> {
                 sys.algorithm = parse_algorithm(&a)?;
             }
             sys.strict_units |= strict_units;
+            if let Some(l) = last_step.as_deref().and_then(shipsim::run::LastStep::parse) {
+                sys.last_step = l;
+            }
             let flags = RunFlags {
                 output,
                 no_output,

@@ -201,6 +201,7 @@ pub fn parse(path: &Path, text: &str) -> Result<System> {
             decimation: 1,
         },
         strict_units: false,
+        last_step: Default::default(),
     })
 }
 

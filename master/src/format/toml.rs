@@ -9,6 +9,8 @@
 //! stop_time = 100.0
 //! step_size = 0.01          # base step h; t_k = start_time + k*h
 //! algorithm = "jacobi"      # or "gauss-seidel"
+//! last_step = "drop"        # stop_time off the grid: "drop" stops at the grid point before
+//!                           # it, "short" takes a shorter last step to it
 //!
 //! [[instances]]
 //! name = "gear"
@@ -16,7 +18,7 @@
 //! step_multiple = 1         # this instance steps every n base steps
 //! parameters = { time_constant = 2.0, rate_max = "10 deg/s" }
 //!
-//! [[connections]]            # or: connections = ["a.y -> b.u", ...]
+//! [[connections]]            # or a list, see below
 //! from = "autopilot.rudder_command"
 //! to = "gear.rudder_command"
 //! gain = 1.0                # to = gain*from + offset (unit conversion)
@@ -34,6 +36,20 @@
 //! decimation = 1
 //! ```
 //!
+//! Connections may instead be one list, which must come before the first table (TOML puts a
+//! key into the last table header above it) and cannot be combined with `[[connections]]`
+//! tables (a TOML key holds one value). Its entries are strings `"from -> to"` with the table
+//! form's keys after commas, or inline tables, mixed freely:
+//!
+//! ```toml
+//! connections = [
+//!     "autopilot.rudder_command -> gear.rudder_command",
+//!     "gear.rudder_angle -> ship.rudder_angle, gain = 1.0, offset = 0.0",
+//!     "ship.r -> log.yaw_rate_deg, gain = 57.29577951308232, convert",
+//!     { from = "ship.psi", to = "autopilot.heading", gain = 1.0 },
+//! ]
+//! ```
+//!
 //! A value is a number, a boolean or a string. For a Real variable a string is a number or a
 //! `pi` expression with an optional unit (`"90 deg"`, `"15 kn"`, `"pi/2"`), converted to the
 //! variable's declared unit when the system is validated ([`crate::units`], `docs/units.md`);
@@ -43,6 +59,7 @@
 
 use super::{collected, line_of};
 use crate::error::{Error, Result};
+use crate::run::LastStep;
 use crate::system::{
     Algorithm, ConnectionSpec, EventSpec, InstanceSpec, OutputSpec, System, Value, ValueSpec,
     VarRef,
@@ -75,6 +92,9 @@ struct RawSimulation {
     step_size: f64,
     #[serde(default)]
     algorithm: Option<Spanned<String>>,
+    /// `"drop"` (default) or `"short"`: a stop time off the base-step grid ([`LastStep`]).
+    #[serde(default)]
+    last_step: Option<Spanned<String>>,
 }
 
 #[derive(Deserialize)]
@@ -148,10 +168,7 @@ struct Reader<'t> {
 
 /// Parses the native TOML format.
 pub fn parse(path: &Path, text: &str) -> Result<System> {
-    let raw: RawSystem = toml::from_str(text).map_err(|e| {
-        let line = e.span().map(|s| line_of(text, s.start));
-        Error::system(path, line, e.message().trim().to_string())
-    })?;
+    let raw: RawSystem = toml::from_str(text).map_err(|e| parse_error(path, text, &e))?;
     let mut r = Reader {
         path,
         text,
@@ -160,6 +177,7 @@ pub fn parse(path: &Path, text: &str) -> Result<System> {
     };
     let sim = raw.simulation;
     let algorithm = r.algorithm(sim.algorithm.as_ref());
+    let last_step = r.last_step(sim.last_step.as_ref());
     let instances = raw.instances.into_iter().map(|i| r.instance(i)).collect();
     let connections = raw
         .connections
@@ -180,10 +198,30 @@ pub fn parse(path: &Path, text: &str) -> Result<System> {
         events,
         output,
         strict_units: true,
+        last_step,
     })
 }
 
 impl Reader<'_> {
+    /// `[simulation] last_step`: "drop" (the default) or "short".
+    fn last_step(&mut self, s: Option<&Spanned<String>>) -> LastStep {
+        let Some(s) = s else {
+            return LastStep::default();
+        };
+        LastStep::parse(s.get_ref()).unwrap_or_else(|| {
+            let e = Error::system(
+                self.path,
+                self.line(s.span()),
+                format!(
+                    "last_step = \"{}\": expected \"drop\" (stop at the last base-step point before an off-grid stop_time) or \"short\" (a shorter last step to it)",
+                    s.get_ref()
+                ),
+            );
+            self.errors.push(e);
+            LastStep::default()
+        })
+    }
+
     fn line(&self, span: std::ops::Range<usize>) -> Option<usize> {
         Some(line_of(self.text, span.start))
     }
@@ -257,21 +295,10 @@ impl Reader<'_> {
     fn connection(&mut self, c: Spanned<RawConnection>) -> Option<ConnectionSpec> {
         let line = self.line(c.span());
         let (from, to, gain, offset, convert) = match c.into_inner() {
-            RawConnection::Short(s) => match s.split_once("->") {
-                Some((a, b)) => (
-                    a.trim().to_string(),
-                    b.trim().to_string(),
-                    None,
-                    None,
-                    false,
-                ),
-                None => {
-                    self.error(
-                        line,
-                        format!(
-                            "connection \"{s}\" must read \"instance.output -> instance.input\""
-                        ),
-                    );
+            RawConnection::Short(s) => match short_connection(&s) {
+                Ok(c) => c,
+                Err(m) => {
+                    self.error(line, format!("connection \"{s}\": {m}"));
                     return None;
                 }
             },
@@ -353,4 +380,85 @@ impl Reader<'_> {
             decimation,
         }
     }
+}
+
+/// A connection's (from, to, gain, offset, convert).
+type Link = (String, String, Option<f64>, Option<f64>, bool);
+
+/// The string form of a connection: `"from -> to"`, then optionally, comma-separated, the keys
+/// of the table form: `gain = G`, `offset = O` and `convert` (or `convert = true`), e.g.
+/// `"ap.rudder_command -> gear.rudder_command, gain = 2.5, offset = 0.1"`.
+fn short_connection(s: &str) -> std::result::Result<Link, String> {
+    const FORM: &str = "it must read \"instance.output -> instance.input\", optionally followed by \", gain = G\", \", offset = O\" and \", convert\"";
+    let mut parts = s.split(',');
+    let ends = parts.next().unwrap_or_default();
+    let Some((from, to)) = ends.split_once("->") else {
+        return Err(FORM.into());
+    };
+    let (mut gain, mut offset, mut convert) = (None, None, None);
+    for part in parts {
+        let (key, value) = match part.split_once('=') {
+            Some((k, v)) => (k.trim(), Some(v.trim())),
+            None => (part.trim(), None),
+        };
+        let number = |v: Option<&str>| {
+            v.and_then(|v| v.parse::<f64>().ok().filter(|x| x.is_finite()))
+                .ok_or(format!(
+                    "'{}': {key} must be a number ({key} = 2.5)",
+                    part.trim()
+                ))
+        };
+        let slot_taken = match key {
+            "gain" => gain.replace(number(value)?).is_some(),
+            "offset" => offset.replace(number(value)?).is_some(),
+            "convert" => {
+                let v = match value {
+                    None | Some("true") => true,
+                    Some("false") => false,
+                    Some(_) => return Err(format!("'{}': convert is true or false", part.trim())),
+                };
+                convert.replace(v).is_some()
+            }
+            _ => {
+                return Err(format!(
+                    "unknown key '{key}' (expected gain, offset or convert); {FORM}"
+                ))
+            }
+        };
+        if slot_taken {
+            return Err(format!("{key} is given twice"));
+        }
+    }
+    Ok((
+        from.trim().to_string(),
+        to.trim().to_string(),
+        gain,
+        offset,
+        convert.unwrap_or(false),
+    ))
+}
+
+/// A TOML parse error, explained where the cause is TOML's own rule on top-level keys: a key
+/// belongs to the last table header above it, so `connections = [...]` must come before the
+/// first table, and a key holds one value, so `connections = [...]` and `[[connections]]`
+/// tables cannot both be in one file.
+fn parse_error(path: &Path, text: &str, e: &toml::de::Error) -> Error {
+    let line = e.span().map(|s| line_of(text, s.start));
+    let msg = e.message().trim();
+    const LIST: &str = "connections = [\"a.y -> b.u\", \"c.y -> d.u, gain = 2.5, convert\", { from = \"e.y\", to = \"f.u\", offset = 1.0 }]";
+    let explained = if msg.contains("duplicate key `connections`") {
+        Some(format!("[[connections]] tables and a connections = [...] list in one file: TOML allows only one of the two for a key. Write every connection in the list (strings and inline tables mix there: {LIST}), or every one as a [[connections]] table"))
+    } else if msg.contains("unknown field `connections`") {
+        let header = line.and_then(|l| {
+            text.lines()
+                .take(l)
+                .map(str::trim)
+                .filter(|h| h.starts_with('['))
+                .last()
+        });
+        Some(format!("connections = [...] is read as a key of the table {} above it: in TOML a key belongs to the last table header before it, so top-level keys must come before the first table. Move the connections list to the top of the file (before [simulation]), or write [[connections]] tables", header.unwrap_or("header")))
+    } else {
+        None
+    };
+    Error::system(path, line, explained.unwrap_or_else(|| msg.to_string()))
 }

@@ -51,7 +51,7 @@ use exchange::Exchange;
 pub use profile::{Profile, Sampling};
 pub use recorder::{ColumnInfo, CsvRecorder, MemoryRecorder, Recorder, Row, Sample};
 use stepping::{Recording, Stepper};
-pub use time_grid::TimeGrid;
+pub use time_grid::{LastStep, OffGrid, TimeGrid};
 
 /// How to run.
 #[derive(Clone, Default)]
@@ -94,6 +94,9 @@ pub struct Summary {
     /// Set when an FMU ended the simulation early (fmi2Discard + fmi2Terminated).
     pub terminated_by: Option<String>,
     pub output_file: Option<PathBuf>,
+    /// Set when the stop time asked for was off the base-step grid: the run stopped before it
+    /// or took a short last step to it (`Display` says which).
+    pub off_grid: Option<OffGrid>,
     /// With [`RunOptions::profile`]: where the step loop's time went (not part of `Display`).
     pub profile: Option<Profile>,
 }
@@ -125,6 +128,9 @@ impl std::fmt::Display for Summary {
             w * 1e6 / self.macro_steps.max(1) as f64,
             w * 1e6 / self.fmu_steps.max(1) as f64
         )?;
+        if let Some(o) = &self.off_grid {
+            write!(f, "\n{}", off_grid_line(o))?;
+        }
         if let Some(t) = &self.terminated_by {
             // The instance's time is its own last successful time (FMI 2.0, sec. 4.2.3), which
             // lies in its last step; the master ends that macro step for the other instances
@@ -140,6 +146,19 @@ impl std::fmt::Display for Summary {
             write!(f, "\n{} rows written to {}", self.rows, p.display())?;
         }
         Ok(())
+    }
+}
+
+/// The summary's line on a stop time off the base-step grid: which [`LastStep`] was done.
+fn off_grid_line(o: &OffGrid) -> String {
+    let stop = o.stop_time;
+    match o.last_step {
+        LastStep::Short => format!(
+            "stop time {stop} s is off the base-step grid: the last step was shortened to end at it (last_step = \"short\")"
+        ),
+        LastStep::Drop => format!(
+            "stop time {stop} s is off the base-step grid: the run stopped before it, at the last grid point (last_step = \"drop\"; last_step = \"short\" or --last-step short takes a shorter last step to it)"
+        ),
     }
 }
 
@@ -383,7 +402,7 @@ fn course_steps(
     let stop = match course.checkpoint {
         Some((at, then)) => {
             if at < first || at >= plan.n_steps {
-                let grid = TimeGrid::new(plan.start_time, plan.step_size, plan.n_steps);
+                let grid = TimeGrid::of(plan);
                 return Err(Error::Other(format!(
                     "checkpoint at step {at}: it must lie in the run, from step {first} (t = {} s) to before the end at step {} (t = {} s)",
                     grid.at(first),
@@ -426,7 +445,7 @@ fn execute<A: Algorithm>(
     if let Some(cp) = course.resume {
         cp.restore(&mut slots, &mut values)?;
     }
-    let grid = TimeGrid::new(plan.start_time, plan.step_size, plan.n_steps);
+    let grid = TimeGrid::of(plan);
     let start_time = match first {
         0 => plan.start_time,
         k => grid.at(k),
@@ -489,6 +508,7 @@ fn execute<A: Algorithm>(
         rows,
         terminated_by: end.count.terminated_by,
         output_file: None,
+        off_grid: plan.off_grid,
     };
     Ok((summary, taken))
 }

@@ -7,6 +7,50 @@
 //! divisible by its step multiple m_i, from t_k with size t_(k+m_i) - t_k, so that t + h is
 //! exactly the next communication point (libcosim's `to_double_duration` rule). With both rules
 //! shipsim hands every FMU bit-for-bit the times and step sizes libcosim does.
+//!
+//! A stop time off the grid ends the run in one of two ways ([`LastStep`]): at the last grid
+//! point before it (the default, libcosim's way), or with a shorter last step to the stop time
+//! itself (FMPy's way: `fmpy.simulation.simulateCS` sets the last communication point to the
+//! stop time when the FMU declares canHandleVariableCommunicationStepSize, FMI 2.0, sec. 4.3.1).
+//! Then t_n is the stop time and every other t_k is as above.
+
+/// What a run does when its stop time is off the base-step grid.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum LastStep {
+    /// Stop at the last grid point before the stop time (a warning says so).
+    #[default]
+    Drop,
+    /// Take a shorter last step to the stop time. Every FMU must declare
+    /// canHandleVariableCommunicationStepSize.
+    Short,
+}
+
+impl LastStep {
+    /// `"short"` or `"drop"` (the system file's `last_step` and the CLI's `--last-step`).
+    pub fn parse(s: &str) -> Option<LastStep> {
+        match s {
+            "short" => Some(LastStep::Short),
+            "drop" => Some(LastStep::Drop),
+            _ => None,
+        }
+    }
+
+    /// The name [`LastStep::parse`] reads.
+    pub fn name(self) -> &'static str {
+        match self {
+            LastStep::Short => "short",
+            LastStep::Drop => "drop",
+        }
+    }
+}
+
+/// A stop time off the base-step grid, and what the run did about it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct OffGrid {
+    /// The stop time asked for.
+    pub stop_time: f64,
+    pub last_step: LastStep,
+}
 
 /// The communication points t_k (see the module documentation).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -16,6 +60,8 @@ pub struct TimeGrid {
     /// (t0, h) in whole nanoseconds, when both are and t_n stays exact in an i64.
     ns: Option<(i64, i64)>,
     n_steps: u64,
+    /// t_n: the grid point, or the stop time after a short last step.
+    end: f64,
 }
 
 impl TimeGrid {
@@ -29,7 +75,29 @@ impl TimeGrid {
             (Some(a), Some(b)) if b > 0 && (n_steps as f64) * (b as f64) < 4e18 => Some((a, b)),
             _ => None,
         };
-        TimeGrid { t0, h, ns, n_steps }
+        let mut grid = TimeGrid {
+            t0,
+            h,
+            ns,
+            n_steps,
+            end: 0.0,
+        };
+        grid.end = grid.on_grid(n_steps);
+        grid
+    }
+
+    /// The same grid with its last step ending at `stop` (a short last step, [`LastStep`]).
+    pub fn ending_at(self, stop: f64) -> TimeGrid {
+        TimeGrid { end: stop, ..self }
+    }
+
+    /// The grid of a plan: with a short last step ([`LastStep::Short`]), t_n is its stop time.
+    pub fn of(plan: &crate::system::Plan) -> TimeGrid {
+        let grid = TimeGrid::new(plan.start_time, plan.step_size, plan.n_steps);
+        match plan.off_grid {
+            Some(o) if o.last_step == LastStep::Short => grid.ending_at(plan.stop_time),
+            _ => grid,
+        }
     }
 
     /// The number of base steps of the run.
@@ -40,6 +108,16 @@ impl TimeGrid {
     /// t_k.
     #[inline]
     pub fn at(&self, k: u64) -> f64 {
+        if k == self.n_steps {
+            self.end
+        } else {
+            self.on_grid(k)
+        }
+    }
+
+    /// t0 + k*h (see the module documentation).
+    #[inline]
+    fn on_grid(&self, k: u64) -> f64 {
         match self.ns {
             Some((t0, h)) => (t0 + k as i64 * h) as f64 / 1e9,
             None => self.t0 + k as f64 * self.h,

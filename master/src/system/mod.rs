@@ -155,6 +155,9 @@ pub struct System {
     /// without a unit check and third-party FMUs declare units loosely (`dimensionless` for an
     /// energy). `shipsim run/check --strict-units` sets it for any file.
     pub strict_units: bool,
+    /// A stop time off the base-step grid: stop before it (the default) or take a short last
+    /// step to it (TOML `[simulation] last_step`, `shipsim run --last-step`).
+    pub last_step: crate::run::LastStep,
 }
 
 impl System {

@@ -62,6 +62,10 @@ pub struct Plan {
     /// Number of base steps: the run ends at t0 + n_steps*h.
     pub n_steps: u64,
     pub stop_time: f64,
+    /// Set when the stop time asked for is off the base-step grid: the run then ends at the last
+    /// grid point before it (`stop_time` is that point) or with a short last step to it
+    /// (`stop_time` is the one asked for and step n_steps is the short one).
+    pub off_grid: Option<crate::run::OffGrid>,
     pub algorithm: Algorithm,
     pub instances: Vec<PlanInstance>,
     /// Stepping order (Gauss-Seidel: connection order; Jacobi: file order).

@@ -20,6 +20,7 @@
 use super::{InstanceSpec, Plan, PlanInstance, System, VarRef};
 use crate::error::{did_you_mean, Error, Result};
 use crate::model_description::ModelDescription;
+use crate::run::{LastStep, OffGrid};
 use std::collections::HashMap;
 
 mod connections;
@@ -34,8 +35,10 @@ mod variability;
 struct Grid {
     /// Number of base steps: the run ends at t0 + n_steps*h.
     n_steps: u64,
-    /// t0 + n_steps*h.
+    /// t0 + n_steps*h, or the stop time after a short last step.
     stop_on_grid: f64,
+    /// A stop time off the grid and what the run does about it.
+    off_grid: Option<OffGrid>,
 }
 
 /// The state of one validation: inputs, the instance index, and what was found.
@@ -84,6 +87,7 @@ impl System {
             step_size: self.step_size,
             n_steps: grid.n_steps,
             stop_time: grid.stop_on_grid,
+            off_grid: grid.off_grid,
             algorithm: self.algorithm,
             instances,
             order,
@@ -123,8 +127,9 @@ impl<'a> Checker<'a> {
             .map(|v| v.name.as_str())
     }
 
-    /// The time grid: a positive step, a stop after the start, at least one step; a stop time
-    /// off the grid is a warning (the run ends at the last grid point before it).
+    /// The time grid: a positive step, a stop after the start, at least one step. A stop time
+    /// off the grid is a warning (the run ends at the last grid point before it), or with
+    /// `last_step = "short"` one more, shorter step to it ([`Checker::short_last_step`]).
     fn grid(&mut self) -> Grid {
         let sys = self.sys;
         if !(sys.step_size > 0.0 && sys.step_size.is_finite()) {
@@ -166,15 +171,58 @@ impl<'a> Checker<'a> {
             n_steps = 1;
         }
         let stop_on_grid = sys.start_time + n_steps as f64 * sys.step_size;
-        if self.errors.is_empty() && (stop_on_grid - stop).abs() > 1e-9 * stop.abs().max(1.0) {
-            self.warnings.push(format!(
-                "{}: stop_time {stop} is not on the base-step grid; the run ends at t = {stop_on_grid}",
-                self.loc(None)
-            ));
-        }
-        Grid {
+        let off =
+            self.errors.is_empty() && (stop_on_grid - stop).abs() > 1e-9 * stop.abs().max(1.0);
+        let grid = Grid {
             n_steps,
             stop_on_grid,
+            off_grid: off.then_some(OffGrid {
+                stop_time: stop,
+                last_step: sys.last_step,
+            }),
+        };
+        match (off, sys.last_step) {
+            (false, _) => grid,
+            (true, LastStep::Drop) => {
+                self.warnings.push(format!(
+                    "{}: stop_time {stop} is not on the base-step grid; the run ends at t = {stop_on_grid}",
+                    self.loc(None)
+                ));
+                grid
+            }
+            (true, LastStep::Short) => self.short_last_step(grid, stop),
+        }
+    }
+
+    /// `last_step = "short"` with a stop time off the grid: one more base step, ending at the
+    /// stop time. Every instance takes it (the last step of a step multiple > 1 is shortened
+    /// too, [`crate::run::TimeGrid::step_size`]), so every FMU must declare
+    /// canHandleVariableCommunicationStepSize (FMI 2.0, sec. 4.3.1): an error names each one
+    /// that does not.
+    fn short_last_step(&mut self, grid: Grid, stop: f64) -> Grid {
+        let sys = self.sys;
+        for (i, inst) in sys.instances.iter().enumerate() {
+            let var_step = self.mds[i]
+                .co_simulation
+                .as_ref()
+                .is_some_and(|c| c.can_handle_variable_communication_step_size);
+            if !var_step {
+                let e = self.err(
+                    inst.line,
+                    format!(
+                        "instance '{}': last_step = \"short\" needs a shorter last step to stop_time {stop} (off the base-step grid, the last grid point is t = {}), but FMU {} does not declare canHandleVariableCommunicationStepSize; use last_step = \"drop\" or a stop time on the grid",
+                        inst.name,
+                        grid.stop_on_grid,
+                        fmu_file_name(inst)
+                    ),
+                );
+                self.errors.push(e);
+            }
+        }
+        Grid {
+            n_steps: grid.n_steps + 1,
+            stop_on_grid: stop,
+            ..grid
         }
     }
 
