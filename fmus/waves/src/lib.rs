@@ -125,9 +125,9 @@ fmi2_export::fmu! {
             "Ship heading psi, same earth frame as wave_direction (held over the step)";
         output real "wave_elevation" ["m"] (|m| m.waves.elevation()),
             "Wave elevation zeta(t) at the ship, in the encounter domain";
-        output real "roll_moment" ["N.m"] (|m| m.waves.roll_moment()),
+        output real "roll_moment" ["N.m"] (|m| m.waves.roll_moment()).gated_by("roll_gain"),
             "Wave roll moment roll_gain sin(gamma) zeta (003 eq. 2.23); 0 while roll_gain = 0 (its default)";
-        output real "yaw_moment" ["N.m"] (|m| m.waves.yaw_moment()),
+        output real "yaw_moment" ["N.m"] (|m| m.waves.yaw_moment()).gated_by("yaw_gain"),
             "Wave yaw moment yaw_gain sin(2 gamma) zeta (003 eq. 2.24); 0 while yaw_gain = 0 (its default)";
         output real "encounter_angle" ["rad"] (|m| m.gamma()),
             "gamma in (-pi, pi]: 0 following, pi head seas";
