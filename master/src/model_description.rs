@@ -32,6 +32,8 @@ pub struct ModelDescription {
     pub log_categories: Option<LogCategories>,
     #[serde(rename = "DefaultExperiment", default)]
     pub default_experiment: Option<DefaultExperiment>,
+    #[serde(rename = "VendorAnnotations", default)]
+    pub vendor_annotations: Option<VendorAnnotations>,
     #[serde(rename = "ModelVariables", default)]
     pub model_variables: ModelVariables,
     #[serde(rename = "ModelStructure", default)]
@@ -152,6 +154,40 @@ pub struct LogCategory {
     pub name: String,
     #[serde(rename = "@description", default)]
     pub description: Option<String>,
+}
+
+/// `VendorAnnotations` (FMI 2.0 section 2.2.6): one `Tool` element per tool; only the tool
+/// "shipsim"'s content is read.
+#[derive(Debug, Clone, Default, Deserialize)]
+pub struct VendorAnnotations {
+    #[serde(rename = "Tool", default)]
+    pub tools: Vec<Tool>,
+}
+
+/// One tool's annotations. For "shipsim": the couplings (an output and the parameter that
+/// scales it), written by our FMUs' export layer.
+#[derive(Debug, Clone, Default, Deserialize)]
+pub struct Tool {
+    #[serde(rename = "@name")]
+    pub name: String,
+    #[serde(rename = "Couplings", default)]
+    pub couplings: Option<Couplings>,
+}
+
+#[derive(Debug, Clone, Default, Deserialize)]
+pub struct Couplings {
+    #[serde(rename = "Coupling", default)]
+    pub couplings: Vec<Coupling>,
+}
+
+/// An output and the parameter that scales it: a connected output whose gain is 0 carries
+/// only zeros (`shipsim check` warns).
+#[derive(Debug, Clone, PartialEq, Eq, Deserialize)]
+pub struct Coupling {
+    #[serde(rename = "@output")]
+    pub output: String,
+    #[serde(rename = "@gain")]
+    pub gain: String,
 }
 
 /// `DefaultExperiment` (FMI 2.0 section 2.2.5).
@@ -420,6 +456,16 @@ impl ModelDescription {
         quick_xml::de::from_str(xml)
     }
 
+    /// The couplings the tool "shipsim" annotates (empty for FMUs that declare none).
+    pub fn couplings(&self) -> &[Coupling] {
+        self.vendor_annotations
+            .iter()
+            .flat_map(|v| &v.tools)
+            .find(|t| t.name == "shipsim")
+            .and_then(|t| t.couplings.as_ref())
+            .map_or(&[], |c| c.couplings.as_slice())
+    }
+
     /// Name -> index map of the model variables.
     pub fn variable_index(&self) -> HashMap<String, usize> {
         self.model_variables
@@ -496,6 +542,29 @@ mod tests {
   </ModelVariables>
   <ModelStructure><Outputs><Unknown index="3" dependencies="2"/><Unknown index="4" dependencies=""/></Outputs></ModelStructure>
 </fmiModelDescription>"#;
+
+    /// The "shipsim" tool's couplings are read; another tool's annotations (any content) and an
+    /// FMU without annotations give none.
+    #[test]
+    fn parses_shipsim_couplings() {
+        let annotated = XML.replace(
+            "  <ModelVariables>",
+            r#"  <VendorAnnotations>
+    <Tool name="other"><Couplings><Coupling output="u" gain="k"/></Couplings><Anything x="1"/></Tool>
+    <Tool name="shipsim"><Couplings><Coupling output="y" gain="k"/></Couplings></Tool>
+  </VendorAnnotations>
+  <ModelVariables>"#,
+        );
+        let md = ModelDescription::parse(&annotated).unwrap();
+        assert_eq!(
+            md.couplings(),
+            [Coupling {
+                output: "y".into(),
+                gain: "k".into()
+            }]
+        );
+        assert!(ModelDescription::parse(XML).unwrap().couplings().is_empty());
+    }
 
     #[test]
     fn parses_typed_structure() {

@@ -136,7 +136,9 @@ fmi2_export::fmu! {
     ContainerShipFmu => "ContainerShip",
     description: "Son & Nomoto (1982) high-speed container ship: nonlinear \
         roll-coupled surge-sway-yaw-roll manoeuvring model with rudder and shaft servos (MSS \
-        container.m), or its linearisation (Lcontainer.m)",
+        container.m), or its linearisation (Lcontainer.m). Its own rudder servo (10 deg, 5 deg/s, \
+        1 s) acts on rudder_command (start value 5 deg): open it up (rudder_max, rudder_rate_max) \
+        when a SteeringGear drives it",
     experiment: (0.0, 600.0, 0.1),
     // Every output is a function of the state: no direct feedthrough from the inputs.
     direct_feedthrough: false,
@@ -146,9 +148,14 @@ fmi2_export::fmu! {
             "1: nonlinear 4-DOF Son & Nomoto model (container_ship.md section 2); 2: linearised model \
              (section 4, MSS Lcontainer.m; no shaft, u = nominal_speed)";
         tunable real "rudder_max" ["rad"] (params.rudder_max).range(0.0, PI),
-            "Rudder command saturation (section 2.6: 10 deg; exRRD2.m: 20 deg)";
+            "Rudder command saturation of the built-in servo (section 2.6: 10 deg; exRRD2.m: 20 deg). \
+            It also limits a SteeringGear's rudder_angle connected to rudder_command: raise it to \
+            at least the gear's angle limit";
         tunable real "rudder_rate_max" ["rad/s"] (params.rudder_rate_max).min(0.0),
-            "Rudder rate limit of the built-in servo (section 2.6: 5 deg/s; exRRD2.m: 20 deg/s)";
+            "Rudder rate limit of the built-in servo (section 2.6: 5 deg/s; exRRD2.m: 20 deg/s). \
+            When a SteeringGear drives rudder_command, open the servo up: rudder_rate_max well above \
+            the gear's rate (e.g. 1 rad/s, as systems/autopilot_*_nonlinear.toml do); the servo's \
+            1 s time constant stays";
         tunable real "shaft_max_rpm" ["rpm"] (params.shaft_max_rpm).min(0.0),
             "Shaft speed command upper limit (section 2.6: 160 rpm; variant 1)";
         tunable real "shaft_min_rpm" ["rpm"] (params.shaft_min_rpm).min(0.0),
@@ -180,7 +187,8 @@ fmi2_export::fmu! {
             "Variant 2: U = sqrt(U0^2 + v^2) as MSS Lcontainer.m (false: strictly linear U = U0)";
         input real "rudder_command" ["rad"] (inputs.rudder_command),
             "Commanded rudder angle delta_c (positive: starboard turn), through the built-in servo \
-             (saturation rudder_max, rate rudder_rate_max, time constant 1 s); start value 5 deg";
+             (saturation rudder_max 10 deg, rate rudder_rate_max 5 deg/s, time constant 1 s). Start \
+             value 5 deg, not 0: unconnected, the ship turns; set 0 for a straight course";
         input real "shaft_speed_command" ["rpm"] (inputs.shaft_command_rpm),
             "Commanded shaft speed n_c (variant 1; clamped to [shaft_min_rpm, shaft_max_rpm])";
         input real "sway_force" ["N"] (inputs.sway_force_ext),

@@ -26,7 +26,10 @@
 //!   - a getter and a setter closure `(|m| .., |m, v| ..)`, where the field path does not fit.
 //! * Modifiers are the const builders of [`Variable`](crate::Variable): `.range(lo, hi)`,
 //!   `.min(lo)`, `.max(hi)` (Real bounds, declared in the XML and enforced on set) and
-//!   `.depends_on(&["input", ..])` (an output's direct dependencies).
+//!   `.depends_on(&["input", ..])` (an output's direct dependencies) and `.gated_by("param")`
+//!   (an output scaled by a parameter, 0 by default or not: written in the XML's
+//!   `<VendorAnnotations>` for the tool "shipsim", so that `shipsim check` warns when the output
+//!   is connected while the parameter is 0).
 //! * `fragment!(args);` in place of an entry splices in a run of entries that several FMUs
 //!   share (see [`crate::fragments`]).
 //!
@@ -150,6 +153,7 @@ macro_rules! __variables {
                 description: $desc,
                 access: $crate::__access!($kind $type [$($unit)?] [$($lo, $hi)?] ($($access)*)),
                 dependencies: None,
+                gate: None,
             } $(.$modifier($($arg)*))*,
         ] $($rest)*)
     };

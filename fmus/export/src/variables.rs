@@ -60,9 +60,19 @@ pub struct Variable<M> {
     /// For outputs: the inputs this output depends on directly (ModelStructure `dependencies`).
     /// `None`: not declared (all inputs, unless the model says `DIRECT_FEEDTHROUGH = false`).
     pub dependencies: Option<&'static [&'static str]>,
+    /// For outputs: the parameter that scales this output (0 makes it 0), written as a
+    /// `shipsim` vendor annotation so that a master can warn about a connection that carries
+    /// only zeros.
+    pub gate: Option<&'static str>,
 }
 
 impl<M> Variable<M> {
+    /// Declares the parameter that scales this output (see [`Variable::gate`]).
+    pub const fn gated_by(mut self, parameter: &'static str) -> Self {
+        self.gate = Some(parameter);
+        self
+    }
+
     /// Declares the inputs an output depends on directly (`&[]`: the state only).
     pub const fn depends_on(mut self, inputs: &'static [&'static str]) -> Self {
         self.dependencies = Some(inputs);

@@ -28,6 +28,29 @@ pub fn real(v: f64) -> String {
 
 const GUID_PLACEHOLDER: &str = "@GUID@";
 
+/// `<VendorAnnotations>` (FMI 2.0, sec. 2.2.6) with the tool "shipsim"'s couplings: each output
+/// declared `.gated_by(parameter)` as `<Coupling output=".." gain=".."/>`. Nothing when no output
+/// declares one (the model description is then as before).
+fn vendor_annotations<M>(x: &mut String, vars: &[crate::Variable<M>]) {
+    let gated: Vec<_> = vars
+        .iter()
+        .filter_map(|v| v.gate.map(|g| (v.name, g)))
+        .collect();
+    if gated.is_empty() {
+        return;
+    }
+    x.push_str("  <VendorAnnotations>\n    <Tool name=\"shipsim\">\n      <Couplings>\n");
+    for (output, gain) in gated {
+        let _ = writeln!(
+            x,
+            r#"        <Coupling output="{}" gain="{}"/>"#,
+            escape(output),
+            escape(gain)
+        );
+    }
+    x.push_str("      </Couplings>\n    </Tool>\n  </VendorAnnotations>\n");
+}
+
 /// The model description with the GUID placeholder (the GUID is a hash of this text).
 fn description_template<M: FmuModel>() -> String {
     description_template_of(&M::default())
@@ -100,6 +123,7 @@ fn description_template_of<M: FmuModel>(default: &M) -> String {
         real(de.stop_time),
         real(de.step_size)
     );
+    vendor_annotations(&mut x, vars);
     x.push_str("  <ModelVariables>\n");
     for (vr, v) in vars.iter().enumerate() {
         let _ = write!(

@@ -1,8 +1,12 @@
 //! `HeadingAutopilot` FMU: the loop-shaped DDG-51 heading autopilot [Taylor2000, sec. 5.2] of
 //! `models::controllers::loop_shaped`, Tustin-discretised in the nondimensional time base, with
 //! the +-30 deg command limit and the 90 deg track-change reference generator. No physics here.
+//!
+//! The design parameters default to the DDG-51 (466 ft, 22 kn); `preset` selects a named design
+//! (`models::controllers::loop_shaped::presets`): 1 the DDG-51, 2 the container ship at 7 m/s.
 
 use fmi2_export::FmuModel;
+use models::controllers::loop_shaped::presets::HeadingPreset;
 use models::controllers::loop_shaped::{
     HeadingAutopilot, HeadingDesign, HeadingReference, TrackChange,
 };
@@ -17,6 +21,49 @@ pub struct HeadingAutopilotFmu {
     heading: f64,
     reference_input: f64,
     autopilot: HeadingAutopilot,
+    /// The named design that replaces the design parameters (`Custom`: none).
+    preset: HeadingPreset,
+}
+
+/// The nine design parameters of `design`, by variable name.
+fn design_values(d: &HeadingDesign) -> [(&'static str, f64); 9] {
+    let c = &d.common;
+    [
+        ("nomoto_k", c.nomoto_k),
+        ("nomoto_t", c.nomoto_t),
+        ("gear_pole", c.gear_pole),
+        ("sample_step", c.sample_step),
+        ("command_limit", c.limit),
+        ("ship_length", c.length),
+        ("ship_speed", c.speed),
+        ("omega_n", d.omega_n),
+        ("zeta", d.zeta),
+    ]
+}
+
+impl HeadingAutopilotFmu {
+    /// The design in use: the parameters' with `preset` = 0, else the preset's. A design
+    /// parameter set to a value that is neither its default (the DDG-51's) nor the preset's
+    /// conflicts with the preset and is refused, whatever the order of the sets.
+    fn resolved_design(&self) -> Result<HeadingDesign, String> {
+        let Some(preset) = self.preset.design() else {
+            return Ok(self.design);
+        };
+        let default = HeadingDesign::default();
+        let values = design_values(&self.design);
+        let ours = design_values(&preset);
+        let defaults = design_values(&default);
+        for ((name, v), ((_, p), (_, d))) in values.iter().zip(ours.iter().zip(defaults.iter())) {
+            if v != p && v != d {
+                return Err(format!(
+                    "preset = {} sets {name} = {p}, but {name} was set to {v}: \
+                     set preset = 0 to give the design parameters one by one",
+                    self.preset as i32
+                ));
+            }
+        }
+        Ok(preset)
+    }
 }
 
 impl Default for HeadingAutopilotFmu {
@@ -29,6 +76,7 @@ impl Default for HeadingAutopilotFmu {
             heading: 0.0,
             reference_input: 0.0,
             autopilot: HeadingAutopilot::new(design).expect("default design is valid"),
+            preset: HeadingPreset::Custom,
         }
     }
 }
@@ -37,11 +85,25 @@ fmi2_export::fmu! {
     HeadingAutopilotFmu => "HeadingAutopilot",
     description: "Loop-shaped DDG-51 heading autopilot (C = L/P, \
         L = wn^2/(s(s^2 + 2 zeta wn s + wn^2))), Tustin in t' = tU/L, +-30 deg command limit, \
-        track-change reference generator",
+        track-change reference generator. The design parameters default to the DDG-51 \
+        (466 ft, 22 kn): for another ship set preset (2: container ship at 7 m/s) or all of them",
     experiment: (0.0, 600.0, 0.05),
     documentation: "documentation.html",
     variables: {
-        loop_shaping_common!(design.common);
+        tunable real "nomoto_k" (design.common.nomoto_k).min(0.0),
+            "Nomoto K' of the design plant in t' = tU/L (eq. 5.26: 2.04, the DDG-51's; preset sets it)";
+        tunable real "nomoto_t" (design.common.nomoto_t).min(0.0),
+            "Nomoto T' in ship lengths (eq. 5.25: 1.9287, the DDG-51's; preset sets it)";
+        tunable real "gear_pole" (design.common.gear_pole).min(0.0),
+            "Steering-gear pole a of a/(s+a) in t' (eq. 5.28: 6, the DDG-51's; preset sets it)";
+        tunable real "sample_step" (design.common.sample_step).min(0.0),
+            "Largest internal Tustin step in ship lengths (t'); each communication step is split into equal samples not longer than this";
+        tunable real "command_limit" ["rad"] (design.common.limit).min(0.0),
+            "Rudder command limit (L2192-2199: 30 deg; container-ship preset: its 10 deg)";
+        fixed real "ship_length" ["m"] (design.common.length).min(0.0),
+            "Ship length L of the time base. Default: the DDG-51's 466 ft, not your ship's: set it with the other design parameters, or set preset";
+        fixed real "ship_speed" ["m/s"] (design.common.speed).min(0.0),
+            "Ship speed U of the time base. Default: the DDG-51's 22 kn, not your ship's: set it with the other design parameters, or set preset";
         tunable real "omega_n" (design.omega_n).min(0.0),
             "Target-loop natural frequency in t' (eqs. 5.32-5.34: sqrt(60))";
         tunable real "zeta" (design.zeta).min(0.0), "Target-loop damping (2)";
@@ -64,11 +126,18 @@ fmi2_export::fmu! {
             "Controller output before the command limit";
         output real "heading_reference_used" ["rad"] (|m| m.autopilot.heading_reference()),
             "Heading reference at the last sample";
+        fixed int "preset" (preset => {
+            0: HeadingPreset::Custom,
+            1: HeadingPreset::Ddg51,
+            2: HeadingPreset::ContainerShip,
+        }),
+            "Named design, replacing nomoto_k, nomoto_t, gear_pole, sample_step, command_limit, ship_length, ship_speed, omega_n, zeta: 0 none (those parameters; defaults DDG-51), 1 DDG-51 at 22 kn (= the defaults), 2 container ship (ContainerShip, L = 175 m) at 7 m/s with its own 1 s, 10 deg servo (K' = 2.921, T' = 4.360, a = 25, limit 10 deg)";
     }
 }
 
 impl FmuModel for HeadingAutopilotFmu {
     fn initialize(&mut self, _start_time: f64) -> Result<(), String> {
+        self.design = self.resolved_design()?;
         let mut autopilot = HeadingAutopilot::new(self.design).map_err(|e| e.to_string())?;
         autopilot.reference = self.reference;
         autopilot.track_change = self.track_change;
@@ -78,6 +147,7 @@ impl FmuModel for HeadingAutopilotFmu {
     }
 
     fn parameters_changed(&mut self) -> Result<(), String> {
+        self.design = self.resolved_design()?;
         self.autopilot
             .set_design(self.design)
             .map_err(|e| e.to_string())

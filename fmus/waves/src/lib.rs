@@ -97,9 +97,15 @@ fmi2_export::fmu! {
             gamma = wave_direction - heading: 0 following, +-pi/2 beam, pi head seas";
         tunable real "roll_gain" ["N"] (params.roll_gain),
             "k_phi in roll_moment = k_phi sin(gamma) zeta(t) [N.m per m of elevation] (003 eq. 2.23; \
-            H_g_phi not given in 003)";
+            H_g_phi not given in 003). Default 0: roll_moment is 0 until set. Choose k_phi so that \
+            the moment's standard deviation k_phi |sin gamma| Hs/4 is the one you want (in the \
+            units of the input it drives, e.g. rad per m for a rudder-equivalent input; \
+            systems/rrs.toml tunes it to an open-loop roll variance)";
         tunable real "yaw_gain" ["N"] (params.yaw_gain),
-            "k_psi in yaw_moment = k_psi sin(2 gamma) zeta(t) [N.m per m of elevation] (003 eq. 2.24)";
+            "k_psi in yaw_moment = k_psi sin(2 gamma) zeta(t) [N.m per m of elevation] (003 eq. 2.24). \
+            Default 0: yaw_moment is 0 until set. Choose k_psi so that the moment's standard \
+            deviation k_psi |sin 2 gamma| Hs/4 is the one you want (in the units of the input it \
+            drives; systems/autopilot_track_offset.toml: 0.0745 rad per m for a 2 deg rudder-equivalent)";
         fixed real "gravity" ["m/s2"] (params.gravity).range(1.0, 20.0),
             "Acceleration of gravity g in eq. 2.22";
         fixed real "wf_omega0" ["rad/s"] (params.wf_omega0).min(1e-3),
@@ -119,10 +125,10 @@ fmi2_export::fmu! {
             "Ship heading psi, same earth frame as wave_direction (held over the step)";
         output real "wave_elevation" ["m"] (|m| m.waves.elevation()),
             "Wave elevation zeta(t) at the ship, in the encounter domain";
-        output real "roll_moment" ["N.m"] (|m| m.waves.roll_moment()),
-            "Wave roll moment roll_gain sin(gamma) zeta (003 eq. 2.23)";
-        output real "yaw_moment" ["N.m"] (|m| m.waves.yaw_moment()),
-            "Wave yaw moment yaw_gain sin(2 gamma) zeta (003 eq. 2.24)";
+        output real "roll_moment" ["N.m"] (|m| m.waves.roll_moment()).gated_by("roll_gain"),
+            "Wave roll moment roll_gain sin(gamma) zeta (003 eq. 2.23); 0 while roll_gain = 0 (its default)";
+        output real "yaw_moment" ["N.m"] (|m| m.waves.yaw_moment()).gated_by("yaw_gain"),
+            "Wave yaw moment yaw_gain sin(2 gamma) zeta (003 eq. 2.24); 0 while yaw_gain = 0 (its default)";
         output real "encounter_angle" ["rad"] (|m| m.gamma()),
             "gamma in (-pi, pi]: 0 following, pi head seas";
         output real "peak_encounter_frequency" ["rad/s"] (|m| m.waves.peak_encounter_frequency()),

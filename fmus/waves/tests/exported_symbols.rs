@@ -68,3 +68,29 @@ fn model_identifier_and_elevation_are_declared() {
     assert!(xml.contains(r#"name="wave_elevation""#));
     assert!(xml.contains(r#"modelIdentifier="Waves""#));
 }
+
+/// The model description declares, for the tool "shipsim", that roll_moment is scaled by
+/// roll_gain and yaw_moment by yaw_gain (FMI 2.0, sec. 2.2.6), between DefaultExperiment and
+/// ModelVariables as the schema orders them; the master reads them back.
+#[test]
+fn couplings_are_annotated() {
+    let xml = fmi2_export::xml::model_description::<waves_fmu::WavesFmu>();
+    assert!(xml.contains(
+        "  <VendorAnnotations>\n    <Tool name=\"shipsim\">\n      <Couplings>\n        \
+         <Coupling output=\"roll_moment\" gain=\"roll_gain\"/>\n        \
+         <Coupling output=\"yaw_moment\" gain=\"yaw_gain\"/>\n      </Couplings>\n    </Tool>\n  \
+         </VendorAnnotations>\n  <ModelVariables>"
+    ));
+    let de = xml.find("<DefaultExperiment").unwrap();
+    assert!(de < xml.find("<VendorAnnotations>").unwrap());
+    let md = shipsim::model_description::ModelDescription::parse(&xml).unwrap();
+    let pairs: Vec<(&str, &str)> = md
+        .couplings()
+        .iter()
+        .map(|c| (c.output.as_str(), c.gain.as_str()))
+        .collect();
+    assert_eq!(
+        pairs,
+        [("roll_moment", "roll_gain"), ("yaw_moment", "yaw_gain")]
+    );
+}

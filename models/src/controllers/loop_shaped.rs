@@ -28,6 +28,8 @@
 //! between samples (no direct feedthrough at the co-simulation interface, so no algebraic loop
 //! with the plant). Per sample: one fixed-size state update, no allocation.
 
+pub mod presets;
+
 use super::ControlError;
 use crate::error::{check_finite, check_positive, check_positive_or_infinite};
 use crate::memo::{bits, Bits, Memo};

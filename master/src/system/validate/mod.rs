@@ -24,6 +24,7 @@ use crate::run::{LastStep, OffGrid};
 use std::collections::HashMap;
 
 mod connections;
+mod couplings;
 mod events;
 mod guids;
 mod order;
@@ -75,6 +76,7 @@ impl System {
         c.step_multiples(grid.n_steps);
         c.shared_guids();
         c.invalid_variability();
+        c.ineffective_couplings(&instances, &connections);
         if !c.errors.is_empty() {
             return Err(if c.errors.len() == 1 {
                 c.errors.pop().unwrap()
