@@ -17,34 +17,34 @@ const QUIET_UNLESS_LOGGING: &str = "MODEL_GUID=({ if (!log) return NULL; \"{not-
 /// Fails silently in any case.
 const ALWAYS_SILENT: &str = "MODEL_GUID=({ return NULL; \"{not-this-guid}\"; })";
 
-fn collecting_sink() -> (Arc<Mutex<Vec<LogRecord>>>, shipsim::instance::LogSink) {
-    let seen: Arc<Mutex<Vec<LogRecord>>> = Arc::default();
-    let s2 = seen.clone();
-    (
-        seen,
-        Arc::new(move |r: &LogRecord| s2.lock().unwrap().push(r.clone())),
-    )
-}
-
-#[test]
-fn instantiate_failure_silent_without_debug_logging_is_explained() {
+/// Builds the test FMU with `define` and instantiates it with loggingOn = fmi2False, which must
+/// fail: what reached the log sink, and the error.
+fn failed_instantiation(define: &str) -> (Vec<LogRecord>, String) {
     let d = tempfile::tempdir().unwrap();
     let p = build_fmu(
         d.path(),
-        "quiet",
+        "failing",
         Variant {
-            defines: &[QUIET_UNLESS_LOGGING],
+            defines: &[define],
             ..Default::default()
         },
     );
     let fmu = Fmu::load(&p).unwrap();
-    let (seen, sink) = collecting_sink();
+    let seen: Arc<Mutex<Vec<LogRecord>>> = Arc::default();
+    let s2 = seen.clone();
+    let sink = Arc::new(move |r: &LogRecord| s2.lock().unwrap().push(r.clone()));
     let e = match fmu.instantiate("q", false, sink) {
         Ok(_) => panic!("instantiated"),
         Err(e) => e.to_string(),
     };
+    let seen = seen.lock().unwrap().clone();
+    (seen, e)
+}
+
+#[test]
+fn instantiate_failure_silent_without_debug_logging_is_explained() {
+    let (seen, e) = failed_instantiation(QUIET_UNLESS_LOGGING);
     // The FMU's own error reached the sink (so the default sink prints it) and the error.
-    let seen = seen.lock().unwrap();
     assert_eq!(seen.len(), 1, "{seen:?}");
     assert_eq!(seen[0].status, fmi2::fmi2Error);
     assert_eq!(
@@ -61,24 +61,10 @@ fn instantiate_failure_silent_without_debug_logging_is_explained() {
 
 #[test]
 fn instantiate_failure_without_any_reason_says_so() {
-    let d = tempfile::tempdir().unwrap();
-    let p = build_fmu(
-        d.path(),
-        "silent",
-        Variant {
-            defines: &[ALWAYS_SILENT],
-            ..Default::default()
-        },
-    );
-    let fmu = Fmu::load(&p).unwrap();
-    let (seen, sink) = collecting_sink();
-    let e = match fmu.instantiate("s", false, sink) {
-        Ok(_) => panic!("instantiated"),
-        Err(e) => e.to_string(),
-    };
-    assert!(seen.lock().unwrap().is_empty());
+    let (seen, e) = failed_instantiation(ALWAYS_SILENT);
+    assert!(seen.is_empty(), "{seen:?}");
     assert!(
-        e.contains("fmi2Instantiate returned NULL for instance 's'")
+        e.contains("fmi2Instantiate returned NULL for instance 'q'")
             && e.contains("(none: the FMU logged no reason)"),
         "{e}"
     );
