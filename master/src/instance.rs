@@ -60,7 +60,37 @@ struct LogCtx {
     name: String,
     sink: LogSink,
     recent: Mutex<VecDeque<String>>,
+    /// The instance was instantiated with loggingOn = fmi2True (debug logging).
+    debug_logging: bool,
 }
+
+impl LogCtx {
+    /// The last messages, or, when the FMU logged none, one line that says so and, if debug
+    /// logging was off, how to switch it on: some FMUs (PythonFMU's) report even their errors
+    /// only with debug logging on.
+    fn recent_or_hint(&self, debug_logging: bool) -> Vec<String> {
+        let recent: Vec<String> = self
+            .recent
+            .lock()
+            .map(|r| r.iter().cloned().collect())
+            .unwrap_or_default();
+        if !recent.is_empty() {
+            recent
+        } else if debug_logging {
+            vec!["(none: the FMU logged no reason)".to_string()]
+        } else {
+            vec![NO_REASON_HINT.to_string()]
+        }
+    }
+
+    fn is_empty(&self) -> bool {
+        self.recent.lock().map(|r| r.is_empty()).unwrap_or(true)
+    }
+}
+
+/// What an error report says when an FMU with debug logging off logged nothing.
+const NO_REASON_HINT: &str = "(none: the FMU logged no reason with debug logging off; rerun \
+     with -v (loggingOn = true): some FMUs, PythonFMU's among them, report their errors only then)";
 
 const RECENT: usize = 8;
 
@@ -201,12 +231,7 @@ impl Core {
             function,
             status,
             time,
-            log: self
-                .log
-                .recent
-                .lock()
-                .map(|r| r.iter().cloned().collect())
-                .unwrap_or_default(),
+            log: self.log.recent_or_hint(self.log.debug_logging),
         }
     }
 }
@@ -267,6 +292,7 @@ impl Fmu {
             name: name.to_string(),
             sink,
             recent: Mutex::new(VecDeque::new()),
+            debug_logging: logging_on,
         });
         let mut target = Box::new(LogTarget {
             sink: Some(log_sink),
@@ -279,7 +305,7 @@ impl Fmu {
             stepFinished: None,
             componentEnvironment: &mut *target as *mut LogTarget as *mut c_void,
         });
-        let comp = unsafe {
+        let call = |logging_on: bool| unsafe {
             (self.lib.api.fmi2Instantiate)(
                 name_c.as_ptr(),
                 fmi2CoSimulation,
@@ -290,24 +316,9 @@ impl Fmu {
                 if logging_on { fmi2True } else { fmi2False },
             )
         };
+        let comp = call(logging_on);
         if comp.is_null() {
-            let recent: Vec<String> = log
-                .recent
-                .lock()
-                .map(|r| r.iter().cloned().collect())
-                .unwrap_or_default();
-            return Err(Error::fmu(
-                &self.path,
-                format!(
-                    "fmi2Instantiate returned NULL for instance '{name}' (GUID \"{}\"){}",
-                    self.guid(),
-                    if recent.is_empty() {
-                        String::new()
-                    } else {
-                        format!("; FMU log: {}", recent.join(" | "))
-                    }
-                ),
-            ));
+            return Err(self.instantiate_failed(name, &log, call));
         }
         Ok(Instance {
             comp,
@@ -330,6 +341,40 @@ impl Fmu {
 }
 
 impl Fmu {
+    /// The error for a NULL from `fmi2Instantiate`, with what the FMU logged. If it logged
+    /// nothing with debug logging off, it is instantiated once more with loggingOn = fmi2True
+    /// (`again`) to learn why: some FMUs, PythonFMU's among them, report even their errors only
+    /// with debug logging on. Those messages reach the sink like any other (errors and warnings
+    /// are shown by default) and the error.
+    #[cold]
+    #[inline(never)]
+    fn instantiate_failed(
+        &self,
+        name: &str,
+        log: &LogCtx,
+        again: impl FnOnce(bool) -> fmi2Component,
+    ) -> Error {
+        let mut debug_logging = log.debug_logging;
+        let mut note = "";
+        if !debug_logging && log.is_empty() {
+            debug_logging = true;
+            let comp = again(true);
+            if !comp.is_null() {
+                // The failure with loggingOn = fmi2False stands; this instance is not used.
+                unsafe { (self.lib.api.fmi2FreeInstance)(comp) };
+                note = " (it succeeded with loggingOn = true)";
+            }
+        }
+        Error::fmu(
+            &self.path,
+            format!(
+                "fmi2Instantiate returned NULL for instance '{name}' (GUID \"{}\"){note}; FMU log: {}",
+                self.guid(),
+                log.recent_or_hint(debug_logging).join(" | ")
+            ),
+        )
+    }
+
     /// The FMU can save and restore serialized states (canGetAndSetFMUstate and
     /// canSerializeFMUstate, FMI 2.0, sec. 4.3.1), else an error naming the FMU and `instance`.
     pub fn require_state_support(&self, instance: &str) -> Result<()> {

@@ -2,7 +2,8 @@
 //! [`crate::export_fmu!`] forwards the symbols here. Every entry runs inside `catch_unwind`.
 
 use crate::instance::{
-    fnv1a, log_raw, mask, Core, Instance, LifeState, Snapshot, StateBox, CAT_ERROR, CAT_EVENTS,
+    fnv1a, log_raw, mask, Core, Instance, LifeState, Snapshot, StateBox, CAT_CALLS, CAT_ERROR,
+    CAT_EVENTS,
 };
 use crate::variables::{Access, Causality, Variability, Variable};
 use crate::{FmuModel, LOG_CATEGORIES};
@@ -198,7 +199,10 @@ pub unsafe fn set_debug_logging<M: FmuModel>(
     with_instance::<M>(c, "fmi2SetDebugLogging", mask::SET_DEBUG_LOGGING, |inst| {
         let on = on != fmi2False;
         if n == 0 {
-            inst.enabled = [on; LOG_CATEGORIES.len()];
+            // On: "all debug messages shall be printed"; off: debug logging is switched off
+            // (FMI 2.0, sec. 2.1.5). Errors and warnings are not debug messages: they stay on.
+            inst.enabled[CAT_EVENTS] = on;
+            inst.enabled[CAT_CALLS] = on;
             return fmi2OK;
         }
         if categories.is_null() {

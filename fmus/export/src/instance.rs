@@ -103,6 +103,21 @@ pub const CAT_ERROR: usize = 2;
 pub const CAT_FATAL: usize = 3;
 pub const CAT_CALLS: usize = 4;
 
+/// Which log categories `fmi2Instantiate` enables. The status categories (`logStatusWarning`,
+/// `logStatusError`, `logStatusFatal`) are always on: an FMU reports its errors whatever the
+/// debug setting. `loggingOn` switches debug logging (FMI 2.0, sec. 2.1.5, `fmi2Instantiate`:
+/// "If loggingOn=fmi2True, debug logging is enabled ... Which LogCategories the FMU sets is
+/// unspecified"); here it enables `logEvents` (a few lifecycle lines per instance) but never
+/// `logCalls` (one line per FMI call). Per-call tracing needs `fmi2SetDebugLogging` with
+/// `logCalls` named, or with loggingOn = fmi2True and no categories ("all debug messages",
+/// FMI 2.0, sec. 2.1.5, `fmi2SetDebugLogging`).
+fn debug_categories_at_instantiation(logging_on: bool) -> [bool; LOG_CATEGORIES.len()] {
+    let mut enabled = [true; LOG_CATEGORIES.len()];
+    enabled[CAT_EVENTS] = logging_on;
+    enabled[CAT_CALLS] = false;
+    enabled
+}
+
 /// FNV-1a 64-bit.
 pub fn fnv1a(bytes: &[u8]) -> u64 {
     let mut h: u64 = 0xcbf29ce484222325;
@@ -123,9 +138,9 @@ impl<M: FmuModel> Instance<M> {
         logging_on: bool,
         magic: u64,
     ) -> Self {
-        let mut enabled = [true; LOG_CATEGORIES.len()];
-        enabled[CAT_EVENTS] = logging_on;
-        enabled[CAT_CALLS] = logging_on;
+        // Per-call tracing only on the importer's explicit request: libcosim (through FMI
+        // Library) always instantiates with loggingOn = fmi2True.
+        let enabled = debug_categories_at_instantiation(logging_on);
         Instance {
             model,
             core: Core {
