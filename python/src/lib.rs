@@ -156,14 +156,18 @@ fn run_detached<T: Send>(
                     .recv_timeout(Duration::from_millis(50))
                     .is_ok()
             });
-            poll(py)?;
-            if finished || handle.is_finished() {
-                break;
-            }
-            if let Err(e) = py.check_signals() {
+            // A pending signal (KeyboardInterrupt) or a failing progress callback stops the
+            // work cleanly, without holding the GIL while it winds down.
+            if let Err(e) = poll(py).and_then(|()| match finished || handle.is_finished() {
+                true => Ok(()),
+                false => py.check_signals(),
+            }) {
                 interrupt.store(true, Ordering::SeqCst);
                 let _ = py.detach(|| handle.join());
                 return Err(e);
+            }
+            if finished || handle.is_finished() {
+                break;
             }
         }
         py.detach(|| handle.join()).map_err(|panic| {

@@ -221,3 +221,17 @@ def test_embedded_local_cluster(local, forked, tmp_path):
     got = shipsim.Campaign.load(forked).run(tmp_path / "embedded", client="local", jobs=2,
                                             progress=False)
     same_table(table, got)
+
+
+def test_a_failing_progress_callback_stops_the_campaign(forked, tmp_path):
+    """An exception in the progress callback stops the runs cleanly and is raised; the runs
+    finished before it are kept and a second run resumes them."""
+    c = shipsim.Campaign.load(forked)
+
+    def boom(done, failed):
+        raise RuntimeError("progress display failed")
+
+    with pytest.raises(RuntimeError, match="progress display failed"):
+        c._native.run(str(tmp_path / "out"), jobs=1, progress=boom)
+    table = c.run(tmp_path / "out", jobs=2, progress=False)
+    assert sorted(table["run"]) == list(range(16))
