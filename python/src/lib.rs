@@ -599,25 +599,29 @@ impl PySystem {
                 .map(|c| c.var_type.name())
                 .collect::<Vec<_>>(),
         )?;
-        out.set_item("time", f64_bytes(py, &rec.time))?;
+        out.set_item("time", le_bytes(py, &rec.time, f64::to_le_bytes)?)?;
         let data = PyList::empty(py);
         for col in &rec.data {
-            data.append(f64_bytes(py, col))?;
+            data.append(le_bytes(py, col, f64::to_le_bytes)?)?;
         }
         out.set_item("data", data)?;
         Ok(out)
     }
 }
 
-/// A bytearray of the values' little-endian bytes (numpy reads it without a copy).
-fn f64_bytes<'py>(py: Python<'py>, v: &[f64]) -> Bound<'py, PyByteArray> {
-    let bytes: Vec<u8> = v.iter().flat_map(|x| x.to_le_bytes()).collect();
-    PyByteArray::new(py, &bytes)
-}
-
-fn i64_bytes<'py>(py: Python<'py>, v: &[i64]) -> Bound<'py, PyByteArray> {
-    let bytes: Vec<u8> = v.iter().flat_map(|x| x.to_le_bytes()).collect();
-    PyByteArray::new(py, &bytes)
+/// A bytearray of the values' little-endian bytes, written in place (numpy reads it without a
+/// copy): `le` is `f64::to_le_bytes` or `i64::to_le_bytes`.
+fn le_bytes<'py, T: Copy, const N: usize>(
+    py: Python<'py>,
+    v: &[T],
+    le: fn(T) -> [u8; N],
+) -> PyResult<Bound<'py, PyByteArray>> {
+    PyByteArray::new_with(py, v.len() * N, |buf| {
+        for (chunk, x) in buf.chunks_exact_mut(N).zip(v) {
+            chunk.copy_from_slice(&le(*x));
+        }
+        Ok(())
+    })
 }
 
 fn summary_dict<'py>(py: Python<'py>, s: &Summary) -> PyResult<Bound<'py, PyDict>> {
@@ -644,8 +648,8 @@ fn table_dict<'py>(py: Python<'py>, t: &Table) -> PyResult<Bound<'py, PyDict>> {
     for c in &t.columns {
         kinds.append(c.type_name())?;
         match c {
-            ColumnData::Float(v) => cols.append(f64_bytes(py, v))?,
-            ColumnData::Int(v) => cols.append(i64_bytes(py, v))?,
+            ColumnData::Float(v) => cols.append(le_bytes(py, v, f64::to_le_bytes)?)?,
+            ColumnData::Int(v) => cols.append(le_bytes(py, v, i64::to_le_bytes)?)?,
             ColumnData::Bool(v) => cols.append(v.clone())?,
             ColumnData::Text(v) => cols.append(v.clone())?,
         }
