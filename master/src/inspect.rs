@@ -373,11 +373,17 @@ fn doc_files(dir: &Path) -> Vec<PathBuf> {
     let mut stack = vec![dir.to_path_buf()];
     while let Some(d) = stack.pop() {
         for e in std::fs::read_dir(&d).into_iter().flatten().flatten() {
-            let p = e.path();
-            if p.is_dir() {
+            // The entry's own type, not its target's: a symlink in a hostile archive could
+            // loop or copy a file from outside the FMU; it is skipped.
+            let (p, Ok(kind)) = (e.path(), e.file_type()) else {
+                continue;
+            };
+            if kind.is_dir() {
                 stack.push(p);
-            } else if let Ok(rel) = p.strip_prefix(dir) {
-                out.push(rel.to_path_buf());
+            } else if kind.is_file() {
+                if let Ok(rel) = p.strip_prefix(dir) {
+                    out.push(rel.to_path_buf());
+                }
             }
         }
     }

@@ -185,7 +185,7 @@ impl Unit {
     pub fn multiply(&self, o: &Unit) -> Unit {
         let mut exponents = self.exponents;
         for (a, b) in exponents.iter_mut().zip(o.exponents) {
-            *a += b;
+            *a = a.saturating_add(b);
         }
         Unit {
             exponents,
@@ -202,7 +202,7 @@ impl Unit {
     /// The unit to the power n (offset must be 0).
     pub fn powi(&self, n: i32) -> Unit {
         Unit {
-            exponents: self.exponents.map(|x| x * n),
+            exponents: self.exponents.map(|x| x.saturating_mul(n)),
             factor: self.factor.powi(n),
             offset: 0.0,
         }
@@ -304,6 +304,11 @@ fn term(t: &str, whole: &str) -> Result<Unit, UnitError> {
             }
         }
     };
+    if power.unsigned_abs() > MAX_POWER {
+        return Err(UnitError(format!(
+            "unit '{whole}': the exponent {power} of '{name}' is out of range (at most {MAX_POWER} in size)"
+        )));
+    }
     let entry = BUILT_IN.iter().find(|(names, _, _)| names.contains(&name));
     let (_, exponents, factor) = entry.ok_or_else(unknown)?;
     Ok(Unit {
@@ -313,6 +318,10 @@ fn term(t: &str, whole: &str) -> Result<Unit, UnitError> {
     }
     .powi(power))
 }
+
+/// The largest exponent of one term of a typed unit (`m^16`): physical units stay far below
+/// it, and it keeps the factor finite and the exponent sums far from overflow.
+const MAX_POWER: u32 = 16;
 
 impl Conversion {
     /// x in `from`, in `to`: `(f1 * x + o1 - o2) / f2`, without the operations that are
@@ -448,6 +457,16 @@ mod tests {
         );
         assert_eq!(Unit::parse("deg / s").unwrap().dimension(), "s-1.rad");
         assert!(Unit::parse("furlong").is_err());
+        // Exponents stay small: no overflow, no infinite factor (km^400 would be inf).
+        assert_eq!(Unit::parse("m^16").unwrap().exponents[1], 16);
+        for absurd in [
+            "m^17",
+            "km^400/km^400",
+            "m^2147483647.m^2147483647",
+            "s-2147483648",
+        ] {
+            assert!(Unit::parse(absurd).is_err(), "{absurd}");
+        }
         assert!(Unit::parse("m/").is_err());
     }
 

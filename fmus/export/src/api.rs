@@ -1101,14 +1101,13 @@ pub unsafe fn do_step<M: FmuModel>(
 ) -> fmi2Status {
     with_instance::<M>(c, "fmi2DoStep", mask::DO_STEP, |inst| {
         let now = inst.core.time;
-        // h finite and > 0 (h * 0 is 0 exactly for finite h, NaN otherwise; a NaN h fails
-        // `h > 0`); t finite and not off `now` by more than a relative 1e-10. A master on the
-        // FMU's own grid hands `t == now` exactly, which needs no tolerance.
-        if !(h > 0.0 && h * 0.0 == 0.0) {
+        // h finite and > 0; t finite and not off `now` by more than a relative 1e-10. A master
+        // on the FMU's own grid hands `t == now` exactly, which needs no tolerance.
+        if !(h > 0.0 && h.is_finite()) {
             return step_size_refused(inst, h);
         }
         let off = || (t - now).abs() > 1e-10 * now.abs().max(1.0);
-        if !(t.abs() < f64::INFINITY && (t == now || !off())) {
+        if !(t.is_finite() && (t == now || !off())) {
             return off_time(inst, t, now);
         }
         if let Some(stop) = inst.core.stop_time {

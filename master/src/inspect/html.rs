@@ -78,7 +78,17 @@ impl Parser {
         if self.in_head || raw.is_empty() {
             return;
         }
-        let decoded = decode_entities(raw);
+        // Control characters (raw or as `&#27;`, `&#x9b;`, ...) would reach the terminal as
+        // escape sequences from an FMU's page: shown as U+FFFD, as HTML itself treats most of
+        // them; tab and line ends stay.
+        let decoded: String = decode_entities(raw)
+            .chars()
+            .map(|c| match c {
+                '\t' | '\n' | '\r' => c,
+                c if c.is_control() => '\u{fffd}',
+                c => c,
+            })
+            .collect();
         match &mut self.pre {
             Some(pre) => pre.push_str(&decoded),
             None => {
@@ -363,6 +373,19 @@ mod tests {
             t,
             "# Waves\n\nA & B <c> déjà vu,\u{a0}5° bold&unknown; &amp\n\nline 1\n  line  2 <x>\n\n\
              - one\n- two\n\nname | unit\na | m\n\nend\n"
+        );
+    }
+
+    #[test]
+    fn control_characters_do_not_reach_the_terminal() {
+        let t = to_text("<p>a&#27;]0;x&#7;b\u{1b}[2J c&#x9b;d\u{9b}e\tf</p>", 100);
+        assert!(
+            !t.chars().any(|c| c.is_control() && c != '\n' && c != '\t'),
+            "{t:?}"
+        );
+        assert_eq!(
+            t,
+            "a\u{fffd}]0;x\u{fffd}b\u{fffd}[2J c\u{fffd}d\u{fffd}e f\n"
         );
     }
 

@@ -547,30 +547,35 @@ fn system_of(
     // ψ̇ = r
     a[(4, 3)] = 1.0;
     if let Some(w) = waves {
-        // sway filter
-        a[(5, 6)] = 1.0;
-        a[(6, 5)] = -w.omega_wv * w.omega_wv;
-        a[(6, 6)] = -2.0 * w.z_wv * w.omega_wv;
-        b[(6, 3)] = 1.0;
+        // The three second-order wave filters (sway, yaw, roll), each driven by white noise.
+        filter(&mut a, &mut b, 5, w.omega_wv, w.z_wv);
+        filter(&mut a, &mut b, 7, w.omega_wr, w.z_wr);
+        filter(&mut a, &mut b, 9, w.omega_wp, w.z_wp);
         let g = w.omega_wv * w.omega_wv * w.k_wv;
         a[(2, 5)] = g / c.tau_v;
         a[(2, 6)] = g * w.tau_wv / c.tau_v;
-        // yaw filter
-        a[(7, 8)] = 1.0;
-        a[(8, 7)] = -w.omega_wr * w.omega_wr;
-        a[(8, 8)] = -2.0 * w.z_wr * w.omega_wr;
-        b[(8, 3)] = 1.0;
         let g = w.omega_wr * w.omega_wr * w.k_wr;
         a[(3, 7)] = g / c.tau_r;
         a[(3, 8)] = g * w.tau_wr / c.tau_r;
-        // roll filter
-        a[(9, 10)] = 1.0;
-        a[(10, 9)] = -w.omega_wp * w.omega_wp;
-        a[(10, 10)] = -2.0 * w.z_wp * w.omega_wp;
-        b[(10, 3)] = 1.0;
         a[(1, 10)] = wn2 * w.omega_wp * w.omega_wp * w.k_wp;
     }
     (a, b)
+}
+
+/// A second-order wave filter on states (i, i + 1): x_i' = x_(i+1),
+/// x_(i+1)' = -omega^2 x_i - 2 zeta omega x_(i+1) + w, with w the white noise of input 3
+/// [Klugt1987, Table 2.2].
+fn filter(
+    a: &mut SMatrix<f64, NX, NX>,
+    b: &mut SMatrix<f64, NX, NU>,
+    i: usize,
+    omega: f64,
+    zeta: f64,
+) {
+    a[(i, i + 1)] = 1.0;
+    a[(i + 1, i)] = -omega * omega;
+    a[(i + 1, i + 1)] = -2.0 * zeta * omega;
+    b[(i + 1, 3)] = 1.0;
 }
 
 #[cfg(test)]
