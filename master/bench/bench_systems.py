@@ -47,10 +47,12 @@ def pinning():
     return ["taskset", "-c", str(CORE)], f"pinned to core {CORE} (`taskset -c {CORE}`)"
 
 
-def run_system(exe, pin, system, every=None):
+def run_system(exe, pin, system, every=None, stop_time=None):
     cmd = pin + [exe, "run", str(system), "--no-output", "--profile=json", "-q"]
     if every is not None:
         cmd += ["--profile-every", str(every)]
+    if stop_time is not None:
+        cmd += ["--stop-time", repr(stop_time)]
     r = subprocess.run(cmd, capture_output=True, text=True, cwd=ROOT)
     if r.returncode != 0:
         raise SystemExit(f"{' '.join(cmd)} failed:\n{r.stderr}")

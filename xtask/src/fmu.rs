@@ -210,21 +210,62 @@ pub fn build_fmus(root: &Path) -> Result<PathBuf> {
     }
     run(&mut cmd)?;
     let out_dir = root.join("target/fmu");
-    let examples_dir = root.join("target/fmu-examples");
-    std::fs::create_dir_all(&out_dir)?;
-    std::fs::create_dir_all(&examples_dir)?;
+    package(
+        &crates,
+        &root.join("target/release"),
+        &out_dir,
+        &root.join("target/fmu-examples"),
+    )?;
+    Ok(out_dir)
+}
+
+/// A variant of some FMUs for a measurement: the FMUs whose model identifiers are `only`, built
+/// with `--cfg <cfg>` in a target directory of their own (`target/variants/<cfg>`, so the
+/// normal build is untouched) and packaged into its `fmu/` folder, which is returned.
+pub fn build_fmu_variant(root: &Path, cfg: &str, only: &[&str]) -> Result<PathBuf> {
+    let crates: Vec<FmuCrate> = fmu_crates(root)?
+        .into_iter()
+        .filter(|c| only.contains(&c.model_identifier.as_str()))
+        .collect();
+    if crates.len() != only.len() {
+        bail!("FMU variant {cfg}: not every one of {only:?} is an FMU crate");
+    }
+    let target = root.join("target/variants").join(cfg);
+    let flags = match std::env::var("RUSTFLAGS") {
+        Ok(f) if !f.trim().is_empty() => format!("{f} --cfg {cfg}"),
+        _ => format!("--cfg {cfg}"),
+    };
+    let mut cmd = cargo();
+    cmd.current_dir(root)
+        .env("CARGO_TARGET_DIR", &target)
+        .env("RUSTFLAGS", flags)
+        .args(["build", "--release", "--lib"]);
     for c in &crates {
-        let so = root.join(format!("target/release/lib{}.so", c.lib_name));
+        cmd.args(["-p", &c.package]);
+    }
+    run(&mut cmd)?;
+    let out_dir = target.join("fmu");
+    package(&crates, &target.join("release"), &out_dir, &out_dir)?;
+    Ok(out_dir)
+}
+
+/// Packages built FMU libraries (in `release`) as `.fmu` archives: into `out_dir`, or
+/// `examples_dir` for example FMUs.
+fn package(crates: &[FmuCrate], release: &Path, out_dir: &Path, examples_dir: &Path) -> Result<()> {
+    std::fs::create_dir_all(out_dir)?;
+    std::fs::create_dir_all(examples_dir)?;
+    for c in crates {
+        let so = release.join(format!("lib{}.so", c.lib_name));
         check_binary(&so)?;
         // SAFETY: our own FMU library; loading runs no initialisers beyond Rust's std.
         let lib = unsafe { libloading::Library::new(&so) }
             .with_context(|| format!("loading {}", so.display()))?;
         let xml = generated_text(&lib, b"shipfmu_model_description")?;
         let html = generated_text(&lib, b"shipfmu_documentation_html")?;
-        let dir = if c.example { &examples_dir } else { &out_dir };
+        let dir = if c.example { examples_dir } else { out_dir };
         let fmu = dir.join(format!("{}.fmu", c.model_identifier));
         write_fmu(&fmu, &c.model_identifier, &xml, &so, &html)?;
         eprintln!("xtask: wrote {}", fmu.display());
     }
-    Ok(out_dir)
+    Ok(())
 }

@@ -291,14 +291,34 @@ fn export_osp() -> Result<()> {
 /// arguments are passed on to it), every system's speed and per-instance profile with the
 /// pure-Rust RRS model loop (bench_systems.py), campaign throughput, fixed cost and warm-up
 /// forks (bench_campaign.py), and the Python package's overhead over the CLI
-/// (bench_python.py); printed, and written to docs/bench.md (committed).
+/// (bench_python.py), and what checks compiled into the FMUs cost: the RRS system against a
+/// variant of its FMUs built without per-call logging (bench_variants.py); printed, and written
+/// to docs/bench.md (committed).
+/// `cargo xtask bench --only variants` runs and prints that section alone.
 fn bench(extra: &[String]) -> Result<()> {
+    let only = match extra {
+        [flag, section, ..] if flag == "--only" => match section.as_str() {
+            "variants" => Some("variants"),
+            other => bail!("cargo xtask bench --only: unknown section {other:?} (known: variants)"),
+        },
+        _ => None,
+    };
     let root = workspace_root();
     fmu::build_fmus(&root)?;
     run(cargo()
         .current_dir(&root)
         .args(["build", "--release", "-p", "shipsim", "--bins"]))?;
     build_tests_bin(&root, "rrs-model-loop")?;
+    let rrs = [
+        "RrsShip",
+        "SteeringGear",
+        "Waves",
+        "Wind",
+        "Sensors",
+        "RrsFilter",
+        "RrsAutopilot",
+    ];
+    let no_call_log = fmu::build_fmu_variant(&root, "shipsim_no_call_log", &rrs)?;
     let python = ensure_venv(&root)?;
     install_python_package(&root, &python)?;
     let script = |name: &str, args: &[String]| -> Result<String> {
@@ -320,15 +340,26 @@ fn bench(extra: &[String]) -> Result<()> {
         }
         Ok(text)
     };
+    let variants = || {
+        script(
+            "bench_variants.py",
+            &[format!("shipsim_no_call_log={}", no_call_log.display())],
+        )
+    };
+    if only == Some("variants") {
+        // One section, printed only: docs/bench.md is written by the whole bench.
+        return variants().map(drop);
+    }
     let master = script("bench_master.py", extra)?;
     let systems = script("bench_systems.py", &[])?;
     let campaigns = script("bench_campaign.py", &[])?;
     let python_pkg = script("bench_python.py", &[])?;
+    let variants = variants()?;
     let doc = format!(
         "# Benchmarks\n\nWritten by `cargo xtask bench` (do not edit by hand). Ratios are \
          measured in one run on one machine; absolute times depend on it.\n\n\
          ## Master overhead per FMU-step (master/bench/bench_master.py)\n\n```text\n{master}```\n\n\
-         {systems}\n{campaigns}\n{python_pkg}"
+         {systems}\n{campaigns}\n{python_pkg}\n{variants}"
     );
     std::fs::write(root.join("docs/bench.md"), doc)?;
     println!("wrote docs/bench.md");

@@ -103,6 +103,11 @@ pub const CAT_ERROR: usize = 2;
 pub const CAT_FATAL: usize = 3;
 pub const CAT_CALLS: usize = 4;
 
+/// Per-call tracing (`logCalls`) compiled in: always, except in the variant that
+/// `cargo xtask bench` builds with `--cfg shipsim_no_call_log` to measure what the check costs
+/// while logging is off (the "logging off" row of docs/bench.md).
+const CALL_LOG: bool = !cfg!(shipsim_no_call_log);
+
 /// Which log categories `fmi2Instantiate` enables. The status categories (`logStatusWarning`,
 /// `logStatusError`, `logStatusFatal`) are always on: an FMU reports its errors whatever the
 /// debug setting. `loggingOn` switches debug logging (FMI 2.0, sec. 2.1.5, `fmi2Instantiate`:
@@ -192,7 +197,7 @@ impl<M: FmuModel> Instance<M> {
     #[inline(always)]
     pub fn check_state(&self, function: &str, mask: u32) -> Result<(), fmi2Status> {
         if self.core.state as u32 & mask != 0 {
-            if self.enabled[CAT_CALLS] {
+            if CALL_LOG && self.enabled[CAT_CALLS] {
                 self.log_call(function);
             }
             Ok(())

@@ -1,0 +1,78 @@
+"""What a check compiled into our FMUs costs: the RRS system run with its FMUs as built
+(target/fmu) against a variant of them built without the check (`cargo xtask bench` builds each
+variant with `--cfg <name>` into target/variants/<name>/fmu; xtask/src/fmu.rs,
+`build_fmu_variant`).
+
+Variants:
+- shipsim_no_call_log: without the per-call tracing test of every FMI entry
+  (fmus/export/src/instance.rs, CALL_LOG), so the row is what per-call logging costs while it is
+  off (issue 18: at most 1 %).
+
+The two builds run in pairs, back to back, pinned to one core (as bench_systems.py does); each run
+is systems/rrs.toml extended to --stop-time (24,000 s by default: 480,000 macro steps) without
+CSV output, and its figure is the step loop's µs per macro step from `--profile=json`. The cost is
+the median over the pairs of (as built / variant - 1); the pairs are listed.
+
+Prints a Markdown section on stdout (cargo xtask bench writes it into docs/bench.md).
+
+Usage (from the repository root, after the FMUs, the variants and shipsim are built):
+    python master/bench/bench_variants.py [--repeat 9] [--stop-time 24000] NAME=DIR ...
+"""
+import argparse
+import os
+import pathlib
+import statistics
+import tempfile
+
+from bench_systems import ROOT, pinning, run_system
+
+WHAT = {
+    "shipsim_no_call_log": "per-call logging, off (`logCalls` not enabled)",
+}
+
+
+def system_with_fmus(src, fmu_dir, dest):
+    """A copy of the system file `src` whose FMUs are read from `fmu_dir`."""
+    text = src.read_text().replace('"../target/fmu/', f'"{fmu_dir.resolve()}/')
+    if str(fmu_dir.resolve()) not in text:
+        raise SystemExit(f"{src}: no FMU path under ../target/fmu/ to replace")
+    dest.write_text(text)
+    return dest
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--shipsim", default=os.environ.get("SHIPSIM_BIN", str(ROOT / "target/release/shipsim")))
+    ap.add_argument("--repeat", type=int, default=9)
+    ap.add_argument("--stop-time", type=float, default=24000.0)
+    ap.add_argument("variants", nargs="+", help="NAME=DIR: a cfg name and its folder of FMUs")
+    a = ap.parse_args()
+    pin, pin_note = pinning()
+    src = ROOT / "systems/rrs.toml"
+    print("## Checks compiled into the FMUs (master/bench/bench_variants.py)\n")
+    print(f"The RRS system (systems/rrs.toml to {a.stop_time:g} s, `--no-output`), {pin_note}, with "
+          "its FMUs as built against the same FMUs built without one check (`--cfg NAME`); runs in "
+          f"{a.repeat} pairs back to back; cost = median over the pairs of the ratio of step-loop "
+          "time per macro step, minus 1.\n")
+    print("| check | variant built with | µs / macro step, as built | without the check | cost | pairs |")
+    print("|---|---|---|---|---|---|")
+    with tempfile.TemporaryDirectory() as tmp:
+        tmp = pathlib.Path(tmp)
+        built = system_with_fmus(src, ROOT / "target/fmu", tmp / "built.toml")
+        for spec in a.variants:
+            name, _, folder = spec.partition("=")
+            variant = system_with_fmus(src, pathlib.Path(folder), tmp / f"{name}.toml")
+            pairs = []
+            for _ in range(a.repeat):
+                x = run_system(a.shipsim, pin, built, stop_time=a.stop_time)["us_per_macro_step"]
+                y = run_system(a.shipsim, pin, variant, stop_time=a.stop_time)["us_per_macro_step"]
+                pairs.append((x, y))
+            med = statistics.median
+            costs = sorted(100 * (x / y - 1) for x, y in pairs)
+            print(f"| {WHAT.get(name, name)} | `--cfg {name}` | {med(p[0] for p in pairs):.4f} "
+                  f"| {med(p[1] for p in pairs):.4f} | **{med(costs):+.2f} %** "
+                  f"| {', '.join(f'{c:+.1f}' for c in costs)} |")
+
+
+if __name__ == "__main__":
+    main()
