@@ -6,7 +6,7 @@
 use clap::Args;
 use shipsim::campaign::kpi::{Stat, StatAccumulator};
 use shipsim::error::{Error, Result};
-use shipsim::plot::Table;
+use shipsim::plot::{parse_window, Table};
 use std::path::PathBuf;
 
 /// The statistics printed, in order, with their column titles.
@@ -46,7 +46,10 @@ struct ColumnStats {
 /// `shipsim stats`.
 pub fn run(args: &StatsArgs) -> Result<()> {
     let file = args.csv.display().to_string();
-    let window = parse_window(args.window.as_deref())?;
+    let window = match args.window.as_deref() {
+        Some(w) => parse_window(w)?,
+        None => (f64::NEG_INFINITY, f64::INFINITY),
+    };
     let table = Table::read(&args.csv)?;
     let time = table
         .column("time")
@@ -90,28 +93,6 @@ pub fn run(args: &StatsArgs) -> Result<()> {
         print!("{}", table_text(&file, span, &stats));
     }
     Ok(())
-}
-
-/// `T0:T1`, `T0:`, `:T1` or none (everything).
-fn parse_window(w: Option<&str>) -> Result<(f64, f64)> {
-    let Some(w) = w else {
-        return Ok((f64::NEG_INFINITY, f64::INFINITY));
-    };
-    let bad = || {
-        Error::Other(format!(
-            "--window {w}: expected T0:T1 (seconds, e.g. 200:1200)"
-        ))
-    };
-    let (a, b) = w.split_once(':').ok_or_else(bad)?;
-    let side = |s: &str, default: f64| match s.trim() {
-        "" => Ok(default),
-        s => s.parse::<f64>().map_err(|_| bad()),
-    };
-    let (t0, t1) = (side(a, f64::NEG_INFINITY)?, side(b, f64::INFINITY)?);
-    if t0.is_nan() || t1.is_nan() || t0 > t1 {
-        return Err(bad());
-    }
-    Ok((t0, t1))
 }
 
 /// The indices of the selected columns, in the order of the pattern list (each column once).
