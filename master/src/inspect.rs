@@ -12,7 +12,6 @@ mod html;
 use crate::error::{Error, Result};
 use crate::fmu::UnpackedFmu;
 use crate::model_description::{Causality, ModelDescription, ScalarVariable};
-use serde::Deserialize;
 use std::collections::HashMap;
 use std::fmt::Write;
 use std::path::{Path, PathBuf};
@@ -98,7 +97,7 @@ pub fn inspect(path: &Path) -> Result<String> {
         let names: Vec<&str> = lc.categories.iter().map(|c| c.name.as_str()).collect();
         let _ = writeln!(s, "log categories: {}", names.join(", "));
     }
-    variables(&mut s, md, &display_units(&u));
+    variables(&mut s, md, &display_units(md));
     Ok(s)
 }
 
@@ -110,58 +109,18 @@ struct Conversion {
     offset: f64,
 }
 
-fn one() -> f64 {
-    1.0
-}
-
-/// `DisplayUnit` of a `Unit` (FMI 2.0, sec. 2.2.2), read here from `modelDescription.xml`
-/// because the master's typed model description does not need it.
-#[derive(Deserialize)]
-struct DisplayUnitXml {
-    #[serde(rename = "@name")]
-    name: String,
-    #[serde(rename = "@factor", default = "one")]
-    factor: f64,
-    #[serde(rename = "@offset", default)]
-    offset: f64,
-}
-
-#[derive(Deserialize)]
-struct UnitXml {
-    #[serde(rename = "@name")]
-    name: String,
-    #[serde(rename = "DisplayUnit", default)]
-    display_units: Vec<DisplayUnitXml>,
-}
-
-#[derive(Deserialize, Default)]
-struct UnitDefinitionsXml {
-    #[serde(rename = "Unit", default)]
-    units: Vec<UnitXml>,
-}
-
-#[derive(Deserialize)]
-struct RootXml {
-    #[serde(rename = "UnitDefinitions", default)]
-    unit_definitions: UnitDefinitionsXml,
-}
-
-/// (unit, display unit) -> conversion, from the unpacked FMU's `modelDescription.xml` (empty
-/// when it has none or they do not parse: the display units are then shown without values).
+/// (unit, display unit) -> conversion, from the model description's unit definitions.
 type DisplayUnits = HashMap<(String, String), Conversion>;
 
-fn display_units(u: &UnpackedFmu) -> DisplayUnits {
-    let xml =
-        std::fs::read_to_string(u.dir.path().join("modelDescription.xml")).unwrap_or_default();
-    let root: Option<RootXml> = quick_xml::de::from_str(&xml).ok();
+fn display_units(md: &ModelDescription) -> DisplayUnits {
     let mut map = HashMap::new();
-    for unit in root.map(|r| r.unit_definitions.units).unwrap_or_default() {
-        for d in unit.display_units {
+    for unit in md.unit_definitions.iter().flat_map(|u| &u.units) {
+        for d in &unit.display_units {
             let conversion = Conversion {
                 factor: d.factor,
                 offset: d.offset,
             };
-            map.insert((unit.name.clone(), d.name), conversion);
+            map.insert((unit.name.clone(), d.name.clone()), conversion);
         }
     }
     map
@@ -223,12 +182,9 @@ impl Units<'_> {
 fn variable(s: &mut String, md: &ModelDescription, units: &DisplayUnits, v: &ScalarVariable) {
     let real = v.real.as_ref();
     let unit = md.real_unit(v).unwrap_or("");
-    let display_name = real.and_then(|r| r.display_unit.as_deref()).or_else(|| {
-        let dt = real?.declared_type.as_deref()?;
-        let types = md.type_definitions.as_ref()?;
-        let t = types.simple_types.iter().find(|t| t.name == dt)?;
-        t.real.as_ref()?.display_unit.as_deref()
-    });
+    let display_name = real
+        .and_then(|r| r.display_unit.as_deref())
+        .or_else(|| md.real_declared_type(v)?.display_unit.as_deref());
     let u = Units {
         unit,
         display: display_name

@@ -87,6 +87,19 @@ pub struct Unit {
     pub name: String,
     #[serde(rename = "BaseUnit", default)]
     pub base_unit: Option<BaseUnit>,
+    #[serde(rename = "DisplayUnit", default)]
+    pub display_units: Vec<DisplayUnit>,
+}
+
+/// A display unit of a unit (FMI 2.0, sec. 2.2.2): value_display = factor * value + offset.
+#[derive(Debug, Clone, Deserialize)]
+pub struct DisplayUnit {
+    #[serde(rename = "@name")]
+    pub name: String,
+    #[serde(rename = "@factor", default = "one")]
+    pub factor: f64,
+    #[serde(rename = "@offset", default)]
+    pub offset: f64,
 }
 
 /// SI exponents plus factor/offset: value_SI = factor * value + offset.
@@ -485,19 +498,22 @@ impl ModelDescription {
     /// The unit of a Real variable, following `declaredType` when the variable has none.
     pub fn real_unit<'a>(&'a self, v: &'a ScalarVariable) -> Option<&'a str> {
         let r = v.real.as_ref()?;
-        if let Some(u) = &r.unit {
-            return Some(u);
-        }
-        let dt = r.declared_type.as_ref()?;
+        r.unit
+            .as_deref()
+            .or_else(|| self.real_declared_type(v)?.unit.as_deref())
+    }
+
+    /// The `Real` element of a Real variable's `declaredType` (FMI 2.0, sec. 2.2.3), which
+    /// supplies the unit, display unit, min and max the variable leaves out.
+    pub fn real_declared_type(&self, v: &ScalarVariable) -> Option<&RealAttributes> {
+        let dt = v.real.as_ref()?.declared_type.as_ref()?;
         self.type_definitions
             .as_ref()?
             .simple_types
             .iter()
             .find(|t| &t.name == dt)?
             .real
-            .as_ref()?
-            .unit
-            .as_deref()
+            .as_ref()
     }
 
     /// Does an input variable have a direct feed-through to any output (ModelStructure)?

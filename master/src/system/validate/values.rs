@@ -105,15 +105,7 @@ fn ambiguous_rad(text: &str, declared: &str, to: &Unit) -> Result<(), String> {
 /// The declared min and max of a variable (a Real's own, else its declared type's).
 fn range(md: &ModelDescription, sv: &ScalarVariable) -> (Option<f64>, Option<f64>) {
     if let Some(r) = &sv.real {
-        let ty = r.declared_type.as_ref().and_then(|dt| {
-            let types = md.type_definitions.as_ref()?;
-            types
-                .simple_types
-                .iter()
-                .find(|t| &t.name == dt)?
-                .real
-                .as_ref()
-        });
+        let ty = md.real_declared_type(sv);
         let min = r.min.or(ty.and_then(|t| t.min));
         return (min, r.max.or(ty.and_then(|t| t.max)));
     }
