@@ -95,8 +95,8 @@ impl NomotoShipFmu {
                         n[i][j],
                     )?;
                 }
-                for i in 0..2 {
-                    p.rudder[i] = set(&format!("b{}", i + 1), self.rudder[i], d.rudder[i], b[i])?;
+                for (i, ours) in b.into_iter().enumerate() {
+                    p.rudder[i] = set(&format!("b{}", i + 1), self.rudder[i], d.rudder[i], ours)?;
                 }
             }
         }
