@@ -559,8 +559,8 @@ fn notes(r: &Results, n: &mut Vec<String>) {
          largest value, π).",
         t3_f23,
         t3_f32,
-        Spread::over(&runs, |r| r.fits[0].0[1]),
-        Spread::over(&runs, |r| r.fits[0].0[3]),
+        Spread::over(runs, |r| r.fits[0].0[1]),
+        Spread::over(runs, |r| r.fits[0].0[3]),
         fmt_num(max_cmd)
     ));
 }
