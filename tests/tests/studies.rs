@@ -42,3 +42,8 @@ fn autopilot() {
 fn path_estimation() {
     check("path_estimation");
 }
+
+#[test]
+fn container_ship_seaway() {
+    check("container_ship_seaway");
+}

@@ -3,14 +3,14 @@
 //! co-simulation FMU. No physics here: the variable table maps the model onto FMI variables.
 
 use fmi2_export::FmuModel;
-use models::error::{check_finite, check_positive, ParamError};
+use models::error::{check_positive, ParamError};
 use models::hull::container_ship::{
     ContainerShip, ContainerShipInputs, ContainerShipOutputs, ContainerShipParams,
     LinearContainerShip, LinearContainerShipInputs, PropellerInflow,
 };
-use models::hull::DEG;
+use models::hull::{check_initial_state, preset_value, DEG};
 use serde::{Deserialize, Serialize};
-use std::f64::consts::PI;
+use std::f64::consts::{FRAC_PI_2, PI};
 
 /// The hull in use: the nonlinear model (variant 1) or the linearised model (variant 2).
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -40,6 +40,99 @@ pub struct ContainerShipFmu {
     /// means compute them. Not part of the state.
     #[serde(skip)]
     outputs: Option<ContainerShipOutputs>,
+    /// The rest of the state the run starts from (all 0 by default: upright on a straight
+    /// course north at the origin, rudder amidships).
+    initial: InitialState,
+    /// 0: none; 1: the source's own servo; 2: driven by an external steering gear.
+    preset: i32,
+}
+
+/// The initial state beyond u, v and n (which have their own parameters), in the order of the
+/// model's state `[u, v, r, x, y, ψ, p, φ, δ, n]` (MSS `container.m`).
+#[derive(Clone, Copy, Debug, Default, Serialize, Deserialize)]
+struct InitialState {
+    yaw_rate: f64,
+    x: f64,
+    y: f64,
+    heading: f64,
+    roll_rate: f64,
+    roll: f64,
+    rudder_angle: f64,
+}
+
+/// The built-in servo of preset 2, opened up for an external steering gear: a command limit
+/// above any gear's angle limit, and a rate limit that does not bind for commands within
+/// 1 rad of the rudder; the servo's 1 s lag stays.
+pub const OPEN_SERVO: (f64, f64) = (FRAC_PI_2, 1.0);
+/// The source's own servo of preset 1 (MSS `container.m`): 10 deg, 5 deg/s.
+pub const OWN_SERVO: (f64, f64) = (10.0 * DEG, 5.0 * DEG);
+
+impl ContainerShipFmu {
+    /// Selects the named preset `code`; preset 2 also makes the start value of `rudder_command`
+    /// 0 unless it was set to something other than the default 5 deg.
+    fn select_preset(&mut self, code: i32) {
+        self.preset = code;
+        if code == 2 && self.inputs.rudder_command == DEFAULT_RUDDER_COMMAND {
+            self.inputs.rudder_command = 0.0;
+        }
+    }
+
+    /// The parameters with the preset's servo in place of `rudder_max` and `rudder_rate_max`;
+    /// a value set to neither the default nor the preset's is refused.
+    fn resolved_params(&self) -> Result<ContainerShipParams, String> {
+        let servo = match self.preset {
+            0 => return Ok(self.params.clone()),
+            1 => OWN_SERVO,
+            2 => OPEN_SERVO,
+            v => return Err(format!("parameter preset = {v} must be 0, 1 or 2")),
+        };
+        let d = ContainerShipParams::default();
+        let mut p = self.params.clone();
+        p.rudder_max = preset_value(
+            self.preset,
+            "rudder_max",
+            p.rudder_max,
+            d.rudder_max,
+            servo.0,
+        )?;
+        p.rudder_rate_max = preset_value(
+            self.preset,
+            "rudder_rate_max",
+            p.rudder_rate_max,
+            d.rudder_rate_max,
+            servo.1,
+        )?;
+        Ok(p)
+    }
+
+    /// The initial state `[v, r, x, y, ψ, p, φ, δ]` (v from `initial_sway_velocity`), checked.
+    fn initial_motion(&self) -> Result<[f64; 8], String> {
+        let i = &self.initial;
+        let v = self.initial_sway_velocity;
+        check_initial_state(
+            &[
+                ("initial_sway_velocity", v),
+                ("initial_yaw_rate", i.yaw_rate),
+                ("initial_x", i.x),
+                ("initial_y", i.y),
+                ("initial_heading", i.heading),
+                ("initial_roll_rate", i.roll_rate),
+                ("initial_roll", i.roll),
+                ("initial_rudder_angle", i.rudder_angle),
+            ],
+            &["initial_roll"],
+        )?;
+        Ok([
+            v,
+            i.yaw_rate,
+            i.x,
+            i.y,
+            i.heading,
+            i.roll_rate,
+            i.roll,
+            i.rudder_angle,
+        ])
+    }
 }
 
 /// Start value of `rudder_command`: a small starboard rudder so that the default experiment turns.
@@ -66,6 +159,8 @@ impl Default for ContainerShipFmu {
             },
             hull: Hull::Nonlinear(ship),
             outputs: None,
+            initial: InitialState::default(),
+            preset: 0,
         }
     }
 }
@@ -100,7 +195,9 @@ impl ContainerShipFmu {
     /// Builds the hull from the parameters (exactly as `ContainerShip::new` /
     /// `LinearContainerShip::new` with the parameter values).
     pub fn build(&self) -> Result<Hull, String> {
-        self.params.validate().map_err(param_error)?;
+        let params = self.resolved_params()?;
+        params.validate().map_err(param_error)?;
+        let motion = self.initial_motion()?;
         match self.variant {
             1 => {
                 let n = self.initial_shaft_speed;
@@ -110,21 +207,20 @@ impl ContainerShipFmu {
                 } else {
                     self.initial_surge_velocity
                 };
-                let v = self.initial_sway_velocity;
-                check_finite("initial_sway_velocity", v)?;
-                let ship = ContainerShip::new(
-                    self.params.clone(),
-                    [u, v, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, n],
-                )
-                .map_err(param_error)?;
+                let mut state = [0.0; 10];
+                state[0] = u;
+                state[1..9].copy_from_slice(&motion);
+                state[9] = n;
+                let ship = ContainerShip::new(params, state).map_err(param_error)?;
                 Ok(Hull::Nonlinear(ship))
             }
             2 => {
                 let mut ship = LinearContainerShip::new(self.nominal_speed).map_err(param_error)?;
                 ship.mss_speed = self.mss_speed;
-                ship.rudder_max = self.params.rudder_max;
-                ship.rudder_rate_max = self.params.rudder_rate_max;
-                ship.max_substep = self.params.max_substep;
+                ship.rudder_max = params.rudder_max;
+                ship.rudder_rate_max = params.rudder_rate_max;
+                ship.max_substep = params.max_substep;
+                ship.set_motion(motion);
                 Ok(Hull::Linear(ship))
             }
             v => Err(format!("parameter variant = {v} must be 1 or 2")),
@@ -217,6 +313,33 @@ fmi2_export::fmu! {
         output bool "outside_validity"
             (|m| matches!(&m.hull, Hull::Nonlinear(s) if s.outside_validity())),
             "Variant 1: a validity guard is active (U < min_speed or n < shaft_min_rpm; MSS would stop)";
+        // The initial state and the named presets (issues 17, 18), appended after the released
+        // variables. The state is x = [u, v, r, x, y, psi, p, phi, delta, n] of container.m; u, v
+        // and n have their own parameters above (initial_sway_velocity applies to both variants).
+        fixed real "initial_yaw_rate" ["rad/s"] (initial.yaw_rate),
+            "Yaw rate r at the start time (state x3; variants 1 and 2; default 0)";
+        fixed real "initial_x" ["m"] (initial.x),
+            "North position at the start time (state x4; variants 1 and 2; default 0)";
+        fixed real "initial_y" ["m"] (initial.y),
+            "East position at the start time (state x5; variants 1 and 2; default 0)";
+        fixed real "initial_heading" ["rad"] (initial.heading),
+            "Heading psi from north, clockwise, at the start time (state x6; variants 1 and 2; \
+             default 0)";
+        fixed real "initial_roll_rate" ["rad/s"] (initial.roll_rate),
+            "Roll rate p at the start time (state x7; variants 1 and 2; default 0)";
+        fixed real "initial_roll" ["rad"] (initial.roll).range(-FRAC_PI_2, FRAC_PI_2),
+            "Roll angle phi at the start time, positive starboard down (state x8; variants 1 and 2; \
+             default 0; within (-pi/2, pi/2))";
+        fixed real "initial_rudder_angle" ["rad"] (initial.rudder_angle),
+            "Actual rudder angle delta of the built-in servo at the start time (state x9; variants 1 \
+             and 2; default 0)";
+        fixed int(0, 2) "preset" (|m| m.preset, |m, v| m.select_preset(v)),
+            "Named rudder servo, replacing rudder_max and rudder_rate_max (a value set to neither \
+             the default nor the preset's is refused): 0 none (those parameters; defaults = 1); 1 the \
+             source's own servo (section 2.6, MSS container.m: 10 deg, 5 deg/s; rudder_command start \
+             5 deg); 2 driven by an external SteeringGear: the servo opened up (rudder_max 90 deg, \
+             rudder_rate_max 1 rad/s; its 1 s lag stays) and the start value of rudder_command 0 \
+             (unless it was set)";
     }
 }
 
@@ -230,12 +353,13 @@ impl FmuModel for ContainerShipFmu {
 
     fn parameters_changed(&mut self) -> Result<(), String> {
         self.outputs = None;
-        self.params.validate().map_err(param_error)?;
+        let params = self.resolved_params()?;
+        params.validate().map_err(param_error)?;
         match &mut self.hull {
-            Hull::Nonlinear(s) => s.params = self.params.clone(),
+            Hull::Nonlinear(s) => s.params = params,
             Hull::Linear(s) => {
-                s.rudder_max = self.params.rudder_max;
-                s.rudder_rate_max = self.params.rudder_rate_max;
+                s.rudder_max = params.rudder_max;
+                s.rudder_rate_max = params.rudder_rate_max;
             }
         }
         Ok(())
@@ -262,6 +386,120 @@ impl FmuModel for ContainerShipFmu {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The presets' values, written out from the sources: MSS container.m's servo, 10 deg =
+    /// 0.17453292519943295 rad and 5 deg/s = 0.08726646259971647 rad/s, rudder_command start
+    /// 5 deg; the opened-up servo of preset 2: 90 deg = 1.5707963267948966 rad, 1 rad/s, start 0.
+    #[test]
+    fn presets_set_the_documented_values() {
+        let mut m = ContainerShipFmu::default();
+        m.select_preset(1);
+        m.initialize(0.0).unwrap();
+        let Hull::Nonlinear(s) = &m.hull else {
+            panic!("variant 1")
+        };
+        assert_eq!(s.params.rudder_max, 0.17453292519943295);
+        assert_eq!(s.params.rudder_rate_max, 0.08726646259971647);
+        assert_eq!(m.inputs.rudder_command, 0.08726646259971647);
+
+        let mut m = ContainerShipFmu::default();
+        m.select_preset(2);
+        m.initialize(0.0).unwrap();
+        let Hull::Nonlinear(s) = &m.hull else {
+            panic!("variant 1")
+        };
+        assert_eq!(s.params.rudder_max, 1.5707963267948966);
+        assert_eq!(s.params.rudder_rate_max, 1.0);
+        assert_eq!(m.inputs.rudder_command, 0.0);
+        // the linear variant takes the same servo
+        let mut m = ContainerShipFmu {
+            variant: 2,
+            ..Default::default()
+        };
+        m.select_preset(2);
+        m.initialize(0.0).unwrap();
+        let Hull::Linear(s) = &m.hull else {
+            panic!("variant 2")
+        };
+        assert_eq!((s.rudder_max, s.rudder_rate_max), (1.5707963267948966, 1.0));
+        // a rudder_command set before the preset is kept
+        let mut m = ContainerShipFmu::default();
+        m.inputs.rudder_command = 0.01;
+        m.select_preset(2);
+        assert_eq!(m.inputs.rudder_command, 0.01);
+    }
+
+    #[test]
+    fn a_servo_set_against_the_preset_is_refused() {
+        let mut m = ContainerShipFmu::default();
+        m.params.rudder_max = 0.5;
+        m.select_preset(2);
+        let e = m.initialize(0.0).unwrap_err();
+        assert!(
+            e.contains(
+                "preset = 2 sets rudder_max = 1.5707963267948966, but rudder_max was set to 0.5"
+            ),
+            "{e}"
+        );
+        // the preset's own value is accepted, also when set in step mode
+        let mut m = ContainerShipFmu::default();
+        m.params.rudder_rate_max = 1.0;
+        m.select_preset(2);
+        m.initialize(0.0).unwrap();
+        m.params.rudder_rate_max = 0.2;
+        assert!(m.parameters_changed().is_err());
+        m.preset = 3;
+        assert!(m.initialize(0.0).unwrap_err().contains("preset = 3"));
+    }
+
+    /// Every initial-state parameter is the state at the start (variant 1 and 2), the defaults
+    /// are today's start, and a roll outside (-pi/2, pi/2) or a non-finite value is refused.
+    #[test]
+    fn the_initial_state_is_the_start() {
+        let mut m = ContainerShipFmu::default();
+        m.initialize(0.0).unwrap();
+        let today = ContainerShip::at_equilibrium(DEFAULT_SHAFT_SPEED).unwrap();
+        let Hull::Nonlinear(s) = &m.hull else {
+            panic!("variant 1")
+        };
+        assert_eq!(s.state(), today.state());
+
+        m.initial_sway_velocity = 0.5;
+        m.initial = InitialState {
+            yaw_rate: 0.01,
+            x: 10.0,
+            y: -20.0,
+            heading: 0.3,
+            roll_rate: -0.02,
+            roll: 0.1,
+            rudder_angle: -0.05,
+        };
+        m.initialize(0.0).unwrap();
+        let Hull::Nonlinear(s) = &m.hull else {
+            panic!("variant 1")
+        };
+        let u = ContainerShip::straight_line_speed(80.0);
+        assert_eq!(
+            s.state(),
+            &[u, 0.5, 0.01, 10.0, -20.0, 0.3, -0.02, 0.1, -0.05, 80.0]
+        );
+        m.variant = 2;
+        m.initialize(0.0).unwrap();
+        let Hull::Linear(s) = &m.hull else {
+            panic!("variant 2")
+        };
+        assert_eq!(
+            s.state(),
+            &[7.0, 0.5, 0.01, 10.0, -20.0, 0.3, -0.02, 0.1, -0.05]
+        );
+        m.initial.roll = 1.6;
+        let e = m.initialize(0.0).unwrap_err();
+        assert!(e.contains("initial_roll = 1.6"), "{e}");
+        m.initial.roll = 0.0;
+        m.initial.x = f64::NAN;
+        let e = m.initialize(0.0).unwrap_err();
+        assert!(e.contains("initial_x = NaN"), "{e}");
+    }
 
     #[test]
     fn errors_name_the_fmu_parameter_and_value() {

@@ -5,7 +5,7 @@
 use fmi2_export::FmuModel;
 use models::error::ParamError;
 use models::hull::mariner::{Mariner, MarinerInputs, MarinerOutputs, MarinerParams, U0_DEFAULT};
-use models::hull::DEG;
+use models::hull::{check_initial_state, DEG};
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 
@@ -23,6 +23,61 @@ pub struct MarinerFmu {
     /// means compute them. Not part of the state.
     #[serde(skip)]
     outputs: Option<MarinerOutputs>,
+    /// The state the run starts from (all 0 by default).
+    initial: InitialState,
+}
+
+/// The initial state, SI, of the model's state `[Δu, v, r, x, y, ψ, δ]` (MSS `mariner.m`), with
+/// the rudder in the sign of the output `rudder_angle` (−δ).
+#[derive(Clone, Copy, Debug, Default, Serialize, Deserialize)]
+struct InitialState {
+    surge_perturbation: f64,
+    sway_velocity: f64,
+    yaw_rate: f64,
+    x: f64,
+    y: f64,
+    heading: f64,
+    rudder_angle: f64,
+}
+
+impl MarinerFmu {
+    /// The start state: the trimmed course's Δu, v, δ (with `trimmed`) or the parameters', with
+    /// r, x, y, ψ from the parameters in both cases.
+    fn initial_state(&self) -> Result<[f64; 7], String> {
+        let i = &self.initial;
+        check_initial_state(
+            &[
+                ("initial_surge_perturbation", i.surge_perturbation),
+                ("initial_sway_velocity", i.sway_velocity),
+                ("initial_yaw_rate", i.yaw_rate),
+                ("initial_x", i.x),
+                ("initial_y", i.y),
+                ("initial_heading", i.heading),
+                ("initial_rudder_angle", i.rudder_angle),
+            ],
+            &[],
+        )?;
+        let (du, v, delta) = if self.trimmed {
+            for (name, value) in [
+                ("initial_surge_perturbation", i.surge_perturbation),
+                ("initial_sway_velocity", i.sway_velocity),
+                ("initial_rudder_angle", i.rudder_angle),
+            ] {
+                if value != 0.0 {
+                    return Err(format!(
+                        "parameter {name} = {value} applies with trimmed = false only (the trim \
+                         solves it)"
+                    ));
+                }
+            }
+            let s = Mariner::trimmed(self.params.u0).map_err(param_error)?;
+            let s = s.state();
+            (s[0], s[1], s[6])
+        } else {
+            (i.surge_perturbation, i.sway_velocity, -i.rudder_angle)
+        };
+        Ok([du, v, i.yaw_rate, i.x, i.y, i.heading, delta])
+    }
 }
 
 /// Start value of `rudder_command`: a small starboard rudder so that the default experiment turns.
@@ -39,13 +94,18 @@ impl Default for MarinerFmu {
             },
             ship: Mariner::trimmed(U0_DEFAULT).expect("valid preset"),
             outputs: None,
+            initial: InitialState::default(),
         }
     }
 }
 
 /// A model error with the model's parameter name replaced by the FMU variable's name.
 fn param_error(e: ParamError) -> String {
-    e.renamed(&[("u0", "nominal_speed")]).to_string()
+    e.renamed(&[
+        ("u0", "nominal_speed"),
+        ("delta_u", "initial_surge_perturbation"),
+    ])
+    .to_string()
 }
 
 impl MarinerFmu {
@@ -104,6 +164,23 @@ fmi2_export::fmu! {
         output real "sway_velocity_prime" (|m| m.out().v_prime), "Prime-system sway v' = v/U";
         output real "yaw_rate_prime" (|m| m.out().r_prime),
             "Prime-system yaw rate r' = r L/U (L = 160.93 m)";
+        // The initial state (issue 17), appended after the released variables: the state
+        // [delta_u, v, r, x, y, psi, delta] of MSS mariner.m.
+        fixed real "initial_surge_perturbation" ["m/s"] (initial.surge_perturbation),
+            "Surge perturbation delta_u at the start time, u = U0 + delta_u > 0 (trimmed = false only; \
+             default 0)";
+        fixed real "initial_sway_velocity" ["m/s"] (initial.sway_velocity),
+            "Sway velocity v at the start time (trimmed = false only; default 0)";
+        fixed real "initial_yaw_rate" ["rad/s"] (initial.yaw_rate),
+            "Yaw rate r at the start time (default 0; with trimmed the course is then no longer \
+             straight)";
+        fixed real "initial_x" ["m"] (initial.x), "North position at the start time (default 0)";
+        fixed real "initial_y" ["m"] (initial.y), "East position at the start time (default 0)";
+        fixed real "initial_heading" ["rad"] (initial.heading),
+            "Heading psi from north, clockwise, at the start time (default 0)";
+        fixed real "initial_rudder_angle" ["rad"] (initial.rudder_angle),
+            "Physical rudder angle at the start time, sign of rudder_angle (the servo state is its \
+             negative, MSS delta; trimmed = false only; default 0)";
     }
 }
 
@@ -111,12 +188,8 @@ impl FmuModel for MarinerFmu {
     fn initialize(&mut self, _start_time: f64) -> Result<(), String> {
         self.outputs = None;
         self.params.validate().map_err(param_error)?;
-        let mut ship = if self.trimmed {
-            Mariner::trimmed(self.params.u0).map_err(param_error)?
-        } else {
-            Mariner::new(self.params.clone(), [0.0; 7]).map_err(param_error)?
-        };
-        ship.params = self.params.clone();
+        let state = self.initial_state()?;
+        let ship = Mariner::new(self.params.clone(), state).map_err(param_error)?;
         self.trim = Mariner::trim_input(self.params.u0);
         self.ship = ship;
         self.keep_outputs();
@@ -144,6 +217,38 @@ impl FmuModel for MarinerFmu {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// trimmed (default): the trim's delta_u, v, delta with r, x, y, psi from the parameters,
+    /// and the defaults give today's start; trimmed = false: every state from the parameters,
+    /// the rudder with the output's sign (state delta = -rudder_angle).
+    #[test]
+    fn the_initial_state_is_the_start() {
+        let mut m = MarinerFmu::default();
+        m.initialize(0.0).unwrap();
+        assert_eq!(m.ship, Mariner::trimmed(U0_DEFAULT).unwrap());
+        m.initial.heading = 0.5;
+        m.initial.x = 100.0;
+        m.initialize(0.0).unwrap();
+        let trim = *Mariner::trimmed(U0_DEFAULT).unwrap().state();
+        let s = m.ship.state();
+        assert_eq!((s[0], s[1], s[6]), (trim[0], trim[1], trim[6]));
+        assert_eq!((s[2], s[3], s[4], s[5]), (0.0, 100.0, 0.0, 0.5));
+        m.initial.sway_velocity = 0.1;
+        let e = m.initialize(0.0).unwrap_err();
+        assert!(
+            e.contains("initial_sway_velocity = 0.1 applies with trimmed = false"),
+            "{e}"
+        );
+        m.trimmed = false;
+        m.initial.rudder_angle = 0.2;
+        m.initial.surge_perturbation = -0.5;
+        m.initialize(0.0).unwrap();
+        assert_eq!(m.ship.state(), &[-0.5, 0.1, 0.0, 100.0, 0.0, 0.5, -0.2]);
+        assert_eq!(m.out().rudder, 0.2);
+        m.initial.surge_perturbation = -8.0;
+        let e = m.initialize(0.0).unwrap_err();
+        assert!(e.contains("initial_surge_perturbation = -8"), "{e}");
+    }
 
     #[test]
     fn errors_name_the_fmu_parameter_and_value() {

@@ -5,8 +5,9 @@
 use fmi2_export::FmuModel;
 use models::error::check_positive;
 use models::hull::rrs_ship::{RrsShip, RrsShipInputs, RrsShipOutputs, NX, U_22KN};
-use models::hull::DEG;
+use models::hull::{check_initial_state, DEG};
 use serde::{Deserialize, Serialize};
+use std::f64::consts::FRAC_PI_2;
 
 /// Parameters, inputs and state of one RRS-ship instance.
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -22,6 +23,22 @@ pub struct RrsShipFmu {
     wind_roll: f64,
     wind_yaw: f64,
     ship: RrsShip,
+    /// The state the run starts from (all 0 by default: upright on a straight course north at
+    /// the origin).
+    initial: InitialState,
+}
+
+/// The initial motion state and position of the hull, `[φ, p, v, r, ψ]` and `(x, y)` of the
+/// model's state (the wave-filter states start at 0).
+#[derive(Clone, Copy, Debug, Default, Serialize, Deserialize)]
+struct InitialState {
+    roll: f64,
+    roll_rate: f64,
+    sway: f64,
+    yaw_rate: f64,
+    heading: f64,
+    x: f64,
+    y: f64,
 }
 
 /// Start value of `rudder_angle`: a small rudder so that the default experiment turns and rolls.
@@ -42,6 +59,7 @@ impl Default for RrsShipFmu {
             wind_roll: 0.0,
             wind_yaw: 0.0,
             ship,
+            initial: InitialState::default(),
         }
     }
 }
@@ -66,6 +84,19 @@ impl RrsShipFmu {
         ] {
             check_positive(name, v)?;
         }
+        let i = &self.initial;
+        check_initial_state(
+            &[
+                ("initial_roll", i.roll),
+                ("initial_roll_rate", i.roll_rate),
+                ("initial_sway", i.sway),
+                ("initial_yaw_rate", i.yaw_rate),
+                ("initial_heading", i.heading),
+                ("initial_x", i.x),
+                ("initial_y", i.y),
+            ],
+            &["initial_roll"],
+        )?;
         Ok(())
     }
 }
@@ -125,6 +156,22 @@ fmi2_export::fmu! {
         input real "wind_yaw_disturbance" ["rad"] (wind_yaw),
             "Second rudder-equivalent yaw disturbance (e.g. the wind moment of eq. 2.20), added to \
              yaw_disturbance";
+        // The initial state (issue 17), appended after the released variables.
+        fixed real "initial_roll" ["rad"] (initial.roll).range(-FRAC_PI_2, FRAC_PI_2),
+            "Roll angle phi at the start time (positive starboard down; default 0; within \
+             (-pi/2, pi/2)). The states are those of eqs. 2.16-2.18 (model 1) and of eq. 3.29 \
+             (models 2, 3: x = [phi, p, v', r, psi]); the wave-filter states start at 0";
+        fixed real "initial_roll_rate" ["rad/s"] (initial.roll_rate),
+            "Roll rate p at the start time (default 0)";
+        fixed real "initial_sway" (initial.sway),
+            "Sway state v (model 1) or v' (models 2, 3, x3 of eq. 3.29) at the start time, in the \
+             model's own scale as the output sway (default 0)";
+        fixed real "initial_yaw_rate" ["rad/s"] (initial.yaw_rate),
+            "Yaw rate r at the start time (default 0)";
+        fixed real "initial_heading" ["rad"] (initial.heading),
+            "Heading psi from north, clockwise, at the start time (default 0)";
+        fixed real "initial_x" ["m"] (initial.x), "North position at the start time (default 0)";
+        fixed real "initial_y" ["m"] (initial.y), "East position at the start time (default 0)";
     }
 }
 
@@ -139,6 +186,11 @@ impl FmuModel for RrsShipFmu {
         };
         ship.min_speed = self.min_speed;
         ship.max_substep = self.max_substep;
+        let i = &self.initial;
+        ship.set_motion(
+            [i.roll, i.roll_rate, i.sway, i.yaw_rate, i.heading],
+            [i.x, i.y],
+        );
         self.ship = ship;
         Ok(())
     }
@@ -161,6 +213,40 @@ impl FmuModel for RrsShipFmu {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The initial state is the start of the state vector [phi, p, v, r, psi, .., x, y] in
+    /// every model, the defaults are today's start (all 0), and a roll outside (-pi/2, pi/2)
+    /// or a non-finite value is refused.
+    #[test]
+    fn the_initial_state_is_the_start() {
+        let mut m = RrsShipFmu::default();
+        m.initialize(0.0).unwrap();
+        assert_eq!(m.ship.state(), &[0.0; NX + 2]);
+        m.initial = InitialState {
+            roll: 0.1,
+            roll_rate: -0.01,
+            sway: 0.2,
+            yaw_rate: 0.003,
+            heading: 1.5,
+            x: 10.0,
+            y: -20.0,
+        };
+        for model in [1, 2, 3] {
+            m.model = model;
+            m.initialize(0.0).unwrap();
+            let s = m.ship.state();
+            assert_eq!(&s[..5], &[0.1, -0.01, 0.2, 0.003, 1.5]);
+            assert_eq!(&s[5..NX], &[0.0; 6]);
+            assert_eq!(&s[NX..], &[10.0, -20.0]);
+        }
+        m.initial.roll = -1.6;
+        let e = m.initialize(0.0).unwrap_err();
+        assert!(e.contains("initial_roll = -1.6"), "{e}");
+        m.initial.roll = 0.0;
+        m.initial.y = f64::NEG_INFINITY;
+        let e = m.initialize(0.0).unwrap_err();
+        assert!(e.contains("initial_y = -inf"), "{e}");
+    }
 
     #[test]
     fn errors_name_the_fmu_parameter_and_value() {

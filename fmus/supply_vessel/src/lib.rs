@@ -4,6 +4,7 @@
 
 use fmi2_export::FmuModel;
 use models::error::check_positive;
+use models::hull::check_initial_state;
 use models::hull::supply_vessel::{
     SupplyVessel, SupplyVesselInputs, SupplyVesselOutputs, NORTHERN_CLIPPER_D, NORTHERN_CLIPPER_M,
 };
@@ -22,6 +23,10 @@ pub struct SupplyVesselFmu {
     /// means compute them. Not part of the state.
     #[serde(skip)]
     outputs: Option<SupplyVesselOutputs>,
+    /// The LF state the run starts from, eta = [x, y, psi] and nu = [u, v, r] of
+    /// [Fossen1999, eqs. (1)-(2)] (all 0 by default: at rest at the origin, heading north).
+    initial_eta: [f64; 3],
+    initial_nu: [f64; 3],
 }
 
 /// Start value of `surge_force` [N]: a small thrust so that the default experiment moves
@@ -41,6 +46,8 @@ impl Default for SupplyVesselFmu {
             },
             vessel,
             outputs: None,
+            initial_eta: [0.0; 3],
+            initial_nu: [0.0; 3],
         }
     }
 }
@@ -140,6 +147,20 @@ fmi2_export::fmu! {
             "Measured east position y_2 = y + eta_w,2";
         output real "measured_heading" ["rad"] (|m| m.out().measured[2]),
             "Measured heading y_3 = psi + eta_w,3";
+        // The initial state (issue 17), appended after the released variables: the LF state
+        // eta = [x, y, psi], nu = [u, v, r] of eqs. 1-2.
+        fixed real "initial_x" ["m"] (initial_eta[0]),
+            "LF north position x at the start time (eta_1 of eq. 1; default 0)";
+        fixed real "initial_y" ["m"] (initial_eta[1]),
+            "LF east position y at the start time (eta_2 of eq. 1; default 0)";
+        fixed real "initial_heading" ["rad"] (initial_eta[2]),
+            "LF heading psi from north, clockwise, at the start time (eta_3 of eq. 1; default 0)";
+        fixed real "initial_surge_velocity" ["m/s"] (initial_nu[0]),
+            "LF surge velocity u at the start time (nu_1 of eq. 2; default 0)";
+        fixed real "initial_sway_velocity" ["m/s"] (initial_nu[1]),
+            "LF sway velocity v at the start time (nu_2 of eq. 2; default 0)";
+        fixed real "initial_yaw_rate" ["rad/s"] (initial_nu[2]),
+            "LF yaw rate r at the start time (nu_3 of eq. 2; default 0)";
     }
 }
 
@@ -149,6 +170,19 @@ impl FmuModel for SupplyVesselFmu {
         let mut vessel = SupplyVessel::new(self.mass, self.damping).map_err(|e| e.to_string())?;
         check_positive("max_substep", self.max_substep)?;
         vessel.max_substep = self.max_substep;
+        let (eta, nu) = (self.initial_eta, self.initial_nu);
+        check_initial_state(
+            &[
+                ("initial_x", eta[0]),
+                ("initial_y", eta[1]),
+                ("initial_heading", eta[2]),
+                ("initial_surge_velocity", nu[0]),
+                ("initial_sway_velocity", nu[1]),
+                ("initial_yaw_rate", nu[2]),
+            ],
+            &[],
+        )?;
+        vessel.set_state(eta, nu);
         self.vessel = vessel;
         self.keep_outputs();
         Ok(())
@@ -168,6 +202,22 @@ impl FmuModel for SupplyVesselFmu {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The initial state is the LF state eta = [x, y, psi], nu = [u, v, r]; defaults 0.
+    #[test]
+    fn the_initial_state_is_the_start() {
+        let mut m = SupplyVesselFmu::default();
+        m.initialize(0.0).unwrap();
+        assert_eq!(m.vessel.state(), &[0.0; 6]);
+        m.initial_eta = [1.0, 2.0, 0.5];
+        m.initial_nu = [0.3, -0.1, 0.01];
+        m.initialize(0.0).unwrap();
+        assert_eq!(m.vessel.state(), &[1.0, 2.0, 0.5, 0.3, -0.1, 0.01]);
+        assert_eq!(m.out().eta, [1.0, 2.0, 0.5]);
+        m.initial_nu[2] = f64::INFINITY;
+        let e = m.initialize(0.0).unwrap_err();
+        assert!(e.contains("initial_yaw_rate = inf"), "{e}");
+    }
 
     #[test]
     fn errors_name_the_fmu_parameter_and_value() {

@@ -5,9 +5,9 @@
 use fmi2_export::FmuModel;
 use models::error::ParamError;
 use models::hull::tokyo_maru::{
-    TokyoMaru, TokyoMaruInputs, TokyoMaruIntegration, TokyoMaruOutputs, T_R,
+    TokyoMaru, TokyoMaruInputs, TokyoMaruIntegration, TokyoMaruOutputs, L, T_R, U,
 };
-use models::hull::DEG;
+use models::hull::{check_initial_state, DEG};
 use serde::{Deserialize, Serialize};
 
 /// Parameters, inputs and state of one Tokyo Maru instance.
@@ -31,6 +31,34 @@ pub struct TokyoMaruFmu {
     /// means compute them. Not part of the state.
     #[serde(skip)]
     outputs: Option<TokyoMaruOutputs>,
+    /// The state the run starts from (all 0 by default: on the track, heading along it).
+    initial: InitialState,
+}
+
+/// The initial state, SI: the x = [psi', r', beta', eta', delta'] of [Parsons1980, eq. (11)]
+/// dimensional, and the along-track position.
+#[derive(Clone, Copy, Debug, Default, Serialize, Deserialize)]
+struct InitialState {
+    heading: f64,
+    yaw_rate: f64,
+    drift_angle: f64,
+    cross_track: f64,
+    along_track: f64,
+    rudder_angle: f64,
+}
+
+impl InitialState {
+    /// The model's state `[ψ′, r′, β′_e, η′, δ′, ξ′]` (r′ = rL/U, η′ = η/L, ξ′ = ξ/L).
+    fn prime(&self) -> [f64; 6] {
+        [
+            self.heading,
+            self.yaw_rate * L / U,
+            self.drift_angle,
+            self.cross_track / L,
+            self.rudder_angle,
+            self.along_track / L,
+        ]
+    }
 }
 
 /// Start value of the rudder inputs: a small rudder so that the default experiment turns.
@@ -52,6 +80,7 @@ impl Default for TokyoMaruFmu {
             current_lateral: 0.0,
             ship: TokyoMaru::design_depth(),
             outputs: None,
+            initial: InitialState::default(),
         }
     }
 }
@@ -166,6 +195,24 @@ fmi2_export::fmu! {
             "Actual rudder angle delta (the internal gear's output, or the input rudder_angle)";
         output real "time_prime" (|m| m.out().time_prime),
             "Nondimensional time t' = tU/L since the start";
+        // The initial state (issue 17), appended after the released variables: the state
+        // x = [psi', r', beta', eta', delta'] of eq. 11 in SI, and the along-track position.
+        fixed real "initial_heading" ["rad"] (initial.heading),
+            "Heading psi' relative to the track at the start time (state x1 of eq. 11; default 0)";
+        fixed real "initial_yaw_rate" ["rad/s"] (initial.yaw_rate),
+            "Yaw rate r = r' U/L at the start time (state x2 of eq. 11; default 0)";
+        fixed real "initial_drift_angle" ["rad"] (initial.drift_angle),
+            "Drift angle beta' relative to the water at the start time (state x3 of eq. 11; equal to \
+             the output drift_angle without current; default 0)";
+        fixed real "initial_cross_track" ["m"] (initial.cross_track),
+            "Lateral deviation eta = eta' L from the track at the start time (state x4 of eq. 11; \
+             default 0)";
+        fixed real "initial_x" ["m"] (initial.along_track),
+            "North (along-track) position xi at the start time (default 0)";
+        fixed real "initial_rudder_angle" ["rad"] (initial.rudder_angle),
+            "Rudder angle delta' at the start time (state x5 of eq. 11): the internal gear's state \
+             with internal_steering_gear = true; otherwise only rudder_angle_actual before the \
+             first step (default 0)";
     }
 }
 
@@ -183,6 +230,19 @@ impl FmuModel for TokyoMaruFmu {
             v => return Err(format!("parameter integration = {v} must be 1 or 2")),
         };
         ship.validate().map_err(param_error)?;
+        let i = &self.initial;
+        check_initial_state(
+            &[
+                ("initial_heading", i.heading),
+                ("initial_yaw_rate", i.yaw_rate),
+                ("initial_drift_angle", i.drift_angle),
+                ("initial_cross_track", i.cross_track),
+                ("initial_x", i.along_track),
+                ("initial_rudder_angle", i.rudder_angle),
+            ],
+            &[],
+        )?;
+        ship.set_full_state_prime(i.prime());
         self.ship = ship;
         self.keep_outputs();
         Ok(())
@@ -211,6 +271,38 @@ impl FmuModel for TokyoMaruFmu {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The initial state in SI is the report's prime state of eq. 11: r' = rL/U and eta' = eta/L
+    /// with L = 290 m, U = 12 kn = 6.173333 m/s (Table 1); the outputs show it before the
+    /// first step; a non-finite value is refused.
+    #[test]
+    fn the_initial_state_is_the_start() {
+        let mut m = TokyoMaruFmu::default();
+        m.initialize(0.0).unwrap();
+        assert_eq!(m.ship.state(), &[0.0; 6]);
+        m.initial = InitialState {
+            heading: -0.14,
+            yaw_rate: 0.001,
+            drift_angle: -0.1,
+            cross_track: 29.0,
+            along_track: 580.0,
+            rudder_angle: 0.13,
+        };
+        m.internal_steering_gear = true;
+        m.initialize(0.0).unwrap();
+        let s = m.ship.state();
+        let (l, u) = (290.0, 12.0 * 1852.0 / 3600.0);
+        assert_eq!((s[0], s[2], s[4]), (-0.14, -0.1, 0.13));
+        assert!((s[1] - 0.001 * l / u).abs() < 1e-15);
+        assert!((s[3] - 0.1).abs() < 1e-16 && (s[5] - 2.0).abs() < 1e-15);
+        let o = m.out();
+        assert!((o.cross_track - 29.0).abs() < 1e-12 && (o.x - 580.0).abs() < 1e-12);
+        assert!((o.yaw_rate - 0.001).abs() < 1e-16);
+        assert_eq!((o.heading, o.drift_angle, o.rudder), (-0.14, -0.1, 0.13));
+        m.initial.drift_angle = f64::NAN;
+        let e = m.initialize(0.0).unwrap_err();
+        assert!(e.contains("initial_drift_angle = NaN"), "{e}");
+    }
 
     #[test]
     fn errors_name_the_fmu_parameter_and_value() {

@@ -11,13 +11,15 @@ use super::{collected, line_of};
 use crate::error::{Error, Result};
 use crate::model_description::{Causality, ModelDescription, VarType};
 use crate::system::{
-    Algorithm, ConnectionSpec, InstanceSpec, OutputSpec, Plan, PlanConnection, System, TypedValue,
-    Value, ValueSpec, VarRef,
+    Algorithm, InstanceSpec, OutputSpec, Plan, PlanConnection, System, TypedValue, Value, ValueSpec,
 };
 use serde::Deserialize;
 use std::collections::HashMap;
 use std::fmt::Write as _;
 use std::path::{Component, Path, PathBuf};
+
+mod connections;
+mod variable_groups;
 
 #[derive(Deserialize)]
 struct Root {
@@ -86,9 +88,9 @@ struct Functions {
     #[serde(rename = "LinearTransformation", default)]
     linear: Vec<LinearTransformation>,
     #[serde(rename = "Sum", default)]
-    sum: Vec<Named>,
+    sum: Vec<SumFunction>,
     #[serde(rename = "VectorSum", default)]
-    vector_sum: Vec<Named>,
+    vector_sum: Vec<VectorSumFunction>,
 }
 
 #[derive(Deserialize)]
@@ -101,10 +103,26 @@ struct LinearTransformation {
     offset: Option<f64>,
 }
 
+/// `<Sum name inputCount>`: out = in[0] + in[1] + ... (OSP-IS; libcosim's `vector_sum_function`
+/// of dimension 1).
 #[derive(Deserialize)]
-struct Named {
+struct SumFunction {
     #[serde(rename = "@name")]
     name: String,
+    #[serde(rename = "@inputCount")]
+    input_count: u32,
+}
+
+/// `<VectorSum name inputCount dimension>`: the component-wise sum of `inputCount` variable
+/// groups of `dimension` variables each.
+#[derive(Deserialize)]
+struct VectorSumFunction {
+    #[serde(rename = "@name")]
+    name: String,
+    #[serde(rename = "@inputCount")]
+    input_count: u32,
+    #[serde(rename = "@dimension")]
+    dimension: u32,
 }
 
 #[derive(Deserialize, Default)]
@@ -127,8 +145,16 @@ enum Connection {
         #[serde(rename = "Signal")]
         signal: SignalEndpoint,
     },
-    VariableGroupConnection {},
-    SignalGroupConnection {},
+    VariableGroupConnection {
+        #[serde(rename = "VariableGroup", default)]
+        groups: Vec<Endpoint>,
+    },
+    SignalGroupConnection {
+        #[serde(rename = "VariableGroup")]
+        group: Endpoint,
+        #[serde(rename = "SignalGroup")]
+        signal: SignalEndpoint,
+    },
 }
 
 #[derive(Deserialize, Clone)]
@@ -157,6 +183,10 @@ struct Reader<'t> {
     path: &'t Path,
     text: &'t str,
     errors: Vec<Error>,
+    /// Simulator name -> its FMU (variable groups are read from beside it).
+    fmus: HashMap<String, PathBuf>,
+    /// Simulator name -> its variable groups, read when a connection first needs them.
+    groups: HashMap<String, Option<variable_groups::Groups>>,
 }
 
 /// Reads an `OspSystemStructure.xml`.
@@ -174,17 +204,23 @@ pub fn parse(path: &Path, text: &str) -> Result<System> {
         path,
         text,
         errors: Vec::new(),
+        fmus: HashMap::new(),
+        groups: HashMap::new(),
     };
     let algorithm = r.algorithm(root.algorithm.as_deref());
-    let instances = root
+    let instances: Vec<InstanceSpec> = root
         .simulators
         .list
         .into_iter()
         .map(|s| r.simulator(s, dir, h))
         .collect();
-    let functions = root.functions.unwrap_or_default();
-    let linear = r.linear_transformations(&functions);
-    let connections = r.connections(root.connections.map(|c| c.list), &linear);
+    r.fmus = instances
+        .iter()
+        .map(|i| (i.name.clone(), i.fmu.clone()))
+        .collect();
+    let functions = r.functions(root.functions.unwrap_or_default());
+    let list = root.connections.map(|c| c.list).unwrap_or_default();
+    let connections = r.connections(list, &functions);
     collected(r.errors)?;
     Ok(System {
         source: path.to_path_buf(),
@@ -225,20 +261,6 @@ pub fn require_end_time(sys: &System) -> Result<()> {
         ));
     }
     Ok(())
-}
-
-/// A LinearTransformation's endpoints: its "in" variable and its "out" variables.
-#[derive(Default)]
-struct Signals {
-    input: HashMap<String, Endpoint>,
-    outputs: HashMap<String, Vec<Endpoint>>,
-}
-
-fn var_ref(e: &Endpoint) -> VarRef {
-    VarRef {
-        instance: e.simulator.clone(),
-        variable: e.name.clone(),
-    }
 }
 
 impl Reader<'_> {
@@ -331,153 +353,6 @@ impl Reader<'_> {
             value,
         })
     }
-
-    /// LinearTransformation functions by name: (factor, offset). Sum/VectorSum are errors.
-    fn linear_transformations(&mut self, functions: &Functions) -> HashMap<String, (f64, f64)> {
-        for f in functions.sum.iter().chain(functions.vector_sum.iter()) {
-            let line = self.line_of(&format!("name=\"{}\"", f.name));
-            self.error(
-                line,
-                format!(
-                    "function '{}': Sum/VectorSum functions are not supported",
-                    f.name
-                ),
-            );
-        }
-        functions
-            .linear
-            .iter()
-            .map(|f| {
-                (
-                    f.name.clone(),
-                    (f.factor.unwrap_or(1.0), f.offset.unwrap_or(0.0)),
-                )
-            })
-            .collect()
-    }
-
-    /// VariableConnections as they come, then one connection per LinearTransformation output
-    /// (functions in name order), with the function's factor and offset.
-    fn connections(
-        &mut self,
-        list: Option<Vec<Connection>>,
-        linear: &HashMap<String, (f64, f64)>,
-    ) -> Vec<ConnectionSpec> {
-        let mut connections = Vec::new();
-        let mut signals = Signals::default();
-        for c in list.unwrap_or_default() {
-            match c {
-                Connection::VariableConnection { variables } => {
-                    connections.extend(self.variable_connection(&variables));
-                }
-                Connection::SignalConnection { variable, signal } => {
-                    self.signal_connection(variable, signal, linear, &mut signals);
-                }
-                Connection::VariableGroupConnection {} | Connection::SignalGroupConnection {} => {
-                    self.error(
-                        None,
-                        "VariableGroupConnection/SignalGroupConnection (OSP-IS variable groups) are not supported",
-                    );
-                }
-            }
-        }
-        let mut fnames: Vec<&String> = linear.keys().collect();
-        fnames.sort();
-        for f in fnames {
-            connections.extend(self.transformed(f, linear[f], &signals));
-        }
-        connections
-    }
-
-    fn variable_connection(&mut self, variables: &[Endpoint]) -> Option<ConnectionSpec> {
-        if variables.len() != 2 {
-            self.error(
-                None,
-                "VariableConnection must have exactly two Variable elements",
-            );
-            return None;
-        }
-        let line = self.line_of(&format!(
-            "name=\"{}\"",
-            variables[1].name.replace('"', "&quot;")
-        ));
-        Some(ConnectionSpec {
-            from: var_ref(&variables[0]),
-            to: var_ref(&variables[1]),
-            gain: 1.0,
-            offset: 0.0,
-            line,
-            either_direction: true,
-            convert: false,
-        })
-    }
-
-    fn signal_connection(
-        &mut self,
-        variable: Endpoint,
-        signal: SignalEndpoint,
-        linear: &HashMap<String, (f64, f64)>,
-        signals: &mut Signals,
-    ) {
-        if !linear.contains_key(&signal.function) {
-            let line = self.line_of(&format!("function=\"{}\"", signal.function));
-            self.error(
-                line,
-                format!(
-                    "SignalConnection refers to unknown function '{}'",
-                    signal.function
-                ),
-            );
-            return;
-        }
-        match signal.name.as_str() {
-            "in" => {
-                signals.input.insert(signal.function, variable);
-            }
-            "out" => signals
-                .outputs
-                .entry(signal.function)
-                .or_default()
-                .push(variable),
-            other => self.error(
-                None,
-                format!(
-                    "function '{}': unknown signal '{other}' (LinearTransformation has 'in' and 'out')",
-                    signal.function
-                ),
-            ),
-        }
-    }
-
-    /// The connections through LinearTransformation `f`: one per "out".
-    fn transformed(
-        &mut self,
-        f: &str,
-        (gain, offset): (f64, f64),
-        signals: &Signals,
-    ) -> Vec<ConnectionSpec> {
-        let (Some(src), Some(dsts)) = (signals.input.get(f), signals.outputs.get(f)) else {
-            let line = self.line_of(&format!("name=\"{f}\""));
-            self.error(
-                line,
-                format!("LinearTransformation '{f}' needs one 'in' and at least one 'out' SignalConnection"),
-            );
-            return Vec::new();
-        };
-        let line = self.line_of(&format!("function=\"{f}\""));
-        dsts.iter()
-            .map(|d| ConnectionSpec {
-                from: var_ref(src),
-                to: var_ref(d),
-                gain,
-                offset,
-                line,
-                either_direction: false,
-                // a LinearTransformation may map one quantity onto another
-                convert: gain != 1.0 || offset != 0.0,
-            })
-            .collect()
-    }
 }
 
 fn esc(s: &str) -> String {
@@ -523,6 +398,7 @@ pub fn write(sys: &System, out: &Path) -> Result<Vec<String>> {
     let unpacked = sys.unpack_fmus()?;
     let mds: Vec<_> = unpacked.iter().map(|u| &u.model_description).collect();
     let plan = sys.validate(&mds)?;
+    let sums = summed_inputs(sys, &plan.connections)?;
     let scenario_path = out.with_file_name("scenario.json");
     let mut warnings = plan.warnings.clone();
     warnings.extend(lost_in_export(sys, &scenario_path));
@@ -542,8 +418,8 @@ pub fn write(sys: &System, out: &Path) -> Result<Vec<String>> {
     let _ = writeln!(x, "    <BaseStepSize>{:?}</BaseStepSize>", sys.step_size);
     x.push_str("    <Algorithm>fixedStep</Algorithm>\n");
     write_simulators(&mut x, sys, &plan, &mds, base);
-    write_functions(&mut x, &plan.connections);
-    write_connections(&mut x, sys, &plan.connections, &mds);
+    write_functions(&mut x, &plan.connections, &sums);
+    write_connections(&mut x, sys, &plan.connections, &mds, &sums);
     x.push_str("</OspSystemStructure>\n");
     if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir)
@@ -682,14 +558,52 @@ fn is_transformed(c: &PlanConnection) -> bool {
     c.gain != 1.0 || c.offset != 0.0
 }
 
-/// `<Functions>`: one LinearTransformation `lt<k>` per connection k with a gain or offset.
-fn write_functions(x: &mut String, connections: &[PlanConnection]) {
+/// A summed input, exported as a `Sum` function `sum<k>` (k: its first term's connection).
+struct SummedInput {
+    /// Its terms, as indices into the plan's connections, in order (`in[0]`, `in[1]`, ...).
+    terms: Vec<usize>,
+}
+
+/// The summed inputs of a plan (in the order of their first terms). A term with a gain or
+/// offset cannot be exported: OSP's `Sum` adds its inputs as they are, and libcosim connects a
+/// function's output to a simulator's input only, never to another function, so there is no
+/// LinearTransformation in front of a Sum input. That is an error naming the connection.
+fn summed_inputs(sys: &System, connections: &[PlanConnection]) -> Result<Vec<SummedInput>> {
+    let mut sums: Vec<SummedInput> = Vec::new();
+    let mut index: HashMap<(usize, u32), usize> = HashMap::new();
+    let mut scaled = Vec::new();
+    for (k, c) in connections.iter().enumerate().filter(|(_, c)| c.sum) {
+        if is_transformed(c) {
+            scaled.push(format!("{} (gain {}, offset {})", c.name, c.gain, c.offset));
+        }
+        let s = *index.entry((c.to_instance, c.to_vr)).or_insert_with(|| {
+            sums.push(SummedInput { terms: Vec::new() });
+            sums.len() - 1
+        });
+        sums[s].terms.push(k);
+    }
+    if !scaled.is_empty() {
+        return Err(Error::system(
+            &sys.source,
+            None,
+            format!(
+                "cannot export to OSP: the summed connection(s) {} have a gain or offset, but OSP's Sum function adds its inputs as they are and libcosim cannot put a LinearTransformation in front of a Sum input (a function feeds simulators only)",
+                scaled.join(", ")
+            ),
+        ));
+    }
+    Ok(sums)
+}
+
+/// `<Functions>`: one LinearTransformation `lt<k>` per connection k with a gain or offset, then
+/// one Sum `sum<k>` per summed input (the OSP schema's order).
+fn write_functions(x: &mut String, connections: &[PlanConnection], sums: &[SummedInput]) {
     let transformed: Vec<_> = connections
         .iter()
         .enumerate()
-        .filter(|(_, c)| is_transformed(c))
+        .filter(|(_, c)| is_transformed(c) && !c.sum)
         .collect();
-    if transformed.is_empty() {
+    if transformed.is_empty() && sums.is_empty() {
         return;
     }
     x.push_str("    <Functions>\n");
@@ -700,15 +614,44 @@ fn write_functions(x: &mut String, connections: &[PlanConnection]) {
             c.gain, c.offset
         );
     }
+    for s in sums {
+        let _ = writeln!(
+            x,
+            "        <Sum name=\"sum{}\" inputCount=\"{}\"/>",
+            s.terms[0],
+            s.terms.len()
+        );
+    }
     x.push_str("    </Functions>\n");
 }
 
-/// `<Connections>`: a VariableConnection, or two SignalConnections through `lt<k>`.
+/// A `<SignalConnection>` between variable `name` of simulator `sim` and signal `signal` of
+/// `function`: into the function when `into`, else out of it.
+fn signal_connection(
+    x: &mut String,
+    (sim, name): (&str, &str),
+    function: &str,
+    signal: &str,
+    into: bool,
+) {
+    let variable = format!("<Variable simulator=\"{sim}\" name=\"{name}\"/>");
+    let signal = format!("<Signal function=\"{function}\" name=\"{signal}\"/>");
+    let (first, second) = if into {
+        (variable, signal)
+    } else {
+        (signal, variable)
+    };
+    let _ = writeln!(x, "        <SignalConnection>\n            {first}\n            {second}\n        </SignalConnection>");
+}
+
+/// `<Connections>`: a VariableConnection, or two SignalConnections through `lt<k>`; then the
+/// SignalConnections of each summed input's `sum<k>` (`in[0]`, `in[1]`, ..., `out`).
 fn write_connections(
     x: &mut String,
     sys: &System,
     connections: &[PlanConnection],
     mds: &[&ModelDescription],
+    sums: &[SummedInput],
 ) {
     if connections.is_empty() {
         return;
@@ -723,20 +666,35 @@ fn write_connections(
             .map(|v| v.name.clone())
             .unwrap_or_default()
     };
+    let from = |c: &PlanConnection| {
+        let name = esc(&var_name(c.from_instance, c.from_vr, false));
+        (esc(&sys.instances[c.from_instance].name), name)
+    };
+    let to = |c: &PlanConnection| {
+        let name = esc(&var_name(c.to_instance, c.to_vr, true));
+        (esc(&sys.instances[c.to_instance].name), name)
+    };
     for (k, c) in connections.iter().enumerate() {
-        if touches_enumeration(c, mds) {
+        if touches_enumeration(c, mds) || c.sum {
             continue;
         }
-        let fname = esc(&var_name(c.from_instance, c.from_vr, false));
-        let tname = esc(&var_name(c.to_instance, c.to_vr, true));
-        let fi = esc(&sys.instances[c.from_instance].name);
-        let ti = esc(&sys.instances[c.to_instance].name);
+        let ((fi, fname), (ti, tname)) = (from(c), to(c));
         if is_transformed(c) {
-            let _ = writeln!(x, "        <SignalConnection>\n            <Variable simulator=\"{fi}\" name=\"{fname}\"/>\n            <Signal function=\"lt{k}\" name=\"in\"/>\n        </SignalConnection>");
-            let _ = writeln!(x, "        <SignalConnection>\n            <Signal function=\"lt{k}\" name=\"out\"/>\n            <Variable simulator=\"{ti}\" name=\"{tname}\"/>\n        </SignalConnection>");
+            let f = format!("lt{k}");
+            signal_connection(x, (&fi, &fname), &f, "in", true);
+            signal_connection(x, (&ti, &tname), &f, "out", false);
         } else {
             let _ = writeln!(x, "        <VariableConnection>\n            <Variable simulator=\"{fi}\" name=\"{fname}\" causality=\"output\"/>\n            <Variable simulator=\"{ti}\" name=\"{tname}\" causality=\"input\"/>\n        </VariableConnection>");
         }
+    }
+    for s in sums {
+        let f = format!("sum{}", s.terms[0]);
+        for (i, &k) in s.terms.iter().enumerate() {
+            let (fi, fname) = from(&connections[k]);
+            signal_connection(x, (&fi, &fname), &f, &format!("in[{i}]"), true);
+        }
+        let (ti, tname) = to(&connections[s.terms[0]]);
+        signal_connection(x, (&ti, &tname), &f, "out", false);
     }
     x.push_str("    </Connections>\n");
 }

@@ -24,6 +24,7 @@
 //! gain = 1.0                # to = gain*from + offset (unit conversion)
 //! offset = 0.0
 //! convert = false           # true: the gain maps one quantity onto another (no unit check)
+//! sum = false               # true: a term of a summed input (see below)
 //!
 //! [[events]]
 //! time = 10.0
@@ -47,6 +48,20 @@
 //!     "gear.rudder_angle -> ship.rudder_angle, gain = 1.0, offset = 0.0",
 //!     "ship.r -> log.yaw_rate_deg, gain = 57.29577951308232, convert",
 //!     { from = "ship.psi", to = "autopilot.heading", gain = 1.0 },
+//! ]
+//! ```
+//!
+//! Several connections into one input are added only when each of them says `sum = true` (in
+//! the string form `, sum`): the input gets t0 + t1 + ..., each term `gain*from + offset`,
+//! added left to right in file order, as libcosim's `Sum` function adds its inputs. A second
+//! connection into an input without it stays an error ("driven twice"), so a copied line is not
+//! silently added:
+//!
+//! ```toml
+//! connections = [
+//!     "wind.yaw_moment -> ship.yaw_moment, sum",
+//!     "waves.yaw_moment -> ship.yaw_moment, sum",
+//!     "current.yaw_moment -> ship.yaw_moment, sum, gain = 0.5",
 //! ]
 //! ```
 //!
@@ -127,6 +142,9 @@ struct RawConnectionFull {
     /// `convert = true`: the gain converts between different physical quantities; no unit check.
     #[serde(default)]
     convert: bool,
+    /// `sum = true`: a term of a summed input ([`ConnectionSpec::sum`]).
+    #[serde(default)]
+    sum: bool,
 }
 
 #[derive(Deserialize)]
@@ -294,7 +312,7 @@ impl Reader<'_> {
 
     fn connection(&mut self, c: Spanned<RawConnection>) -> Option<ConnectionSpec> {
         let line = self.line(c.span());
-        let (from, to, gain, offset, convert) = match c.into_inner() {
+        let (from, to, gain, offset, flags) = match c.into_inner() {
             RawConnection::Short(s) => match short_connection(&s) {
                 Ok(c) => c,
                 Err(m) => {
@@ -302,7 +320,13 @@ impl Reader<'_> {
                     return None;
                 }
             },
-            RawConnection::Full(f) => (f.from, f.to, f.gain, f.offset, f.convert),
+            RawConnection::Full(f) => {
+                let flags = Flags {
+                    convert: f.convert,
+                    sum: f.sum,
+                };
+                (f.from, f.to, f.gain, f.offset, flags)
+            }
         };
         let (Some(f), Some(t)) = (VarRef::parse(&from), VarRef::parse(&to)) else {
             self.error(
@@ -320,7 +344,8 @@ impl Reader<'_> {
             offset: offset.unwrap_or(0.0),
             line,
             either_direction: false,
-            convert,
+            convert: flags.convert,
+            sum: flags.sum,
         })
     }
 
@@ -382,20 +407,36 @@ impl Reader<'_> {
     }
 }
 
-/// A connection's (from, to, gain, offset, convert).
-type Link = (String, String, Option<f64>, Option<f64>, bool);
+/// A connection's boolean keys.
+#[derive(Default)]
+struct Flags {
+    convert: bool,
+    sum: bool,
+}
+
+/// A connection's (from, to, gain, offset, flags).
+type Link = (String, String, Option<f64>, Option<f64>, Flags);
+
+/// A boolean key of the string form: `key` alone or `key = true` is true, `key = false` false.
+fn flag(key: &str, value: Option<&str>, part: &str) -> std::result::Result<bool, String> {
+    match value {
+        None | Some("true") => Ok(true),
+        Some("false") => Ok(false),
+        Some(_) => Err(format!("'{}': {key} is true or false", part.trim())),
+    }
+}
 
 /// The string form of a connection: `"from -> to"`, then optionally, comma-separated, the keys
-/// of the table form: `gain = G`, `offset = O` and `convert` (or `convert = true`), e.g.
-/// `"ap.rudder_command -> gear.rudder_command, gain = 2.5, offset = 0.1"`.
+/// of the table form: `gain = G`, `offset = O`, `convert` (or `convert = true`) and `sum` (or
+/// `sum = true`), e.g. `"ap.rudder_command -> gear.rudder_command, gain = 2.5, offset = 0.1"`.
 fn short_connection(s: &str) -> std::result::Result<Link, String> {
-    const FORM: &str = "it must read \"instance.output -> instance.input\", optionally followed by \", gain = G\", \", offset = O\" and \", convert\"";
+    const FORM: &str = "it must read \"instance.output -> instance.input\", optionally followed by \", gain = G\", \", offset = O\", \", convert\" and \", sum\"";
     let mut parts = s.split(',');
     let ends = parts.next().unwrap_or_default();
     let Some((from, to)) = ends.split_once("->") else {
         return Err(FORM.into());
     };
-    let (mut gain, mut offset, mut convert) = (None, None, None);
+    let (mut gain, mut offset, mut convert, mut sum) = (None, None, None, None);
     for part in parts {
         let (key, value) = match part.split_once('=') {
             Some((k, v)) => (k.trim(), Some(v.trim())),
@@ -411,17 +452,11 @@ fn short_connection(s: &str) -> std::result::Result<Link, String> {
         let slot_taken = match key {
             "gain" => gain.replace(number(value)?).is_some(),
             "offset" => offset.replace(number(value)?).is_some(),
-            "convert" => {
-                let v = match value {
-                    None | Some("true") => true,
-                    Some("false") => false,
-                    Some(_) => return Err(format!("'{}': convert is true or false", part.trim())),
-                };
-                convert.replace(v).is_some()
-            }
+            "convert" => convert.replace(flag(key, value, part)?).is_some(),
+            "sum" => sum.replace(flag(key, value, part)?).is_some(),
             _ => {
                 return Err(format!(
-                    "unknown key '{key}' (expected gain, offset or convert); {FORM}"
+                    "unknown key '{key}' (expected gain, offset, convert or sum); {FORM}"
                 ))
             }
         };
@@ -434,7 +469,10 @@ fn short_connection(s: &str) -> std::result::Result<Link, String> {
         to.trim().to_string(),
         gain,
         offset,
-        convert.unwrap_or(false),
+        Flags {
+            convert: convert.unwrap_or(false),
+            sum: sum.unwrap_or(false),
+        },
     ))
 }
 

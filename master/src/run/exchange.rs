@@ -9,6 +9,15 @@
 //!
 //! The three FMI types the exchange moves (Real, Integer, Boolean; Enumeration travels as
 //! Integer) are one generic [`Port`] over a [`Kind`].
+//!
+//! A summed input ([`PlanConnection::sum`](crate::system::PlanConnection)) gets its first
+//! connection's term in the gather and every further term added after it, one at a time in
+//! plan order: ((t0 + t1) + t2) + ..., each term `gain*from + offset`, starting from t0 itself
+//! (not from 0.0, which would turn a sole -0.0 into +0.0). This is the order of libcosim's
+//! `vector_sum_function::calculate` (`include/cosim/function/vector_sum.hpp`: the output is
+//! assigned `in[0]`, then `in[1]`, `in[2]`, ... are added in index order), which runs OSP's
+//! `Sum` and `VectorSum` functions; floating-point addition is not associative, so any other
+//! order (a tree, a Kahan sum, a sum from 0.0) differs in the last bits for three or more terms.
 
 use crate::error::Result;
 use crate::fmu::VR;
@@ -35,6 +44,9 @@ pub trait Kind {
     fn values(v: &Values) -> &[Self::Value];
     fn values_mut(v: &mut Values) -> &mut [Self::Value];
     fn map(value: Self::Value, map: Self::Map) -> Self::Value;
+    /// Adds a further term to a summed input (validation admits sums of Real inputs only;
+    /// Integer wraps and Boolean is a logical or, so that the operation is defined for each).
+    fn add(sum: Self::Value, term: Self::Value) -> Self::Value;
     fn set<S>(inst: &mut Instance<S>, vrs: &[VR], values: &[Self::Value]) -> Result<()>;
     fn get<S: Readable>(inst: &mut Instance<S>, vrs: &[VR], out: &mut [Self::Value]) -> Result<()>;
 }
@@ -67,6 +79,10 @@ impl Kind for Real {
         m.gain * value + m.offset
     }
     #[inline]
+    fn add(sum: f64, term: f64) -> f64 {
+        sum + term
+    }
+    #[inline]
     fn set<S>(inst: &mut Instance<S>, vrs: &[VR], values: &[f64]) -> Result<()> {
         inst.set_real(vrs, values)
     }
@@ -88,6 +104,10 @@ impl Kind for Integer {
     #[inline]
     fn map(value: i32, _: ()) -> i32 {
         value
+    }
+    #[inline]
+    fn add(sum: i32, term: i32) -> i32 {
+        sum.wrapping_add(term)
     }
     #[inline]
     fn set<S>(inst: &mut Instance<S>, vrs: &[VR], values: &[i32]) -> Result<()> {
@@ -113,6 +133,10 @@ impl Kind for Boolean {
         value
     }
     #[inline]
+    fn add(sum: i32, term: i32) -> i32 {
+        i32::from(sum != 0 || term != 0)
+    }
+    #[inline]
     fn set<S>(inst: &mut Instance<S>, vrs: &[VR], values: &[i32]) -> Result<()> {
         inst.set_boolean(vrs, values)
     }
@@ -128,6 +152,12 @@ struct Link<K: Kind> {
     map: K::Map,
 }
 
+/// A further term of a summed input: added to the port's input `input` after its first term.
+struct Term<K: Kind> {
+    input: usize,
+    link: Link<K>,
+}
+
 /// Observed variables of one instance and type (connection sources and recorded outputs), in
 /// the order of the batched fmi2GetXxx, stored at `Values[at..at + vrs.len()]`.
 #[derive(Default)]
@@ -141,6 +171,8 @@ pub struct Port<K: Kind> {
     /// Connected inputs, in the order of the batched fmi2SetXxx.
     input_vrs: Vec<VR>,
     links: Vec<Link<K>>,
+    /// The second and further terms of summed inputs, in plan order (empty without sums).
+    terms: Vec<Term<K>>,
     scratch: Vec<K::Value>,
     observed: Observed,
 }
@@ -150,6 +182,7 @@ impl<K: Kind> Default for Port<K> {
         Port {
             input_vrs: Vec::new(),
             links: Vec::new(),
+            terms: Vec::new(),
             scratch: Vec::new(),
             observed: Observed::default(),
         }
@@ -162,10 +195,23 @@ impl<K: Kind> Port<K> {
         self.input_vrs.is_empty() && self.observed.vrs.is_empty()
     }
 
-    fn connect(&mut self, vr: VR, source: usize, map: K::Map) {
+    /// Connects input `vr` (its first or only term); returns its index among the inputs.
+    fn connect(&mut self, vr: VR, source: usize, map: K::Map) -> usize {
         self.input_vrs.push(vr);
         self.links.push(Link { source, map });
         self.scratch.push(K::Value::default());
+        self.input_vrs.len() - 1
+    }
+
+    /// Connects input `vr`, or adds a further term to the summed input `first` (after the
+    /// terms it has); returns the input's index.
+    fn connect_term(&mut self, first: Option<usize>, vr: VR, source: usize, map: K::Map) -> usize {
+        let Some(input) = first else {
+            return self.connect(vr, source, map);
+        };
+        let link = Link { source, map };
+        self.terms.push(Term { input, link });
+        input
     }
 
     /// Gathers the connected inputs into the scratch buffer and writes them with one batched
@@ -176,6 +222,10 @@ impl<K: Kind> Port<K> {
         let shared = K::values(values);
         for (x, l) in self.scratch.iter_mut().zip(&self.links) {
             *x = K::map(shared[l.source], l.map);
+        }
+        for t in &self.terms {
+            let x = &mut self.scratch[t.input];
+            *x = K::add(*x, K::map(shared[t.link.source], t.link.map));
         }
         K::set(inst, &self.input_vrs, &self.scratch)
     }
@@ -308,19 +358,26 @@ impl Exchange {
                 }
             })
             .collect();
+        // (instance, type, vr) of a summed input -> its index among the port's inputs
+        let mut summed: HashMap<(usize, VarType, VR), usize> = HashMap::new();
         for (c, g) in plan.connections.iter().zip(links) {
             let p = &mut ports[c.to_instance];
-            match kind_of(c.var_type) {
-                VarType::Real => p.real.connect(
-                    c.to_vr,
-                    g,
-                    Linear {
+            let t = kind_of(c.var_type);
+            let key = (c.to_instance, t, c.to_vr);
+            let first = summed.get(&key).copied();
+            let input = match t {
+                VarType::Real => {
+                    let map = Linear {
                         gain: c.gain,
                         offset: c.offset,
-                    },
-                ),
-                VarType::Boolean => p.boolean.connect(c.to_vr, g, ()),
-                _ => p.integer.connect(c.to_vr, g, ()),
+                    };
+                    p.real.connect_term(first, c.to_vr, g, map)
+                }
+                VarType::Boolean => p.boolean.connect_term(first, c.to_vr, g, ()),
+                _ => p.integer.connect_term(first, c.to_vr, g, ()),
+            };
+            if c.sum {
+                summed.insert(key, input);
             }
         }
         for p in ports.iter_mut() {

@@ -119,6 +119,11 @@ pub struct ConnectionSpec {
     /// The gain converts between physically different quantities (e.g. a wave moment in N.m
     /// into a rudder-equivalent disturbance in rad): the unit check is skipped for it.
     pub convert: bool,
+    /// A term of a summed input: every connection into the input says so, and the input gets
+    /// the sum of their `gain*from + offset`, added in the order of [`System::connections`]
+    /// (TOML `sum = true`; an OSP `Sum` function's inputs `in[0]`, `in[1]`, ...). Without it a
+    /// second connection into an input is an error.
+    pub sum: bool,
 }
 
 #[derive(Debug, Clone)]

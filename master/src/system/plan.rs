@@ -34,6 +34,9 @@ pub struct PlanConnection {
     pub gain: f64,
     pub offset: f64,
     pub name: String,
+    /// A term of a summed input ([`ConnectionSpec::sum`](super::ConnectionSpec::sum)): the
+    /// input gets the sum of its connections' terms, added in plan order.
+    pub sum: bool,
 }
 
 #[derive(Debug, Clone)]

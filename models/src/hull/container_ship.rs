@@ -579,6 +579,12 @@ impl LinearContainerShip {
         &self.state
     }
 
+    /// Sets the state `[v, r, x, y, ψ, p, φ, δ]` (u stays U₀), e.g. to start an FMU from a given
+    /// state.
+    pub fn set_motion(&mut self, motion: [f64; 8]) {
+        self.state[1..].copy_from_slice(&motion);
+    }
+
     /// Time [s] advanced.
     pub fn time(&self) -> f64 {
         self.time

@@ -42,6 +42,48 @@ pub fn wrap_pi(a: f64) -> f64 {
     w
 }
 
+/// Checks the named values of an initial state: each is finite, and each name listed in
+/// `angles_within_half_pi` (a roll angle) lies in (−π/2, π/2), where a hull's small-angle or
+/// restoring model still means something (capsized is outside every model here).
+pub fn check_initial_state(
+    values: &[(&str, f64)],
+    angles_within_half_pi: &[&str],
+) -> Result<(), crate::error::ParamError> {
+    for &(name, v) in values {
+        crate::error::check_finite(name, v)?;
+        if angles_within_half_pi.contains(&name) {
+            crate::error::require(
+                v.abs() < std::f64::consts::FRAC_PI_2,
+                name,
+                v,
+                "must lie in (-pi/2, pi/2)",
+            )?;
+        }
+    }
+    Ok(())
+}
+
+/// The value of a parameter that the named preset `preset` sets to `ours`: `ours`, when the
+/// parameter is still at its `default` or already equals `ours`; a parameter set to anything
+/// else conflicts with the preset and is refused (whatever the order of the sets), as the
+/// heading autopilot's `preset` does.
+pub fn preset_value(
+    preset: i32,
+    name: &str,
+    value: f64,
+    default: f64,
+    ours: f64,
+) -> Result<f64, String> {
+    if value == default || value == ours {
+        Ok(ours)
+    } else {
+        Err(format!(
+            "preset = {preset} sets {name} = {ours}, but {name} was set to {value}: set preset = 0 \
+             to give the parameters one by one"
+        ))
+    }
+}
+
 /// First-order rudder servo of the MSS ships (MSS `container.m`, also used by `mariner.m` and
 /// `Lcontainer.m`): the command is saturated to ±`max`, the rate
 /// is `(δ_c,sat − δ)/1 s` clipped to ±`rate_max`. There is no separate limit on the state.
@@ -54,6 +96,28 @@ pub(crate) fn mss_rudder_rate(command: f64, delta: f64, max: f64, rate_max: f64)
 #[cfg(test)]
 mod tests {
     use super::*;
+    #[test]
+    fn initial_state_checks() {
+        assert!(check_initial_state(&[("x", 1e6), ("roll", 1.5)], &["roll"]).is_ok());
+        let e = check_initial_state(&[("x", f64::NAN)], &[]).unwrap_err();
+        assert!(e.to_string().contains("x = NaN"), "{e}");
+        let e = check_initial_state(&[("roll", 1.6)], &["roll"]).unwrap_err();
+        assert!(e.to_string().contains("roll = 1.6"), "{e}");
+        assert!(check_initial_state(&[("heading", 100.0)], &["roll"]).is_ok());
+    }
+
+    #[test]
+    fn preset_values_and_conflicts() {
+        assert_eq!(preset_value(2, "a", 1.0, 1.0, 3.0), Ok(3.0));
+        assert_eq!(preset_value(2, "a", 3.0, 1.0, 3.0), Ok(3.0));
+        let e = preset_value(2, "a", 2.0, 1.0, 3.0).unwrap_err();
+        assert!(
+            e.contains("preset = 2 sets a = 3, but a was set to 2"),
+            "{e}"
+        );
+        assert!(preset_value(2, "a", f64::NAN, 1.0, 3.0).is_err());
+    }
+
     #[test]
     fn wrap() {
         assert!((wrap_pi(3.0 * std::f64::consts::PI) - std::f64::consts::PI).abs() < 1e-12);

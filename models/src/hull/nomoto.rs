@@ -183,6 +183,26 @@ impl NomotoShip {
             .expect("valid preset")
     }
 
+    /// The first-order Nomoto model of the Son & Nomoto container ship at `speed` [m/s]: K′ and
+    /// T′ of its linearised model (MSS `Lcontainer.m`, roll coupling included) by the low-frequency
+    /// match of [`crate::controllers::loop_shaped::presets`] (K′ = 2.920998, T′ = 4.359567, the
+    /// same in t′ at every speed), L = 175 m. The plant the heading autopilot's container-ship
+    /// preset is designed on.
+    pub fn container_ship(speed: f64) -> Result<Self, ParamError> {
+        use crate::controllers::loop_shaped::presets::{
+            container_ship_yaw_rate, nomoto_first_order,
+        };
+        check_positive("speed", speed)?;
+        let (k, t) = container_ship_yaw_rate(speed)
+            .and_then(|g| nomoto_first_order(&g))
+            .map_err(|_| ParamError::new("speed", speed, "gives no Nomoto model"))?;
+        Self::new(
+            NomotoModel::FirstOrder { t, k },
+            super::container_ship::L,
+            speed,
+        )
+    }
+
     /// State `[v′, r′, ψ, x, y]`.
     pub fn state(&self) -> &[f64; 5] {
         &self.state
@@ -193,6 +213,11 @@ impl NomotoShip {
         self.state[0] = v_prime;
         self.state[1] = r_prime;
         self.state[2] = heading;
+    }
+
+    /// Sets the motion (v′, r′, ψ) and the position (x, y) [m].
+    pub fn set_state(&mut self, state: [f64; 5]) {
+        self.state = state;
     }
 
     pub fn time(&self) -> f64 {

@@ -437,6 +437,15 @@ impl RrsShip {
         self.time
     }
 
+    /// Sets the motion state `[φ, p, v, r, ψ]` and the position `[x, y]`, the wave-filter states
+    /// to 0: the start of a run from a given state (the states of [Klugt1987, eqs. (2.16)-(2.18)]
+    /// and [Klugt1987, eq. (3.29)]; the caller checks the values).
+    pub fn set_motion(&mut self, motion: [f64; 5], position: [f64; 2]) {
+        self.state = [0.0; NX + 2];
+        self.state[..5].copy_from_slice(&motion);
+        self.state[NX..].copy_from_slice(&position);
+    }
+
     /// Hull coefficients at speed `u` (ignored by the simulation model).
     pub fn coefficients(&self, u: f64) -> RrsHullCoefficients {
         match &self.variant {

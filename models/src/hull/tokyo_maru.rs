@@ -331,6 +331,12 @@ impl TokyoMaru {
         self.state = [x[0], x[1], x[2], x[3], x[4], 0.0];
     }
 
+    /// Sets the full nondimensional state `[ψ′, r′, β′_e, η′, δ′, ξ′]` (the x of
+    /// [Parsons1980, eq. (11)] plus the along-track ξ′), e.g. to start an FMU from a given state.
+    pub fn set_full_state_prime(&mut self, x: [f64; 6]) {
+        self.state = x;
+    }
+
     /// State `[ψ′, r′, β′_e, η′, δ′, ξ′]`.
     pub fn state(&self) -> &[f64; 6] {
         &self.state

@@ -18,11 +18,13 @@
 //!
 //! Nothing in a loop's macro step allocates (`tests/tests/model_loop_no_alloc.rs`).
 //!
-//! Loops: [`rrs`] runs `systems/rrs.toml`.
+//! Loops: [`rrs`] runs `systems/rrs.toml`; [`container_ship`] runs
+//! `systems/container_ship_seaway_autopilot.toml` (summed inputs).
 
 // `k % m == 0` reads as the master's rate rule (`Slot::steps_at`).
 #![allow(unknown_lints, clippy::manual_is_multiple_of)]
 
+pub mod container_ship;
 pub mod rrs;
 
 use shipsim::run::recorder::write_real;

@@ -8,6 +8,7 @@ use crate::study::{Env, Report};
 
 pub mod autopilot;
 pub mod autopilot_robustness;
+pub mod container_ship_seaway;
 pub mod dgps_trial;
 pub mod dp_observer;
 mod path_common;
@@ -28,6 +29,7 @@ pub const STUDIES: &[Study] = &[
     ("path_control", path_control::run),
     ("autopilot", autopilot::run),
     ("path_estimation", path_estimation::run),
+    ("container_ship_seaway", container_ship_seaway::run),
 ];
 
 /// Studies in the report only (`cargo xtask report`): campaigns too long for the test suite,

@@ -1,16 +1,20 @@
 //! Connections: both ends exist, an output drives an input, the types agree, gain and offset
-//! only on Real, the units are compatible (FMI 2.0 section 2.2.2), no input is driven twice;
-//! and the inputs no connection drives.
+//! only on Real, the units are compatible (FMI 2.0 section 2.2.2), no input is driven twice
+//! unless every connection into it is a term of a sum (`sum = true`, Real only); and the
+//! inputs no connection drives.
 
 use super::Checker;
 use crate::error::Error;
 use crate::model_description::{Causality, ModelDescription, ScalarVariable, VarType};
 use crate::system::{ConnectionSpec, PlanConnection};
 use std::borrow::Cow;
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 
 /// Inputs driven by a connection: (instance, variable index) -> (connection name, line).
 pub(super) type Driven = HashMap<(usize, usize), (String, Option<usize>)>;
+
+/// Inputs whose first connection is a term of a sum (`sum = true`).
+type Summed = HashSet<(usize, usize)>;
 
 /// A connection with both ends resolved, in output -> input direction.
 struct Ends<'c> {
@@ -43,6 +47,7 @@ impl<'a> Checker<'a> {
     pub(super) fn connections(&mut self) -> (Vec<PlanConnection>, Driven) {
         let mut connections = Vec::new();
         let mut driven = Driven::new();
+        let mut summed = Summed::new();
         for spec in &self.sys.connections {
             let Some(ends) = self.resolve_ends(spec) else {
                 continue;
@@ -50,7 +55,7 @@ impl<'a> Checker<'a> {
             let mut ok = self.check_causality(&ends);
             ok &= self.check_types(&ends);
             ok &= self.check_units(&ends);
-            ok &= self.check_driven_once(&ends, &mut driven);
+            ok &= self.check_driven_once(&ends, &mut driven, &mut summed);
             if ok {
                 connections.push(self.plan_connection(ends));
             }
@@ -131,6 +136,15 @@ impl<'a> Checker<'a> {
             errors.push(self.err(
                 line,
                 format!("connection {name}: String connections are not supported"),
+            ));
+        }
+        if ft != VarType::Real && spec.sum {
+            errors.push(self.err(
+                line,
+                format!(
+                    "connection {name}: sum = true adds Real inputs only ('{}' is {ft})",
+                    spec.to
+                ),
             ));
         }
         if ft != VarType::Real && (spec.gain != 1.0 || spec.offset != 0.0) {
@@ -231,24 +245,36 @@ impl<'a> Checker<'a> {
         }
     }
 
-    /// An input is driven by one connection at most.
-    fn check_driven_once(&mut self, c: &Ends, driven: &mut Driven) -> bool {
-        if let Some((prev, pline)) = driven.get(&c.to) {
-            let e = self.err(
-                c.spec.line,
-                format!(
-                    "input '{}' is driven twice: by {} and by {prev}{}",
-                    c.spec.to,
-                    c.name,
-                    pline.map(|l| format!(" (line {l})")).unwrap_or_default()
-                ),
-            );
-            self.errors.push(e);
-            false
-        } else {
+    /// An input is driven by one connection at most, unless every connection into it is a
+    /// term of a sum (`sum = true`): then it is driven by their sum.
+    fn check_driven_once(&mut self, c: &Ends, driven: &mut Driven, summed: &mut Summed) -> bool {
+        let Some((prev, pline)) = driven.get(&c.to) else {
             driven.insert(c.to, (c.name.clone(), c.spec.line));
-            true
+            if c.spec.sum {
+                summed.insert(c.to);
+            }
+            return true;
+        };
+        if c.spec.sum && summed.contains(&c.to) {
+            return true;
         }
+        let at = |l: Option<usize>| l.map(|l| format!(" (line {l})")).unwrap_or_default();
+        let hint = if crate::format::osp::is_osp(self.sys) {
+            "; to add them, connect them through a Sum function"
+        } else {
+            "; to add them, set sum = true on every connection into it"
+        };
+        let e = self.err(
+            c.spec.line,
+            format!(
+                "input '{}' is driven twice: by {} and by {prev}{}{hint}",
+                c.spec.to,
+                c.name,
+                at(*pline)
+            ),
+        );
+        self.errors.push(e);
+        false
     }
 
     fn plan_connection(&self, c: Ends) -> PlanConnection {
@@ -265,6 +291,7 @@ impl<'a> Checker<'a> {
             },
             gain: c.spec.gain,
             offset: c.spec.offset,
+            sum: c.spec.sum,
             name: c.name,
         }
     }
