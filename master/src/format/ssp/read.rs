@@ -178,9 +178,8 @@ impl Reader<'_> {
             connections,
             events: Vec::new(),
             output: OutputSpec {
-                file: None,
-                variables: None,
                 decimation: 1,
+                ..OutputSpec::default()
             },
             strict_units: true,
             last_step: Default::default(),
