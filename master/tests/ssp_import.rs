@@ -11,10 +11,37 @@
 //! Then one test per refusal and malformed file: each error names the file, line and element.
 mod common;
 use common::{read_csv, zip_files};
-use shipsim::run::{run_system, Output, RunOptions};
+use shipsim::run::{load_fmus, run as run_plan, run_system, Output, RunOptions};
 use shipsim::system::System;
+use std::alloc::{GlobalAlloc, Layout, System as SysAlloc};
+use std::cell::Cell;
 use std::path::{Path, PathBuf};
 use std::process::Command;
+
+/// Counts the heap allocations of the current thread (the tests run in parallel threads; a run
+/// is single-threaded).
+struct Counting;
+thread_local! {
+    static ALLOCS: Cell<usize> = const { Cell::new(0) };
+}
+fn count() -> usize {
+    ALLOCS.with(Cell::get)
+}
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, l: Layout) -> *mut u8 {
+        let _ = ALLOCS.try_with(|c| c.set(c.get() + 1));
+        SysAlloc.alloc(l)
+    }
+    unsafe fn dealloc(&self, p: *mut u8, l: Layout) {
+        SysAlloc.dealloc(p, l)
+    }
+    unsafe fn realloc(&self, p: *mut u8, l: Layout, n: usize) -> *mut u8 {
+        let _ = ALLOCS.try_with(|c| c.set(c.get() + 1));
+        SysAlloc.realloc(p, l, n)
+    }
+}
+#[global_allocator]
+static A: Counting = Counting;
 
 fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
@@ -446,4 +473,70 @@ fn a_broken_archive_is_named() {
     zip_files(&empty, &[("readme.txt", b"x".to_vec())]);
     let e = System::load(&empty).unwrap_err().to_string();
     has(&e, &["empty.ssp", "no SystemStructure.ssd"]);
+}
+
+#[test]
+fn the_value_mappings_allocate_nothing_in_the_step_loop() {
+    let d = case("mapping");
+    let mut sys = System::load(&d.path().join("SystemStructure.ssd")).unwrap();
+    let fmus = load_fmus(&sys).unwrap();
+    let mds: Vec<_> = fmus.iter().map(|f| &f.model_description).collect();
+    let mut counts = Vec::new();
+    for stop in [1.0, 100.0] {
+        sys.stop_time = Some(stop);
+        let plan = sys.validate(&mds).unwrap();
+        assert!(plan.connections.iter().all(|c| c.mapping.is_some()));
+        let before = count();
+        let s = run_plan(
+            &plan,
+            &fmus,
+            Output::Writer(Box::new(std::io::sink())),
+            &RunOptions::default(),
+        )
+        .unwrap();
+        counts.push(count() - before);
+        assert_eq!(s.macro_steps, (stop / H) as u64);
+    }
+    assert_eq!(counts[0], counts[1], "allocations for 16 vs 1600 steps");
+}
+
+#[test]
+fn a_value_mapping_on_a_real_connection_is_refused() {
+    let d = case("linear");
+    let p = d.path().join("SystemStructure.ssd");
+    let t = std::fs::read_to_string(&p).unwrap().replace(
+        "<ssc:LinearTransformation factor=\"2.5\" offset=\"-1\"/>",
+        "<ssc:IntegerMappingTransformation><ssc:MapEntry source=\"1\" target=\"2\"/></ssc:IntegerMappingTransformation>",
+    );
+    std::fs::write(&p, t).unwrap();
+    let sys = System::load(&p).unwrap();
+    let fmus = sys.unpack_fmus().unwrap();
+    let mds: Vec<_> = fmus.iter().map(|f| &f.model_description).collect();
+    let e = sys.validate(&mds).unwrap_err().to_string();
+    has(
+        &e,
+        &[
+            "SystemStructure.ssd:",
+            "A.real_continuous_output -> B.real_continuous_input",
+            "the value mapping does not apply",
+            "Real",
+        ],
+    );
+}
+
+#[test]
+fn a_missing_stop_time_asks_for_one() {
+    let d = case("linear");
+    let p = d.path().join("SystemStructure.ssd");
+    let t = std::fs::read_to_string(&p)
+        .unwrap()
+        .replace(" stopTime=\"1\"", "");
+    std::fs::write(&p, t).unwrap();
+    let mut sys = System::load(&p).unwrap();
+    let e = shipsim::format::osp::require_end_time(&sys)
+        .unwrap_err()
+        .to_string();
+    has(&e, &["SystemStructure.ssd", "stopTime", "--stop-time"]);
+    sys.stop_time = Some(0.5);
+    shipsim::format::osp::require_end_time(&sys).unwrap();
 }

@@ -218,6 +218,7 @@ pub fn is_osp(sys: &System) -> bool {
 /// since (`shipsim run --stop-time`) is an error naming the file, instead of the one-second run
 /// that the validation's default stop time (start + 1 s) would give. Other systems pass.
 pub fn require_end_time(sys: &System) -> Result<()> {
+    super::ssp::require_stop_time(sys)?;
     if is_osp(sys) && sys.stop_time.is_none() {
         return Err(Error::system(
             &sys.source,

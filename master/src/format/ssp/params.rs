@@ -34,8 +34,8 @@ enum PValue {
     Integer(i64),
     Boolean(bool),
     String(String),
-    /// Item name and, when resolved through an `Enumeration`, its value.
-    Enumeration(String, Option<i32>),
+    /// Item name and the items of its `Enumeration` (when the parameter names one).
+    Enumeration(String, Option<Vec<(String, i32)>>),
 }
 
 #[derive(Debug, Clone)]
@@ -229,14 +229,10 @@ fn parameter_value(
         "Integer" => PValue::Integer(text.trim().parse::<i32>().map_err(|_| bad())? as i64),
         "Boolean" => PValue::Boolean(parse_bool(text).ok_or_else(bad)? == 1),
         "String" => PValue::String(text.to_string()),
-        "Enumeration" => {
-            let value = v
-                .attr("name")
-                .and_then(|e| enums.get(e))
-                .and_then(|items| items.iter().find(|(n, _)| n == text))
-                .map(|(_, x)| *x);
-            PValue::Enumeration(text.to_string(), value)
-        }
+        "Enumeration" => PValue::Enumeration(
+            text.to_string(),
+            v.attr("name").and_then(|e| enums.get(e)).cloned(),
+        ),
         other => return Err(format!("<{other}> values are not supported")),
     })
 }
@@ -313,9 +309,9 @@ fn transform(v: &PValue, t: &Element) -> Result<PValue, String> {
                 .and_then(|(_, t)| parse_bool(t?))
                 .map_or(*x, |t| t == 1),
         )),
-        ("EnumerationMappingTransformation", PValue::Enumeration(x, _)) => {
+        ("EnumerationMappingTransformation", PValue::Enumeration(x, items)) => {
             match entries().find(|(s, _)| *s == Some(x.as_str())) {
-                Some((_, Some(t))) => Ok(PValue::Enumeration(t.to_string(), None)),
+                Some((_, Some(t))) => Ok(PValue::Enumeration(t.to_string(), items.clone())),
                 _ => Ok(v.clone()),
             }
         }
@@ -417,12 +413,16 @@ fn value(r: &mut Reader, i: usize, variable: &str, p: &Param, file: &PathBuf) ->
         PValue::Integer(x) => Value::Integer(*x),
         PValue::Boolean(x) => Value::Boolean(*x),
         PValue::String(s) => Value::String(s.clone()),
-        PValue::Enumeration(_, Some(v)) => Value::Integer(i64::from(*v)),
-        PValue::Enumeration(item, None) => {
-            return fail(
+        PValue::Enumeration(item, items) => match items
+            .iter()
+            .flatten()
+            .find(|(n, _)| n == item)
+        {
+            Some((_, v)) => Value::Integer(i64::from(*v)),
+            None => return fail(
                 r,
                 format!("enumeration item \"{item}\" is not an item of an <Enumeration> of the SSV or SSD (give its name attribute)"),
-            )
-        }
+            ),
+        },
     })
 }
