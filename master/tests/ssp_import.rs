@@ -540,3 +540,42 @@ fn a_missing_stop_time_asks_for_one() {
     sys.stop_time = Some(0.5);
     shipsim::format::osp::require_end_time(&sys).unwrap();
 }
+
+#[test]
+fn a_system_binding_with_a_prefix_and_a_mapping_of_prefixed_names() {
+    let d = case("params");
+    let p = d.path().join("SystemStructure.ssd");
+    let text = std::fs::read_to_string(&p).unwrap();
+    // B's own binding moves to the root system, with prefix "B." (SSP 1.0: the prefix is
+    // prepended before the mapping, so the mapping names "B.slope").
+    let own = "          <ssd:ParameterBinding source=\"gains.ssv\">\n            <ssd:ParameterMapping source=\"gains.ssm\"/>\n          </ssd:ParameterBinding>\n";
+    assert!(text.contains(own));
+    let text = text.replace(own, "").replacen(
+        "<ssd:System name=\"root\">\n",
+        "<ssd:System name=\"root\">\n    <ssd:ParameterBindings>\n      <ssd:ParameterBinding source=\"gains.ssv\" prefix=\"B.\">\n        <ssd:ParameterMapping source=\"prefixed.ssm\"/>\n      </ssd:ParameterBinding>\n    </ssd:ParameterBindings>\n",
+        1,
+    );
+    std::fs::write(&p, text).unwrap();
+    let ssm = std::fs::read_to_string(d.path().join("gains.ssm"))
+        .unwrap()
+        .replace(
+            "source=\"slope\" target=\"",
+            "source=\"B.slope\" target=\"B.",
+        )
+        .replace(
+            "source=\"offset\" target=\"",
+            "source=\"B.offset\" target=\"B.",
+        );
+    std::fs::write(d.path().join("prefixed.ssm"), ssm).unwrap();
+    let t = run(&p);
+    close(
+        &column(&t, "B.real_continuous_output"),
+        |n| 1.5 * n as f64 * H,
+        "B",
+    );
+    close(
+        &column(&t, "B.integer_output"),
+        |n| -4.0 + n as f64,
+        "B int",
+    );
+}

@@ -204,11 +204,11 @@ impl Reader<'_> {
         crate::units::declared(md, name).ok()
     }
 
-    /// The model description of instance `i` (read once, when a unit is needed).
+    /// The model description of instance `i` (each FMU read once, when a unit is needed).
     pub(super) fn model_description(&mut self, i: usize) -> Option<&ModelDescription> {
         let fmu = &self.instances[i].fmu;
         self.mds
-            .entry(i)
+            .entry(fmu.clone())
             .or_insert_with(|| {
                 crate::fmu::UnpackedFmu::open(fmu)
                     .ok()

@@ -124,16 +124,17 @@ fn binding(r: &mut Reader, b: &Element, target: Target) -> Option<Binding> {
         }
     };
     let mut params = parameter_set(r, &set, &file, inline)?;
+    // the prefix comes first: mapping entries name the prefixed parameters
+    let prefix = b.attr("prefix").unwrap_or("");
+    for p in &mut params {
+        p.name = format!("{prefix}{}", p.name);
+    }
     if let Some(m) = b.child("ParameterMapping") {
         let mapping = match m.attr("source") {
             Some(uri) => referenced(r, uri, m.line, "<ParameterMapping>")?,
             None => (m.child("ParameterMapping")?.clone(), r.shown.clone()),
         };
         params = map_parameters(r, params, &mapping.0, &mapping.1)?;
-    }
-    let prefix = b.attr("prefix").unwrap_or("");
-    for p in &mut params {
-        p.name = format!("{prefix}{}", p.name);
     }
     Some(Binding {
         target,

@@ -71,8 +71,8 @@ pub(super) struct Reader<'a> {
     pub instances: Vec<InstanceSpec>,
     pub connectors: HashMap<Port, Connector>,
     pub edges: Vec<Edge>,
-    /// Model descriptions, read when a unit is needed.
-    pub mds: HashMap<usize, Option<ModelDescription>>,
+    /// Model descriptions by FMU file, read when a unit is needed.
+    pub mds: HashMap<PathBuf, Option<ModelDescription>>,
     pub step_hints: Vec<Option<f64>>,
     /// System paths ("" is the root).
     pub systems: std::collections::HashSet<String>,
