@@ -197,17 +197,18 @@ fn parameter_sets_in_ssv_files_with_an_ssm_mapping() {
         "A",
     );
     close(&column(&t, "A.integer_output"), |n| 7.0 + n as f64, "A int");
-    // gains.ssm: slope 0.75 -> real_tunable_parameter, times 2; offset -> integer_input
+    b_from_gains(&t);
+}
+
+/// B's parameters from gains.ssv through the mapping: slope 0.75 -> real_tunable_parameter,
+/// times 2; offset -4 -> integer_input.
+fn b_from_gains(t: &Table) {
     close(
-        &column(&t, "B.real_continuous_output"),
+        &column(t, "B.real_continuous_output"),
         |n| 1.5 * n as f64 * H,
         "B",
     );
-    close(
-        &column(&t, "B.integer_output"),
-        |n| -4.0 + n as f64,
-        "B int",
-    );
+    close(&column(t, "B.integer_output"), |n| -4.0 + n as f64, "B int");
 }
 
 #[test]
@@ -568,14 +569,5 @@ fn a_system_binding_with_a_prefix_and_a_mapping_of_prefixed_names() {
         );
     std::fs::write(d.path().join("prefixed.ssm"), ssm).unwrap();
     let t = run(&p);
-    close(
-        &column(&t, "B.real_continuous_output"),
-        |n| 1.5 * n as f64 * H,
-        "B",
-    );
-    close(
-        &column(&t, "B.integer_output"),
-        |n| -4.0 + n as f64,
-        "B int",
-    );
+    b_from_gains(&t);
 }
