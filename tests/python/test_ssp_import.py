@@ -159,3 +159,18 @@ def test_errors_name_file_and_element(feedthrough, tmp_path):
     r = subprocess.run([BIN, "check", str(ssd)], capture_output=True, text=True)
     assert r.returncode != 0
     assert "SystemStructure.ssd:" in r.stderr and 'endConnector "nope"' in r.stderr, r.stderr
+
+
+def test_python_system_load_reads_an_ssp(feedthrough, tmp_path):
+    """The Python package's System.load (through the library's System::load) on an .ssp: the same
+    columns, bit for bit, as the CLI. Needs the shipsim package built from this tree."""
+    import shipsim as package
+
+    d = case("nested", feedthrough, tmp_path)
+    ssp = pack(d)
+    cli = shipsim(ssp)
+    system = package.System.load(ssp)
+    assert "outer/inner/B" in system.instances
+    got = system.run(as_frame=False)
+    for c in ("A.real_continuous_output", "outer/inner/B.real_continuous_output"):
+        assert np.asarray(got[c], dtype=np.float64).tobytes() == cli[c].tobytes(), c
