@@ -238,6 +238,7 @@ pub fn parse(path: &Path, text: &str) -> Result<System> {
         },
         strict_units: false,
         last_step: Default::default(),
+        archive: None,
     })
 }
 
@@ -253,6 +254,7 @@ pub fn is_osp(sys: &System) -> bool {
 /// since (`shipsim run --stop-time`) is an error naming the file, instead of the one-second run
 /// that the validation's default stop time (start + 1 s) would give. Other systems pass.
 pub fn require_end_time(sys: &System) -> Result<()> {
+    super::ssp::require_stop_time(sys)?;
     if is_osp(sys) && sys.stop_time.is_none() {
         return Err(Error::system(
             &sys.source,

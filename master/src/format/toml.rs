@@ -217,6 +217,7 @@ pub fn parse(path: &Path, text: &str) -> Result<System> {
         output,
         strict_units: true,
         last_step,
+        archive: None,
     })
 }
 
@@ -346,6 +347,7 @@ impl Reader<'_> {
             either_direction: false,
             convert: flags.convert,
             sum: flags.sum,
+            mapping: None,
         })
     }
 

@@ -3,8 +3,8 @@
 //! Every variable the run reads (a connection source or a recorded output) gets one place in
 //! the shared [`Values`], per FMI type; an instance's observed variables of one type are a
 //! contiguous range, so reading them is one batched `fmi2GetXxx` straight into that range.
-//! Every connected input knows the place it reads from (and, for Real, the gain and offset),
-//! so writing an instance's inputs is one gather into a scratch buffer and one batched
+//! Every connected input knows the place it reads from (and, for Real, the gain and offset; for
+//! Integer and Boolean, an optional value mapping), so writing an instance's inputs is one gather into a scratch buffer and one batched
 //! `fmi2SetXxx`. Nothing here allocates after [`Exchange::build`].
 //!
 //! The three FMI types the exchange moves (Real, Integer, Boolean; Enumeration travels as
@@ -23,7 +23,7 @@ use crate::error::Result;
 use crate::fmu::VR;
 use crate::instance::{Instance, Readable};
 use crate::model_description::VarType;
-use crate::system::Plan;
+use crate::system::{Plan, ValueMapping};
 use std::collections::HashMap;
 
 /// The current value of every observed variable, one vector per FMI type.
@@ -39,11 +39,12 @@ pub struct Values {
 /// transforms one, and the batched FMI calls that move them.
 pub trait Kind {
     type Value: Copy + Default;
-    /// What a connection applies to a value on its way (Real: gain and offset).
-    type Map: Copy;
+    /// What a connection applies to a value on its way (Real: gain and offset; Integer and
+    /// Boolean: an optional [`ValueMapping`]).
+    type Map;
     fn values(v: &Values) -> &[Self::Value];
     fn values_mut(v: &mut Values) -> &mut [Self::Value];
-    fn map(value: Self::Value, map: Self::Map) -> Self::Value;
+    fn map(value: Self::Value, map: &Self::Map) -> Self::Value;
     /// Adds a further term to a summed input (validation admits sums of Real inputs only;
     /// Integer wraps and Boolean is a logical or, so that the operation is defined for each).
     fn add(sum: Self::Value, term: Self::Value) -> Self::Value;
@@ -75,7 +76,7 @@ impl Kind for Real {
         &mut v.real
     }
     #[inline]
-    fn map(value: f64, m: Linear) -> f64 {
+    fn map(value: f64, m: &Linear) -> f64 {
         m.gain * value + m.offset
     }
     #[inline]
@@ -94,7 +95,7 @@ impl Kind for Real {
 
 impl Kind for Integer {
     type Value = i32;
-    type Map = ();
+    type Map = Option<ValueMapping>;
     fn values(v: &Values) -> &[i32] {
         &v.integer
     }
@@ -102,8 +103,8 @@ impl Kind for Integer {
         &mut v.integer
     }
     #[inline]
-    fn map(value: i32, _: ()) -> i32 {
-        value
+    fn map(value: i32, m: &Option<ValueMapping>) -> i32 {
+        mapped(value, m)
     }
     #[inline]
     fn add(sum: i32, term: i32) -> i32 {
@@ -121,7 +122,7 @@ impl Kind for Integer {
 
 impl Kind for Boolean {
     type Value = i32;
-    type Map = ();
+    type Map = Option<ValueMapping>;
     fn values(v: &Values) -> &[i32] {
         &v.boolean
     }
@@ -129,8 +130,8 @@ impl Kind for Boolean {
         &mut v.boolean
     }
     #[inline]
-    fn map(value: i32, _: ()) -> i32 {
-        value
+    fn map(value: i32, m: &Option<ValueMapping>) -> i32 {
+        mapped(value, m)
     }
     #[inline]
     fn add(sum: i32, term: i32) -> i32 {
@@ -143,6 +144,16 @@ impl Kind for Boolean {
     #[inline]
     fn get<S: Readable>(inst: &mut Instance<S>, vrs: &[VR], out: &mut [i32]) -> Result<()> {
         inst.get_boolean(vrs, out)
+    }
+}
+
+/// An Integer or Boolean value through a connection's optional value mapping (SSP mapping
+/// transformations): a binary search in the table built before the first step, no allocation.
+#[inline(always)]
+fn mapped(value: i32, m: &Option<ValueMapping>) -> i32 {
+    match m {
+        None => value,
+        Some(m) => m.apply(value),
     }
 }
 
@@ -221,11 +232,11 @@ impl<K: Kind> Port<K> {
     fn set_inputs<S>(&mut self, inst: &mut Instance<S>, values: &Values) -> Result<()> {
         let shared = K::values(values);
         for (x, l) in self.scratch.iter_mut().zip(&self.links) {
-            *x = K::map(shared[l.source], l.map);
+            *x = K::map(shared[l.source], &l.map);
         }
         for t in &self.terms {
             let x = &mut self.scratch[t.input];
-            *x = K::add(*x, K::map(shared[t.link.source], t.link.map));
+            *x = K::add(*x, K::map(shared[t.link.source], &t.link.map));
         }
         K::set(inst, &self.input_vrs, &self.scratch)
     }
@@ -373,8 +384,8 @@ impl Exchange {
                     };
                     p.real.connect_term(first, c.to_vr, g, map)
                 }
-                VarType::Boolean => p.boolean.connect_term(first, c.to_vr, g, ()),
-                _ => p.integer.connect_term(first, c.to_vr, g, ()),
+                VarType::Boolean => p.boolean.connect_term(first, c.to_vr, g, c.mapping.clone()),
+                _ => p.integer.connect_term(first, c.to_vr, g, c.mapping.clone()),
             };
             if c.sum {
                 summed.insert(key, input);

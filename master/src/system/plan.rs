@@ -37,6 +37,8 @@ pub struct PlanConnection {
     /// A term of a summed input ([`ConnectionSpec::sum`](super::ConnectionSpec::sum)): the
     /// input gets the sum of its connections' terms, added in plan order.
     pub sum: bool,
+    /// The value mapping of an Integer or Boolean connection (SSP mapping transformations).
+    pub mapping: Option<super::ValueMapping>,
 }
 
 #[derive(Debug, Clone)]

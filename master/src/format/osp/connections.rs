@@ -89,6 +89,7 @@ fn plain(from: VarRef, to: VarRef, line: Option<usize>) -> ConnectionSpec {
         either_direction: false,
         convert: false,
         sum: false,
+        mapping: None,
     }
 }
 
