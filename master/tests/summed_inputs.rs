@@ -9,7 +9,7 @@
 //! the test as the additions the standard order prescribes; every comparison is exact (bits).
 mod common;
 use common::*;
-use shipsim::run::{load_fmus, run, run_with, MemoryRecorder, Output, RunOptions};
+use shipsim::run::{load_fmus, run, Output, RunOptions};
 use shipsim::system::System;
 use std::alloc::{GlobalAlloc, Layout, System as SysAlloc};
 use std::cell::Cell;
@@ -69,27 +69,9 @@ fmu = "testfmu.fmu"
     )
 }
 
-/// Runs a system file in memory: the recorder.
-fn run_memory(path: &Path) -> MemoryRecorder {
-    let sys = System::load(path).unwrap();
-    let fmus = load_fmus(&sys).unwrap();
-    let mds: Vec<_> = fmus.iter().map(|f| &f.model_description).collect();
-    let plan = sys.validate(&mds).unwrap();
-    let mut memory = MemoryRecorder::new();
-    run_with(&plan, &fmus, Some(&mut memory), &RunOptions::default()).unwrap();
-    memory
-}
-
-fn bits(xs: &[f64]) -> Vec<u64> {
-    xs.iter().map(|x| x.to_bits()).collect()
-}
-
 /// The check's error text for a system file.
 fn check_error(path: &Path) -> String {
-    let sys = System::load(path).unwrap();
-    let fmus = load_fmus(&sys).unwrap();
-    let mds: Vec<_> = fmus.iter().map(|f| &f.model_description).collect();
-    sys.validate(&mds).unwrap_err().to_string()
+    load_plan(path).map(|_| ()).unwrap_err().to_string()
 }
 
 #[test]

@@ -13,7 +13,7 @@
 //! A summed input ([`PlanConnection::sum`](crate::system::PlanConnection)) gets its first
 //! connection's term in the gather and every further term added after it, one at a time in
 //! plan order: ((t0 + t1) + t2) + ..., each term `gain*from + offset`, starting from t0 itself
-//! (not from 0.0, which would turn a sole -0.0 into +0.0). This is the order of libcosim's
+//! (not from 0.0). This is the order of libcosim's
 //! `vector_sum_function::calculate` (`include/cosim/function/vector_sum.hpp`: the output is
 //! assigned `in[0]`, then `in[1]`, `in[2]`, ... are added in index order), which runs OSP's
 //! `Sum` and `VectorSum` functions; floating-point addition is not associative, so any other
