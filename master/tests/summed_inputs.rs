@@ -348,3 +348,36 @@ fn export_to_osp_refuses_a_summed_term_with_a_gain() {
     );
     assert!(!osp.exists());
 }
+
+/// A plain connection passes -0.0 on as -0.0 (libcosim's VariableConnection transfers the value
+/// as it is), and so do the terms of a sum (libcosim's Sum starts from in[0]); a connection with
+/// a gain gives +0.0, as libcosim's LinearTransformation (offset + factor*in = 0.0 + -0.0).
+#[test]
+fn negative_zero_passes_through_plain_connections_and_sums() {
+    let d = tempfile::tempdir().unwrap();
+    test_fmu(d.path());
+    let cases: [(&str, f64); 3] = [
+        ("\"z.y2 -> s.u\"", -0.0),
+        ("\"z.y2 -> s.u, sum\", \"z.y2 -> s.u, sum\"", -0.0),
+        ("\"z.y2 -> s.u, gain = 2.0\"", 0.0),
+    ];
+    for (connections, expected) in cases {
+        // z.y2 = k*u = -1 * 0.0 = -0.0; s.y2 = 1 * s.u shows s.u
+        let text = format!(
+            "connections = [{connections}]\n[simulation]\nstop_time = 0.05\nstep_size = 0.01\n\
+             [[instances]]\nname = \"z\"\nfmu = \"testfmu.fmu\"\nparameters = {{ u = 0.0, k = -1.0 }}\n\
+             [[instances]]\nname = \"s\"\nfmu = \"testfmu.fmu\"\n"
+        );
+        let p = write_system(d.path(), "zero.toml", &text);
+        let m = run_memory(&p);
+        assert_eq!(
+            bits(m.column("z.y2").unwrap()),
+            vec![(-0.0f64).to_bits(); 6]
+        );
+        assert_eq!(
+            bits(m.column("s.y2").unwrap()),
+            vec![expected.to_bits(); 6],
+            "{connections}"
+        );
+    }
+}

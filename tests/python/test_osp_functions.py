@@ -83,12 +83,17 @@ def osp_file(rates):
                       rates.get(n, 1))
             for n, (ci, di, p) in SOURCES.items()]
     sims += [simulator(n, {"real_tunable_parameter": 0.0}, rates.get(n, 1)) for n in ["s1", "s2", "s3", "s4"]]
+    # z's output is -0.0 + (-0.0)*t = -0.0, passed to s5 (whose -0.0*t keeps the sign of zero)
+    sims += [simulator("z", {"real_continuous_input": -0.0, "real_tunable_parameter": -0.0}),
+             simulator("s5", {"real_tunable_parameter": -0.0})]
     conns = [signal(s, "real_continuous_output", "total", f"in[{i}]") for i, s in enumerate(SUM_ORDER)]
     conns.append(signal("s1", "real_continuous_input", "total", "out"))
     conns += [signal("a", "real_continuous_output", "scale", "in"),
               signal("s2", "real_continuous_input", "scale", "out")]
     conns += [signal_group(s, "vec_out", "vsum", f"in[{i}]") for i, s in enumerate(VECTOR_SUM_ORDER)]
     conns.append(signal_group("s3", "vec_in", "vsum", "out"))
+    conns.append('<VariableConnection><Variable simulator="z" name="real_continuous_output"/>'
+                 '<Variable simulator="s5" name="real_continuous_input"/></VariableConnection>')
     conns.append('<VariableGroupConnection><VariableGroup simulator="d" name="port_out"/>'
                  '<VariableGroup simulator="s4" name="port_in"/></VariableGroupConnection>')
     nl = "\n        "
@@ -148,7 +153,7 @@ def test_osp_functions_and_groups_equal_libcosim_bit_for_bit(feedthrough, tmp_pa
     header, ours = read_csv(tmp_path / "ours.csv")
     out = "real_continuous_output"
     dout = "real_discrete_output"
-    wanted = ["time"] + [f"{s}.{out}" for s in ["a", "b", "c", "d", "s1", "s2", "s3", "s4"]] \
+    wanted = ["time"] + [f"{s}.{out}" for s in ["a", "b", "c", "d", "s1", "s2", "s3", "s4", "z", "s5"]] \
         + [f"{s}.{dout}" for s in ["a", "b", "c", "d", "s3", "s4"]]
     assert all(w in header for w in wanted), header
     ours = [[r[header.index(w)] for w in wanted] for r in ours]
@@ -158,6 +163,8 @@ def test_osp_functions_and_groups_equal_libcosim_bit_for_bit(feedthrough, tmp_pa
         for name, x, y in zip(wanted[1:], a[1:], b):
             assert float(x).hex() == float(y).hex(), f"row {k} (t = {a[0]}), {name}: shipsim {x!r} vs libcosim {y!r}"
     col = {w: [r[j] for r in ours] for j, w in enumerate(wanted)}
+    # A plain connection passes -0.0 on as libcosim does (compared above; here: it is -0.0).
+    assert {float(x).hex() for x in col[f"s5.{out}"]} == {"-0x0.0p+0"}
     assert len(set(col[f"s1.{out}"][1:])) > 10 and len(set(col[f"s3.{out}"][1:])) > 5, "sums do not move"
     if rates:
         return  # the checks below follow the single-rate timing (one step of delay)

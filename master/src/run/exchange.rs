@@ -65,6 +65,19 @@ pub struct Linear {
     pub offset: f64,
 }
 
+impl Linear {
+    /// The map of a connection with this gain and offset. A plain connection (gain 1, offset 0)
+    /// passes its value on unchanged, as libcosim's VariableConnection does, the sign of zero
+    /// included: its offset is -0.0, since x + (-0.0) is x for every x while -0.0 + 0.0 is +0.0.
+    /// Any other keeps its offset: libcosim's LinearTransformation computes offset + factor*in,
+    /// which gives +0.0 for offset 0 and factor*in = -0.0, as gain*x + 0.0 does.
+    pub fn of(gain: f64, offset: f64) -> Linear {
+        let plain = gain == 1.0 && offset == 0.0;
+        let offset = if plain { -0.0 } else { offset };
+        Linear { gain, offset }
+    }
+}
+
 impl Kind for Real {
     type Value = f64;
     type Map = Linear;
@@ -367,11 +380,8 @@ impl Exchange {
             let first = summed.get(&key).copied();
             let input = match t {
                 VarType::Real => {
-                    let map = Linear {
-                        gain: c.gain,
-                        offset: c.offset,
-                    };
-                    p.real.connect_term(first, c.to_vr, g, map)
+                    p.real
+                        .connect_term(first, c.to_vr, g, Linear::of(c.gain, c.offset))
                 }
                 VarType::Boolean => p.boolean.connect_term(first, c.to_vr, g, ()),
                 _ => p.integer.connect_term(first, c.to_vr, g, ()),
