@@ -214,40 +214,16 @@ fn multi_rate_terms_add_what_plain_connections_deliver() {
     let d = tempfile::tempdir().unwrap();
     test_fmu(d.path());
     for algo in ["jacobi", "gauss-seidel"] {
-        let text = format!(
-            r#"connections = ["a.y -> s1.u", "b.y -> s2.u", "c.y -> s3.u", "a.y -> s.u, sum", "b.y -> s.u, sum", "c.y -> s.u, sum"]
-[simulation]
-stop_time = 0.6
-step_size = 0.01
-algorithm = "{algo}"
-[[instances]]
-name = "a"
-fmu = "testfmu.fmu"
-parameters = {{ u = 0.1 }}
-[[instances]]
-name = "b"
-fmu = "testfmu.fmu"
-step_multiple = 2
-parameters = {{ u = 0.2 }}
-[[instances]]
-name = "c"
-fmu = "testfmu.fmu"
-step_multiple = 3
-parameters = {{ u = 0.3 }}
-[[instances]]
-name = "s"
-fmu = "testfmu.fmu"
-[[instances]]
-name = "s1"
-fmu = "testfmu.fmu"
-[[instances]]
-name = "s2"
-fmu = "testfmu.fmu"
-[[instances]]
-name = "s3"
-fmu = "testfmu.fmu"
-"#
-        );
+        let connections = "connections = [\"a.y -> s1.u\", \"b.y -> s2.u\", \"c.y -> s3.u\", \"a.y -> s.u, sum\", \"b.y -> s.u, sum\", \"c.y -> s.u, sum\"]";
+        let sinks: String = ["s1", "s2", "s3"]
+            .iter()
+            .map(|n| format!("[[instances]]\nname = \"{n}\"\nfmu = \"testfmu.fmu\"\n"))
+            .collect();
+        let text = system(algo, connections, &sinks)
+            .replace("stop_time = 0.1", "stop_time = 0.6")
+            .replace("name = \"b\"\n", "name = \"b\"\nstep_multiple = 2\n")
+            .replace("name = \"c\"\n", "name = \"c\"\nstep_multiple = 3\n");
+        assert_eq!(text.matches("step_multiple").count(), 2);
         let p = write_system(d.path(), "rates.toml", &text);
         let m = run_memory(&p);
         let col = |n: &str| m.column(n).unwrap().to_vec();
