@@ -8,8 +8,7 @@
 //! shows in y2 exactly the value its input u was set to. Every comparison is exact (bits).
 mod common;
 use common::*;
-use shipsim::run::{load_fmus, run_with, MemoryRecorder, RunOptions};
-use shipsim::system::{Plan, System};
+use shipsim::system::System;
 use std::path::Path;
 
 /// Sources a, b, c (y2 = u = 0.1, 0.2, 0.3) and sinks s, e; `functions` and `connections` as
@@ -93,29 +92,8 @@ fn setup(text: &str) -> (tempfile::TempDir, std::path::PathBuf) {
     (d, p)
 }
 
-fn plan_of(path: &Path) -> shipsim::Result<(Plan, System)> {
-    let sys = System::load(path)?;
-    let fmus = load_fmus(&sys)?;
-    let mds: Vec<_> = fmus.iter().map(|f| &f.model_description).collect();
-    Ok((sys.validate(&mds)?, sys))
-}
-
-fn run_memory(path: &Path) -> MemoryRecorder {
-    let sys = System::load(path).unwrap();
-    let fmus = load_fmus(&sys).unwrap();
-    let mds: Vec<_> = fmus.iter().map(|f| &f.model_description).collect();
-    let plan = sys.validate(&mds).unwrap();
-    let mut memory = MemoryRecorder::new();
-    run_with(&plan, &fmus, Some(&mut memory), &RunOptions::default()).unwrap();
-    memory
-}
-
-fn bits(xs: &[f64]) -> Vec<u64> {
-    xs.iter().map(|x| x.to_bits()).collect()
-}
-
 fn error_of(path: &Path) -> String {
-    match plan_of(path) {
+    match load_plan(path) {
         Ok(_) => panic!("{} loads", path.display()),
         Err(e) => e.to_string(),
     }
@@ -196,14 +174,14 @@ fn vector_sum_adds_variable_groups_component_by_component() {
 fn variable_group_connection_connects_nested_groups_by_causality() {
     let conns = "<VariableGroupConnection><VariableGroup simulator=\"a\" name=\"port_out\"/><VariableGroup simulator=\"b\" name=\"port_in\"/></VariableGroupConnection>";
     let (_d, p) = setup(&osp("", conns));
-    let (plan, _) = plan_of(&p).unwrap();
+    let (plan, _) = load_plan(&p).unwrap();
     let names: Vec<&str> = plan.connections.iter().map(|c| c.name.as_str()).collect();
     // Force: a.y -> b.u; LinearVelocity: b.y -> a.u (turned around: a.u is the input)
     assert_eq!(names, ["a.y -> b.u", "b.y -> a.u"]);
     // a nested group by its own name: Force to Force
     let conns = "<VariableGroupConnection><VariableGroup simulator=\"a\" name=\"force_out\"/><VariableGroup simulator=\"b\" name=\"force_in\"/></VariableGroupConnection>";
     let (_d, p) = setup(&osp("", conns));
-    let (plan, _) = plan_of(&p).unwrap();
+    let (plan, _) = load_plan(&p).unwrap();
     assert_eq!(plan.connections.len(), 1);
     assert_eq!(plan.connections[0].name, "a.y -> b.u");
     // and the value flows: b.u (shown in b.y2) is a.y of the previous communication point
@@ -308,5 +286,5 @@ fn variable_groups_need_the_osp_model_description() {
     std::fs::write(sub.join("testfmu_OspModelDescription.xml"), GROUPS).unwrap();
     let text = osp("", conns).replace("source=\"testfmu.fmu\"", "source=\"../testfmu.fmu\"");
     let p = write_system(&sub, "OspSystemStructure.xml", &text);
-    assert_eq!(plan_of(&p).unwrap().0.connections.len(), 2);
+    assert_eq!(load_plan(&p).unwrap().0.connections.len(), 2);
 }

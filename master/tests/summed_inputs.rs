@@ -9,7 +9,7 @@
 //! the test as the additions the standard order prescribes; every comparison is exact (bits).
 mod common;
 use common::*;
-use shipsim::run::{load_fmus, run, run_with, MemoryRecorder, Output, RunOptions};
+use shipsim::run::{load_fmus, run, Output, RunOptions};
 use shipsim::system::System;
 use std::alloc::{GlobalAlloc, Layout, System as SysAlloc};
 use std::cell::Cell;
@@ -69,27 +69,9 @@ fmu = "testfmu.fmu"
     )
 }
 
-/// Runs a system file in memory: the recorder.
-fn run_memory(path: &Path) -> MemoryRecorder {
-    let sys = System::load(path).unwrap();
-    let fmus = load_fmus(&sys).unwrap();
-    let mds: Vec<_> = fmus.iter().map(|f| &f.model_description).collect();
-    let plan = sys.validate(&mds).unwrap();
-    let mut memory = MemoryRecorder::new();
-    run_with(&plan, &fmus, Some(&mut memory), &RunOptions::default()).unwrap();
-    memory
-}
-
-fn bits(xs: &[f64]) -> Vec<u64> {
-    xs.iter().map(|x| x.to_bits()).collect()
-}
-
 /// The check's error text for a system file.
 fn check_error(path: &Path) -> String {
-    let sys = System::load(path).unwrap();
-    let fmus = load_fmus(&sys).unwrap();
-    let mds: Vec<_> = fmus.iter().map(|f| &f.model_description).collect();
-    sys.validate(&mds).unwrap_err().to_string()
+    load_plan(path).map(|_| ()).unwrap_err().to_string()
 }
 
 #[test]
@@ -232,40 +214,16 @@ fn multi_rate_terms_add_what_plain_connections_deliver() {
     let d = tempfile::tempdir().unwrap();
     test_fmu(d.path());
     for algo in ["jacobi", "gauss-seidel"] {
-        let text = format!(
-            r#"connections = ["a.y -> s1.u", "b.y -> s2.u", "c.y -> s3.u", "a.y -> s.u, sum", "b.y -> s.u, sum", "c.y -> s.u, sum"]
-[simulation]
-stop_time = 0.6
-step_size = 0.01
-algorithm = "{algo}"
-[[instances]]
-name = "a"
-fmu = "testfmu.fmu"
-parameters = {{ u = 0.1 }}
-[[instances]]
-name = "b"
-fmu = "testfmu.fmu"
-step_multiple = 2
-parameters = {{ u = 0.2 }}
-[[instances]]
-name = "c"
-fmu = "testfmu.fmu"
-step_multiple = 3
-parameters = {{ u = 0.3 }}
-[[instances]]
-name = "s"
-fmu = "testfmu.fmu"
-[[instances]]
-name = "s1"
-fmu = "testfmu.fmu"
-[[instances]]
-name = "s2"
-fmu = "testfmu.fmu"
-[[instances]]
-name = "s3"
-fmu = "testfmu.fmu"
-"#
-        );
+        let connections = "connections = [\"a.y -> s1.u\", \"b.y -> s2.u\", \"c.y -> s3.u\", \"a.y -> s.u, sum\", \"b.y -> s.u, sum\", \"c.y -> s.u, sum\"]";
+        let sinks: String = ["s1", "s2", "s3"]
+            .iter()
+            .map(|n| format!("[[instances]]\nname = \"{n}\"\nfmu = \"testfmu.fmu\"\n"))
+            .collect();
+        let text = system(algo, connections, &sinks)
+            .replace("stop_time = 0.1", "stop_time = 0.6")
+            .replace("name = \"b\"\n", "name = \"b\"\nstep_multiple = 2\n")
+            .replace("name = \"c\"\n", "name = \"c\"\nstep_multiple = 3\n");
+        assert_eq!(text.matches("step_multiple").count(), 2);
         let p = write_system(d.path(), "rates.toml", &text);
         let m = run_memory(&p);
         let col = |n: &str| m.column(n).unwrap().to_vec();
@@ -365,4 +323,37 @@ fn export_to_osp_refuses_a_summed_term_with_a_gain() {
         "{e}"
     );
     assert!(!osp.exists());
+}
+
+/// A plain connection passes -0.0 on as -0.0 (libcosim's VariableConnection transfers the value
+/// as it is), and so do the terms of a sum (libcosim's Sum starts from in[0]); a connection with
+/// a gain gives +0.0, as libcosim's LinearTransformation (offset + factor*in = 0.0 + -0.0).
+#[test]
+fn negative_zero_passes_through_plain_connections_and_sums() {
+    let d = tempfile::tempdir().unwrap();
+    test_fmu(d.path());
+    let cases: [(&str, f64); 3] = [
+        ("\"z.y2 -> s.u\"", -0.0),
+        ("\"z.y2 -> s.u, sum\", \"z.y2 -> s.u, sum\"", -0.0),
+        ("\"z.y2 -> s.u, gain = 2.0\"", 0.0),
+    ];
+    for (connections, expected) in cases {
+        // z.y2 = k*u = -1 * 0.0 = -0.0; s.y2 = 1 * s.u shows s.u
+        let text = format!(
+            "connections = [{connections}]\n[simulation]\nstop_time = 0.05\nstep_size = 0.01\n\
+             [[instances]]\nname = \"z\"\nfmu = \"testfmu.fmu\"\nparameters = {{ u = 0.0, k = -1.0 }}\n\
+             [[instances]]\nname = \"s\"\nfmu = \"testfmu.fmu\"\n"
+        );
+        let p = write_system(d.path(), "zero.toml", &text);
+        let m = run_memory(&p);
+        assert_eq!(
+            bits(m.column("z.y2").unwrap()),
+            vec![(-0.0f64).to_bits(); 6]
+        );
+        assert_eq!(
+            bits(m.column("s.y2").unwrap()),
+            vec![expected.to_bits(); 6],
+            "{connections}"
+        );
+    }
 }

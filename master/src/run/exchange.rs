@@ -13,7 +13,7 @@
 //! A summed input ([`PlanConnection::sum`](crate::system::PlanConnection)) gets its first
 //! connection's term in the gather and every further term added after it, one at a time in
 //! plan order: ((t0 + t1) + t2) + ..., each term `gain*from + offset`, starting from t0 itself
-//! (not from 0.0, which would turn a sole -0.0 into +0.0). This is the order of libcosim's
+//! (not from 0.0). This is the order of libcosim's
 //! `vector_sum_function::calculate` (`include/cosim/function/vector_sum.hpp`: the output is
 //! assigned `in[0]`, then `in[1]`, `in[2]`, ... are added in index order), which runs OSP's
 //! `Sum` and `VectorSum` functions; floating-point addition is not associative, so any other
@@ -64,6 +64,19 @@ pub struct Boolean;
 pub struct Linear {
     pub gain: f64,
     pub offset: f64,
+}
+
+impl Linear {
+    /// The map of a connection with this gain and offset. A plain connection (gain 1, offset 0)
+    /// passes its value on unchanged, as libcosim's VariableConnection does, the sign of zero
+    /// included: its offset is -0.0, since x + (-0.0) is x for every x while -0.0 + 0.0 is +0.0.
+    /// Any other keeps its offset: libcosim's LinearTransformation computes offset + factor*in,
+    /// which gives +0.0 for offset 0 and factor*in = -0.0, as gain*x + 0.0 does.
+    pub fn of(gain: f64, offset: f64) -> Linear {
+        let plain = gain == 1.0 && offset == 0.0;
+        let offset = if plain { -0.0 } else { offset };
+        Linear { gain, offset }
+    }
 }
 
 impl Kind for Real {
@@ -378,11 +391,8 @@ impl Exchange {
             let first = summed.get(&key).copied();
             let input = match t {
                 VarType::Real => {
-                    let map = Linear {
-                        gain: c.gain,
-                        offset: c.offset,
-                    };
-                    p.real.connect_term(first, c.to_vr, g, map)
+                    p.real
+                        .connect_term(first, c.to_vr, g, Linear::of(c.gain, c.offset))
                 }
                 VarType::Boolean => p.boolean.connect_term(first, c.to_vr, g, c.mapping.clone()),
                 _ => p.integer.connect_term(first, c.to_vr, g, c.mapping.clone()),

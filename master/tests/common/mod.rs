@@ -143,3 +143,30 @@ pub fn our_fmu(model_identifier: &str) -> PathBuf {
     );
     p
 }
+
+/// A system file with its FMUs loaded and validated: (plan, FMUs).
+pub fn load_plan(
+    path: &Path,
+) -> shipsim::Result<(
+    shipsim::system::Plan,
+    Vec<std::sync::Arc<shipsim::fmu::Fmu>>,
+)> {
+    let sys = shipsim::system::System::load(path)?;
+    let fmus = shipsim::run::load_fmus(&sys)?;
+    let mds: Vec<_> = fmus.iter().map(|f| &f.model_description).collect();
+    Ok((sys.validate(&mds)?, fmus))
+}
+
+/// Runs a system file, recording every output in memory.
+pub fn run_memory(path: &Path) -> shipsim::run::MemoryRecorder {
+    let (plan, fmus) = load_plan(path).unwrap();
+    let mut memory = shipsim::run::MemoryRecorder::new();
+    let opts = shipsim::run::RunOptions::default();
+    shipsim::run::run_with(&plan, &fmus, Some(&mut memory), &opts).unwrap();
+    memory
+}
+
+/// The bits of each value, for exact comparisons.
+pub fn bits(xs: &[f64]) -> Vec<u64> {
+    xs.iter().map(|x| x.to_bits()).collect()
+}
