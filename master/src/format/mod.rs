@@ -11,6 +11,7 @@ use crate::system::System;
 use std::path::Path;
 
 pub mod osp;
+pub mod ssp;
 pub mod toml;
 
 impl System {
