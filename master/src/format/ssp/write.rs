@@ -343,7 +343,8 @@ impl Archive {
         );
         for (i, inst) in plan.instances.iter().enumerate() {
             let ssv = ssvs[i].as_ref().map(|(n, _)| n.as_str());
-            let step = (inst.step_multiple > 1).then(|| inst.step_multiple as f64 * plan.step_size);
+            let step =
+                (inst.step_multiple > 1).then_some(inst.step_multiple as f64 * plan.step_size);
             component(
                 &mut x,
                 &inst.name,
