@@ -299,19 +299,13 @@ def test_fmpy_simulates_export_within_its_subset(tmp_path):
 
 
 def _libcosim_runner_from_ssp():
-    """Child process: python test_ssp_export.py SSP_FILE N_STEPS COLUMN...; libcosim_runner.main
-    with the execution created from the .ssp."""
-    import libcosim_runner
+    """Child process: python test_ssp_export.py SSP_FILE N_STEPS COLUMN...; libcosim_runner.py run
+    as the main script (same arguments) with the execution created from the .ssp."""
+    import runpy
     from libcosimpy.CosimExecution import CosimExecution
 
     CosimExecution.from_osp_config_file = staticmethod(lambda path: CosimExecution.from_ssp_file(path))
-    try:
-        libcosim_runner.main()
-    except SystemExit as e:
-        sys.stderr.write(f"{e}\n")
-        sys.stderr.flush()
-        os._exit(2)
-    os._exit(0)
+    runpy.run_path(str(pathlib.Path(__file__).with_name("libcosim_runner.py")), run_name="__main__")
 
 
 if __name__ == "__main__":
