@@ -27,6 +27,7 @@ Environment: SHIPSIM_BIN (the master), SHIPSIM_FMU_DIR (our built FMUs).
 import csv
 import os
 import pathlib
+import re
 import subprocess
 import sys
 import tomllib
@@ -104,6 +105,27 @@ def test_refused_with_what_ssp_cannot_express(system, tmp_path):
     assert r.returncode != 0, f"{system}: export-ssp accepted a system with events"
     assert NOT_EXPORTABLE[system] in r.stderr and "SSP 1.0 has no scenario form" in r.stderr, r.stderr
     assert not ssp.exists() and not list(tmp_path.glob("*.partial"))
+
+
+@pytest.mark.parametrize("old, new, named", [
+    ('algorithm = "jacobi"', 'algorithm = "gauss-seidel"', 'algorithm "gauss-seidel": SSP 1.0 has no master algorithm'),
+    ('algorithm = "jacobi"', 'algorithm = "jacobi"\nlast_step = "short"\nstop_time = 10.025',
+     'stop time 10.025 s is off the base-step grid and last_step = "short"'),
+], ids=["gauss-seidel", "short-last-step"])
+def test_refused_settings(old, new, named, tmp_path):
+    """What the simulation settings ask for and SSP 1.0 cannot say is refused by name."""
+    toml, _ = localise(FMPY_SYSTEM, tmp_path)
+    text = toml.read_text()
+    assert old in text
+    text = text.replace(old, new)
+    if "stop_time = 10.025" in new:
+        text = re.sub(r"(?m)^stop_time\s*=\s*[-+0-9.eE_]+\n", "", text, count=1)
+    toml.write_text(text)
+    shipsim("check", toml)
+    ssp = tmp_path / "out.ssp"
+    r = shipsim("export-ssp", toml, "-o", ssp, check=False)
+    assert r.returncode != 0 and named in r.stderr, r.stderr
+    assert not ssp.exists()
 
 
 @pytest.mark.parametrize("system", exportable(), ids=ids)
