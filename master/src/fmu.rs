@@ -79,6 +79,21 @@ impl std::fmt::Debug for Fmu {
     }
 }
 
+/// Unpacks a zip archive (an FMU, or an SSP for the SSP reader) into a new temporary directory.
+pub fn unpack_archive(path: &Path) -> Result<tempfile::TempDir> {
+    let file =
+        std::fs::File::open(path).map_err(|e| Error::fmu(path, format!("cannot open: {e}")))?;
+    let mut zip = zip::ZipArchive::new(file)
+        .map_err(|e| Error::fmu(path, format!("not a valid FMU (zip) archive: {e}")))?;
+    let dir = tempfile::Builder::new()
+        .prefix("shipsim-fmu-")
+        .tempdir()
+        .map_err(|e| Error::io("creating a temporary directory", e))?;
+    zip.extract(dir.path())
+        .map_err(|e| Error::fmu(path, format!("cannot unpack the archive: {e}")))?;
+    Ok(dir)
+}
+
 /// Unpacks and parses an FMU without loading its binary (for `inspect` and validation).
 pub struct UnpackedFmu {
     pub path: PathBuf,
@@ -88,16 +103,7 @@ pub struct UnpackedFmu {
 
 impl UnpackedFmu {
     pub fn open(path: &Path) -> Result<UnpackedFmu> {
-        let file =
-            std::fs::File::open(path).map_err(|e| Error::fmu(path, format!("cannot open: {e}")))?;
-        let mut zip = zip::ZipArchive::new(file)
-            .map_err(|e| Error::fmu(path, format!("not a valid FMU (zip) archive: {e}")))?;
-        let dir = tempfile::Builder::new()
-            .prefix("shipsim-fmu-")
-            .tempdir()
-            .map_err(|e| Error::io("creating a temporary directory", e))?;
-        zip.extract(dir.path())
-            .map_err(|e| Error::fmu(path, format!("cannot unpack the archive: {e}")))?;
+        let dir = unpack_archive(path)?;
         let md_path = dir.path().join("modelDescription.xml");
         let xml = std::fs::read_to_string(&md_path).map_err(|e| {
             Error::fmu(

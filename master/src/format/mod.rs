@@ -3,6 +3,7 @@
 //!
 //! - [`toml`]: shipsim's native system file (read).
 //! - [`osp`]: OSP `OspSystemStructure.xml`, libcosim's format (read and write).
+//! - [`ssp`]: SSP 1.0, an `.ssp` archive or a `SystemStructure.ssd` (read).
 //!
 //! The readers depend on [`crate::system`]; `system` depends on no reader.
 
@@ -15,8 +16,12 @@ pub mod ssp;
 pub mod toml;
 
 impl System {
-    /// Reads a system file: `.xml` is OSP `OspSystemStructure.xml`, anything else TOML.
+    /// Reads a system file: `.ssp` is an SSP 1.0 archive and `.ssd` an SSP system structure
+    /// description, `.xml` is OSP `OspSystemStructure.xml`, anything else TOML.
     pub fn load(path: &Path) -> Result<System> {
+        if ssp::is_ssp_path(path) {
+            return ssp::load(path);
+        }
         let is_xml = path
             .extension()
             .map(|e| e.eq_ignore_ascii_case("xml"))

@@ -202,6 +202,7 @@ pub fn parse(path: &Path, text: &str) -> Result<System> {
         },
         strict_units: false,
         last_step: Default::default(),
+        archive: None,
     })
 }
 
@@ -409,6 +410,7 @@ impl Reader<'_> {
             line,
             either_direction: true,
             convert: false,
+            mapping: None,
         })
     }
 
@@ -475,6 +477,7 @@ impl Reader<'_> {
                 either_direction: false,
                 // a LinearTransformation may map one quantity onto another
                 convert: gain != 1.0 || offset != 0.0,
+                mapping: None,
             })
             .collect()
     }

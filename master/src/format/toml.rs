@@ -199,6 +199,7 @@ pub fn parse(path: &Path, text: &str) -> Result<System> {
         output,
         strict_units: true,
         last_step,
+        archive: None,
     })
 }
 
@@ -321,6 +322,7 @@ impl Reader<'_> {
             line,
             either_direction: false,
             convert,
+            mapping: None,
         })
     }
 

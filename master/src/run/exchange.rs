@@ -3,8 +3,8 @@
 //! Every variable the run reads (a connection source or a recorded output) gets one place in
 //! the shared [`Values`], per FMI type; an instance's observed variables of one type are a
 //! contiguous range, so reading them is one batched `fmi2GetXxx` straight into that range.
-//! Every connected input knows the place it reads from (and, for Real, the gain and offset),
-//! so writing an instance's inputs is one gather into a scratch buffer and one batched
+//! Every connected input knows the place it reads from (and, for Real, the gain and offset; for
+//! Integer and Boolean, an optional value mapping), so writing an instance's inputs is one gather into a scratch buffer and one batched
 //! `fmi2SetXxx`. Nothing here allocates after [`Exchange::build`].
 //!
 //! The three FMI types the exchange moves (Real, Integer, Boolean; Enumeration travels as
@@ -14,7 +14,7 @@ use crate::error::Result;
 use crate::fmu::VR;
 use crate::instance::{Instance, Readable};
 use crate::model_description::VarType;
-use crate::system::Plan;
+use crate::system::{Plan, ValueMapping};
 use std::collections::HashMap;
 
 /// The current value of every observed variable, one vector per FMI type.
@@ -30,11 +30,12 @@ pub struct Values {
 /// transforms one, and the batched FMI calls that move them.
 pub trait Kind {
     type Value: Copy + Default;
-    /// What a connection applies to a value on its way (Real: gain and offset).
-    type Map: Copy;
+    /// What a connection applies to a value on its way (Real: gain and offset; Integer and
+    /// Boolean: an optional [`ValueMapping`]).
+    type Map;
     fn values(v: &Values) -> &[Self::Value];
     fn values_mut(v: &mut Values) -> &mut [Self::Value];
-    fn map(value: Self::Value, map: Self::Map) -> Self::Value;
+    fn map(value: Self::Value, map: &Self::Map) -> Self::Value;
     fn set<S>(inst: &mut Instance<S>, vrs: &[VR], values: &[Self::Value]) -> Result<()>;
     fn get<S: Readable>(inst: &mut Instance<S>, vrs: &[VR], out: &mut [Self::Value]) -> Result<()>;
 }
@@ -63,7 +64,7 @@ impl Kind for Real {
         &mut v.real
     }
     #[inline]
-    fn map(value: f64, m: Linear) -> f64 {
+    fn map(value: f64, m: &Linear) -> f64 {
         m.gain * value + m.offset
     }
     #[inline]
@@ -78,7 +79,7 @@ impl Kind for Real {
 
 impl Kind for Integer {
     type Value = i32;
-    type Map = ();
+    type Map = Option<ValueMapping>;
     fn values(v: &Values) -> &[i32] {
         &v.integer
     }
@@ -86,8 +87,8 @@ impl Kind for Integer {
         &mut v.integer
     }
     #[inline]
-    fn map(value: i32, _: ()) -> i32 {
-        value
+    fn map(value: i32, m: &Option<ValueMapping>) -> i32 {
+        mapped(value, m)
     }
     #[inline]
     fn set<S>(inst: &mut Instance<S>, vrs: &[VR], values: &[i32]) -> Result<()> {
@@ -101,7 +102,7 @@ impl Kind for Integer {
 
 impl Kind for Boolean {
     type Value = i32;
-    type Map = ();
+    type Map = Option<ValueMapping>;
     fn values(v: &Values) -> &[i32] {
         &v.boolean
     }
@@ -109,8 +110,8 @@ impl Kind for Boolean {
         &mut v.boolean
     }
     #[inline]
-    fn map(value: i32, _: ()) -> i32 {
-        value
+    fn map(value: i32, m: &Option<ValueMapping>) -> i32 {
+        mapped(value, m)
     }
     #[inline]
     fn set<S>(inst: &mut Instance<S>, vrs: &[VR], values: &[i32]) -> Result<()> {
@@ -119,6 +120,16 @@ impl Kind for Boolean {
     #[inline]
     fn get<S: Readable>(inst: &mut Instance<S>, vrs: &[VR], out: &mut [i32]) -> Result<()> {
         inst.get_boolean(vrs, out)
+    }
+}
+
+/// An Integer or Boolean value through a connection's optional value mapping (SSP mapping
+/// transformations): a binary search in the table built before the first step, no allocation.
+#[inline(always)]
+fn mapped(value: i32, m: &Option<ValueMapping>) -> i32 {
+    match m {
+        None => value,
+        Some(m) => m.apply(value),
     }
 }
 
@@ -175,7 +186,7 @@ impl<K: Kind> Port<K> {
     fn set_inputs<S>(&mut self, inst: &mut Instance<S>, values: &Values) -> Result<()> {
         let shared = K::values(values);
         for (x, l) in self.scratch.iter_mut().zip(&self.links) {
-            *x = K::map(shared[l.source], l.map);
+            *x = K::map(shared[l.source], &l.map);
         }
         K::set(inst, &self.input_vrs, &self.scratch)
     }
@@ -319,8 +330,8 @@ impl Exchange {
                         offset: c.offset,
                     },
                 ),
-                VarType::Boolean => p.boolean.connect(c.to_vr, g, ()),
-                _ => p.integer.connect(c.to_vr, g, ()),
+                VarType::Boolean => p.boolean.connect(c.to_vr, g, c.mapping.clone()),
+                _ => p.integer.connect(c.to_vr, g, c.mapping.clone()),
             }
         }
         for p in ports.iter_mut() {

@@ -119,6 +119,50 @@ pub struct ConnectionSpec {
     /// The gain converts between physically different quantities (e.g. a wave moment in N.m
     /// into a rudder-equivalent disturbance in rad): the unit check is skipped for it.
     pub convert: bool,
+    /// A value mapping of an Integer, Enumeration or Boolean connection (SSP 1.0 mapping
+    /// transformations); None passes values unchanged.
+    pub mapping: Option<ValueMapping>,
+}
+
+/// A table that maps the values of a discrete connection: SSP 1.0
+/// `IntegerMappingTransformation`, `EnumerationMappingTransformation` (by item values) and
+/// `BooleanMappingTransformation` (`SystemStructureCommon.xsd`, `GTransformationChoice`).
+/// Sorted by source, one entry per source; a value without an entry passes unchanged.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ValueMapping {
+    /// Boolean (values 0/1; any nonzero source counts as 1) or Integer/Enumeration.
+    pub boolean: bool,
+    entries: Vec<(i32, i32)>,
+}
+
+impl ValueMapping {
+    /// The table of (source, target) pairs; a source given twice is an error.
+    pub fn new(boolean: bool, mut entries: Vec<(i32, i32)>) -> std::result::Result<Self, String> {
+        entries.sort_by_key(|e| e.0);
+        if let Some(w) = entries.windows(2).find(|w| w[0].0 == w[1].0) {
+            return Err(format!("source value {} is mapped twice", w[0].0));
+        }
+        Ok(ValueMapping { boolean, entries })
+    }
+
+    /// The (source, target) pairs, by source.
+    pub fn entries(&self) -> &[(i32, i32)] {
+        &self.entries
+    }
+
+    /// The mapped value (a binary search; no allocation).
+    #[inline]
+    pub fn apply(&self, value: i32) -> i32 {
+        let key = if self.boolean {
+            i32::from(value != 0)
+        } else {
+            value
+        };
+        match self.entries.binary_search_by_key(&key, |e| e.0) {
+            Ok(k) => self.entries[k].1,
+            Err(_) => value,
+        }
+    }
 }
 
 #[derive(Debug, Clone)]
@@ -158,6 +202,9 @@ pub struct System {
     /// A stop time off the base-step grid: stop before it (the default) or take a short last
     /// step to it (TOML `[simulation] last_step`, `shipsim run --last-step`).
     pub last_step: crate::run::LastStep,
+    /// The unpacked SSP archive the FMU paths point into, kept as long as the system (set by
+    /// the SSP reader for `.ssp` files).
+    pub archive: Option<std::sync::Arc<tempfile::TempDir>>,
 }
 
 impl System {

@@ -34,6 +34,8 @@ pub struct PlanConnection {
     pub gain: f64,
     pub offset: f64,
     pub name: String,
+    /// The value mapping of an Integer or Boolean connection (SSP mapping transformations).
+    pub mapping: Option<super::ValueMapping>,
 }
 
 #[derive(Debug, Clone)]

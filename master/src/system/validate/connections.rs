@@ -142,6 +142,23 @@ impl<'a> Checker<'a> {
                 ),
             ));
         }
+        if let Some(m) = &spec.mapping {
+            let boolean = matches!(ft, VarType::Boolean);
+            if m.boolean != boolean
+                || !matches!(
+                    ft,
+                    VarType::Integer | VarType::Enumeration | VarType::Boolean
+                )
+            {
+                errors.push(self.err(
+                    line,
+                    format!(
+                        "connection {name}: the value mapping does not apply to '{}' ({ft})",
+                        spec.from
+                    ),
+                ));
+            }
+        }
         if c.to.0 == c.from.0 {
             self.warnings.push(format!(
                 "{}: connection {name} feeds an instance back to itself",
@@ -265,6 +282,7 @@ impl<'a> Checker<'a> {
             },
             gain: c.spec.gain,
             offset: c.spec.offset,
+            mapping: c.spec.mapping.clone(),
             name: c.name,
         }
     }
