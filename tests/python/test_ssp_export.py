@@ -6,7 +6,9 @@
   size from the file's OSP annotation), gives results equal bit for bit (tolerance 0) to
   `shipsim run` of the TOML; the run is cut and recorded as in test_systems_libcosim.py (localise).
 * The same .ssp run by shipsim itself (`shipsim run system.ssp`, the SSP importer) gives the
-  TOML's results bit for bit.
+  TOML's results bit for bit; an SSD written here with Integer and Boolean mapping
+  transformations, a linear transformation and a String parameter exports and runs back
+  unchanged.
 * The systems SSP 1.0 cannot express are refused with an error naming what (NOT_EXPORTABLE), and
   no archive is written.
 * FMPy (fmpy.ssp, a subset of SSP): it reads every export (components, FMU sources, connections,
@@ -240,6 +242,115 @@ def test_export_equals_shipsim_from_ssp(system, tmp_path):
     for a, b in zip(r1, r2):
         got = [b[j] for j in col]
         assert got == a, f"{system}, t = {a[0]}: {[(h, x, y) for h, x, y in zip(h1, a, got) if x != y][:5]}"
+
+
+MAPPED_SSD = """<?xml version="1.0" encoding="UTF-8"?>
+<ssd:SystemStructureDescription xmlns:ssd="http://ssp-standard.org/SSP1/SystemStructureDescription"
+    xmlns:ssc="http://ssp-standard.org/SSP1/SystemStructureCommon"
+    xmlns:ssv="http://ssp-standard.org/SSP1/SystemStructureParameterValues"
+    xmlns:osp="http://opensimulationplatform.com/SSP/OSPAnnotations" name="mapped" version="1.0">
+  <ssd:System name="mapped">
+    <ssd:Elements>
+      <ssd:Component name="A" source="Feedthrough.fmu">
+        <ssd:Connectors>
+          <ssd:Connector name="integer_output" kind="output"><ssc:Integer/></ssd:Connector>
+          <ssd:Connector name="boolean_output" kind="output"><ssc:Boolean/></ssd:Connector>
+          <ssd:Connector name="real_continuous_output" kind="output"><ssc:Real/></ssd:Connector>
+        </ssd:Connectors>
+        <ssd:ParameterBindings>
+          <ssd:ParameterBinding>
+            <ssd:ParameterValues>
+              <ssv:ParameterSet version="1.0" name="A">
+                <ssv:Parameters>
+                  <ssv:Parameter name="integer_input"><ssv:Integer value="2"/></ssv:Parameter>
+                  <ssv:Parameter name="boolean_input"><ssv:Boolean value="true"/></ssv:Parameter>
+                  <ssv:Parameter name="real_continuous_input"><ssv:Real value="1.5"/></ssv:Parameter>
+                  <ssv:Parameter name="string_parameter"><ssv:String value="a &lt;b&gt; &amp; &quot;c&quot;"/></ssv:Parameter>
+                </ssv:Parameters>
+              </ssv:ParameterSet>
+            </ssd:ParameterValues>
+          </ssd:ParameterBinding>
+        </ssd:ParameterBindings>
+      </ssd:Component>
+      <ssd:Component name="B" source="Feedthrough.fmu">
+        <ssd:Connectors>
+          <ssd:Connector name="integer_input" kind="input"><ssc:Integer/></ssd:Connector>
+          <ssd:Connector name="boolean_input" kind="input"><ssc:Boolean/></ssd:Connector>
+          <ssd:Connector name="real_continuous_input" kind="input"><ssc:Real/></ssd:Connector>
+        </ssd:Connectors>
+      </ssd:Component>
+    </ssd:Elements>
+    <ssd:Connections>
+      <ssd:Connection startElement="A" startConnector="integer_output" endElement="B" endConnector="integer_input">
+        <ssc:IntegerMappingTransformation>
+          <ssc:MapEntry source="1" target="100"/>
+          <ssc:MapEntry source="2" target="200"/>
+        </ssc:IntegerMappingTransformation>
+      </ssd:Connection>
+      <ssd:Connection startElement="A" startConnector="boolean_output" endElement="B" endConnector="boolean_input">
+        <ssc:BooleanMappingTransformation>
+          <ssc:MapEntry source="true" target="false"/>
+          <ssc:MapEntry source="false" target="true"/>
+        </ssc:BooleanMappingTransformation>
+      </ssd:Connection>
+      <ssd:Connection startElement="A" startConnector="real_continuous_output" endElement="B" endConnector="real_continuous_input">
+        <ssc:LinearTransformation factor="2" offset="0.5"/>
+      </ssd:Connection>
+    </ssd:Connections>
+  </ssd:System>
+  <ssd:DefaultExperiment startTime="0" stopTime="1">
+    <ssd:Annotations>
+      <ssc:Annotation type="com.opensimulationplatform">
+        <osp:Algorithm><osp:FixedStepAlgorithm baseStepSize="0.25"/></osp:Algorithm>
+      </ssc:Annotation>
+    </ssd:Annotations>
+  </ssd:DefaultExperiment>
+</ssd:SystemStructureDescription>
+"""
+
+
+def test_mappings_and_strings_round_trip(tmp_path):
+    """An SSD written here from SSP 1.0 (Integer and Boolean mapping transformations, a linear
+    transformation, an inline parameter set with a String that needs XML escaping), run by shipsim,
+    exported and run again from the .ssp: the same results, bit for bit, and the values the SSD
+    defines, row by row (integer 1 -> 100 and 2 -> 200, boolean negated, 2 * 1.5 + 0.5 = 3.5, the
+    String's length 11)."""
+    import fixtures
+    fixtures.build("Feedthrough", tmp_path)
+    ssd = tmp_path / "SystemStructure.ssd"
+    ssd.write_text(MAPPED_SSD)
+    before = tmp_path / "ssd.csv"
+    shipsim("run", ssd, "-o", before, "-q")
+    ssp = tmp_path / "out" / "mapped.ssp"
+    r = export(ssd, ssp)
+    assert "libcosim applies no mapping transformation" in r.stderr, r.stderr
+    with zipfile.ZipFile(ssp) as z:
+        text = z.read("SystemStructure.ssd").decode()
+        ssv = z.read("resources/A.ssv")
+    schema = etree.XMLSchema(file=str(SCHEMA_DIR / "SystemStructureDescription.xsd"))
+    assert schema.validate(etree.fromstring(text.encode())), schema.error_log
+    schema = etree.XMLSchema(file=str(SCHEMA_DIR / "SystemStructureParameterValues.xsd"))
+    assert schema.validate(etree.fromstring(ssv)), schema.error_log
+    for entry in ['<ssc:MapEntry source="1" target="100"/>', '<ssc:MapEntry source="2" target="200"/>',
+                  '<ssc:MapEntry source="false" target="true"/>', '<ssc:MapEntry source="true" target="false"/>',
+                  '<ssc:LinearTransformation factor="2.0" offset="0.5"/>']:
+        assert entry in text, entry
+    after = tmp_path / "ssp.csv"
+    shipsim("run", ssp, "-o", after, "-q")
+    assert read_csv(after) == read_csv(before)
+    header, rows = read_csv(after)
+    col = {h: j for j, h in enumerate(header)}
+    # Feedthrough adds its step count k to integer_output and flips boolean_output on odd k; B's
+    # inputs at row k come from A's outputs at row k - 1 (row 0: after initialization).
+    imap, bmap = {1: 100, 2: 200}, {1: 0, 0: 1}
+    for k, r in enumerate(rows):
+        src = rows[max(k - 1, 0)]
+        a_int, a_bool = int(src[col["A.integer_output"]]), int(src[col["A.boolean_output"]])
+        assert r[col["B.integer_output"]] == imap.get(a_int, a_int) + k, (k, r)
+        assert r[col["B.boolean_output"]] == bmap[a_bool] ^ (k & 1), (k, r)
+        assert r[col["B.real_continuous_output"]] == 2 * 1.5 + 0.5, (k, r)
+        assert r[col["A.string_length"]] == len('a <b> & "c"'), (k, r)
+    assert rows[0][col["B.integer_output"]] == 200 and len(rows) == 5
 
 
 def fmpy_parameter_set(ssp):

@@ -6,7 +6,9 @@
 //!
 //! - `SystemStructure.ssd`: one `ssd:System` with one `ssd:Component` per instance (SSP 1.0,
 //!   sec. 5.3), the connectors that connections use, with their type and unit; the connections,
-//!   a gain or offset as `ssc:LinearTransformation` (sec. 5.4.5); the units of the connectors as
+//!   a gain or offset as `ssc:LinearTransformation`, the value mapping of an Integer or Boolean
+//!   connection (read from an SSP) as `ssc:IntegerMappingTransformation` or
+//!   `ssc:BooleanMappingTransformation` (sec. 5.4.5); the units of the connectors as
 //!   `ssc:Unit` with their SI exponents, factor and offset (sec. 5.4.3, from each FMU's
 //!   `UnitDefinitions` or, for a unit the FMU does not define, [`crate::units`]);
 //!   `ssd:DefaultExperiment` with the start and stop time (sec. 5.6).
@@ -52,9 +54,6 @@ const NS_SSV: &str = "http://ssp-standard.org/SSP1/SystemStructureParameterValue
 const NS_OSP: &str = "http://opensimulationplatform.com/SSP/OSPAnnotations";
 /// The annotation type libcosim's SSP parser looks for (`src/cosim/ssp/ssp_parser.cpp`).
 const OSP_ANNOTATION: &str = "com.opensimulationplatform";
-
-/// The name of the SSD in the archive (SSP 1.0, sec. 8; libcosim's default).
-pub const SSD_NAME: &str = "SystemStructure.ssd";
 
 /// Writes the system as an SSP 1.0 archive at `out`; returns warnings about what was left out.
 /// The system is validated first (FMU model descriptions are read, binaries are not loaded);
@@ -131,9 +130,10 @@ fn refusals(sys: &System, plan: &Plan, mds: &[&ModelDescription]) -> Vec<Error> 
 /// Inputs driven by more than one connection (summed inputs), with their connections, in
 /// plan order.
 fn summed_inputs(connections: &[PlanConnection]) -> Vec<(String, Vec<&PlanConnection>)> {
-    let mut by_input: Vec<((usize, u32), Vec<&PlanConnection>)> = Vec::new();
+    // a value reference is unique per type only (FMI 2.0, sec. 2.2.7)
+    let mut by_input: Vec<((usize, u32, VarType), Vec<&PlanConnection>)> = Vec::new();
     for c in connections {
-        let key = (c.to_instance, c.to_vr);
+        let key = (c.to_instance, c.to_vr, vr_space(c.var_type));
         match by_input.iter_mut().find(|(k, _)| *k == key) {
             Some((_, v)) => v.push(c),
             None => by_input.push((key, vec![c])),
@@ -166,7 +166,7 @@ fn enumerations(plan: &Plan, mds: &[&ModelDescription]) -> Vec<String> {
             (c.from_instance, c.from_vr, false),
             (c.to_instance, c.to_vr, true),
         ] {
-            if let Some(v) = by_vr(mds[i], vr, input) {
+            if let Some(v) = by_vr(mds[i], vr, c.var_type, input) {
                 if v.var_type() == Some(VarType::Enumeration) {
                     found.push(format!("{}.{}", plan.instances[i].name, v.name));
                 }
@@ -186,6 +186,19 @@ fn left_out(sys: &System, plan: &Plan) -> Vec<String> {
              are left out"
                 .to_string(),
         );
+    }
+    let mapped: Vec<&str> = plan
+        .connections
+        .iter()
+        .filter(|c| c.mapping.is_some())
+        .map(|c| c.name.as_str())
+        .collect();
+    if !mapped.is_empty() {
+        warnings.push(format!(
+            "libcosim applies no mapping transformation (it passes the values of {} unchanged); \
+             shipsim and other SSP tools apply them",
+            mapped.join(", ")
+        ));
     }
     let multiples: Vec<String> = plan
         .instances
@@ -209,12 +222,23 @@ fn variable<'m>(md: &'m ModelDescription, name: &str) -> Option<&'m ScalarVariab
     md.model_variables.variables.iter().find(|v| v.name == name)
 }
 
-/// The variable with value reference `vr` that is an input (or not).
-fn by_vr(md: &ModelDescription, vr: u32, input: bool) -> Option<&ScalarVariable> {
-    md.model_variables
-        .variables
-        .iter()
-        .find(|v| v.value_reference == vr && (v.causality == Causality::Input) == input)
+/// The variable of a connection end: value reference `vr` of type `t`, an input (or not). A
+/// value reference is unique per base type only (FMI 2.0, sec. 2.2.7); Enumerations share
+/// Integer's.
+fn by_vr(md: &ModelDescription, vr: u32, t: VarType, input: bool) -> Option<&ScalarVariable> {
+    md.model_variables.variables.iter().find(|v| {
+        v.value_reference == vr
+            && (v.causality == Causality::Input) == input
+            && v.var_type().map(vr_space) == Some(vr_space(t))
+    })
+}
+
+/// The value-reference space of a type: Enumerations share Integer's.
+fn vr_space(t: VarType) -> VarType {
+    match t {
+        VarType::Enumeration => VarType::Integer,
+        t => t,
+    }
 }
 
 /// An XML attribute value.
@@ -394,7 +418,7 @@ impl Archive {
         let text = SimpleFileOptions::default().compression_method(CompressionMethod::Deflated);
         // an FMU is a ZIP already: stored as it is
         let stored = SimpleFileOptions::default().compression_method(CompressionMethod::Stored);
-        z.start_file(SSD_NAME, text).map_err(zip_err)?;
+        z.start_file(super::DEFAULT_SSD, text).map_err(zip_err)?;
         z.write_all(self.ssd.as_bytes()).map_err(io)?;
         for (name, body) in &self.ssvs {
             z.start_file(name.as_str(), text).map_err(zip_err)?;
@@ -512,7 +536,7 @@ fn connectors(
             (c.from_instance, c.from_vr, false),
             (c.to_instance, c.to_vr, true),
         ] {
-            let Some(v) = by_vr(mds[i], vr, input) else {
+            let Some(v) = by_vr(mds[i], vr, c.var_type, input) else {
                 continue;
             };
             if out[i].iter().any(|k| k.name == v.name) {
@@ -632,8 +656,8 @@ fn connections(
     x.push_str("    <ssd:Connections>\n");
     for c in &plan.connections {
         let (Some(f), Some(t)) = (
-            by_vr(mds[c.from_instance], c.from_vr, false),
-            by_vr(mds[c.to_instance], c.to_vr, true),
+            by_vr(mds[c.from_instance], c.from_vr, c.var_type, false),
+            by_vr(mds[c.to_instance], c.to_vr, c.var_type, true),
         ) else {
             continue;
         };
@@ -652,18 +676,43 @@ fn connections(
         if fu.is_some() && tu.is_some() && fu != tu {
             x.push_str(" suppressUnitConversion=\"true\"");
         }
-        if c.gain == 1.0 && c.offset == 0.0 {
-            x.push_str("/>\n");
-            continue;
+        match transformation(c) {
+            None => x.push_str("/>\n"),
+            Some(t) => {
+                let _ = writeln!(x, ">\n        {t}\n      </ssd:Connection>");
+            }
         }
-        let _ = writeln!(
-            x,
-            ">\n        <ssc:LinearTransformation factor=\"{}\" offset=\"{}\"/>\n      </ssd:Connection>",
-            xs_double(c.gain),
-            xs_double(c.offset)
-        );
     }
     x.push_str("    </ssd:Connections>\n");
+}
+
+/// A connection's transformation (SSP 1.0, `GTransformationChoice`): its value mapping as an
+/// Integer or Boolean mapping transformation, or its gain and offset as a linear one.
+fn transformation(c: &PlanConnection) -> Option<String> {
+    if let Some(m) = &c.mapping {
+        let (el, value): (&str, fn(i32) -> String) = match m.boolean {
+            true => ("BooleanMappingTransformation", |v| (v != 0).to_string()),
+            false => ("IntegerMappingTransformation", |v| v.to_string()),
+        };
+        let mut t = format!("<ssc:{el}>");
+        for (source, target) in m.entries() {
+            let _ = write!(
+                t,
+                "\n          <ssc:MapEntry source=\"{}\" target=\"{}\"/>",
+                value(*source),
+                value(*target)
+            );
+        }
+        let _ = write!(t, "\n        </ssc:{el}>");
+        return Some(t);
+    }
+    (c.gain != 1.0 || c.offset != 0.0).then(|| {
+        format!(
+            "<ssc:LinearTransformation factor=\"{}\" offset=\"{}\"/>",
+            xs_double(c.gain),
+            xs_double(c.offset)
+        )
+    })
 }
 
 /// `ssd:DefaultExperiment` with the base step as libcosim's fixed-step algorithm annotation.
