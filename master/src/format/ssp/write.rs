@@ -131,7 +131,8 @@ fn refusals(sys: &System, plan: &Plan, mds: &[&ModelDescription]) -> Vec<Error> 
 /// plan order.
 fn summed_inputs(connections: &[PlanConnection]) -> Vec<(String, Vec<&PlanConnection>)> {
     // a value reference is unique per type only (FMI 2.0, sec. 2.2.7)
-    let mut by_input: Vec<((usize, u32, VarType), Vec<&PlanConnection>)> = Vec::new();
+    type Input = (usize, u32, VarType);
+    let mut by_input: Vec<(Input, Vec<&PlanConnection>)> = Vec::new();
     for c in connections {
         let key = (c.to_instance, c.to_vr, vr_space(c.var_type));
         match by_input.iter_mut().find(|(k, _)| *k == key) {
