@@ -1,4 +1,5 @@
-//! The `shipsim` command line: `run`, `check`, `inspect`, `export-osp`, `plot`, `campaign`.
+//! The `shipsim` command line: `run`, `check`, `inspect`, `export-osp`, `export-ssp`, `plot`,
+//! `campaign`.
 mod cli;
 
 use clap::{Parser, Subcommand};
@@ -137,6 +138,14 @@ enum Command {
         #[arg(long, short)]
         output: Option<PathBuf>,
     },
+    /// Write an SSP 1.0 archive (.ssp: SystemStructure.ssd, the FMUs, the parameters as .ssv)
+    /// for a system; what SSP cannot express (events, summed inputs, ...) is an error.
+    ExportSsp {
+        system: PathBuf,
+        /// Output file (default: the system file with the extension .ssp).
+        #[arg(long, short)]
+        output: Option<PathBuf>,
+    },
 }
 
 fn main() -> ExitCode {
@@ -212,6 +221,7 @@ fn dispatch(cmd: Command) -> shipsim::Result<()> {
             run_cli(&sys, &flags, checkpoints)
         }
         Command::ExportOsp { system, output } => export_osp(&system, output),
+        Command::ExportSsp { system, output } => export_ssp(&system, output),
         Command::Campaign { command } => cli::campaign::dispatch(command, ctrl_c_flag),
         Command::Stats(args) => cli::stats::run(&args),
     }
@@ -523,6 +533,16 @@ fn export_osp(system: &Path, output: Option<PathBuf>) -> shipsim::Result<()> {
             .join("OspSystemStructure.xml")
     });
     let warnings = shipsim::format::osp::write(&sys, &out)?;
+    print_warnings(&warnings);
+    eprintln!("wrote {}", out.display());
+    Ok(())
+}
+
+/// `shipsim export-ssp`: an SSP 1.0 archive (SystemStructure.ssd, the FMUs, the parameters).
+fn export_ssp(system: &Path, output: Option<PathBuf>) -> shipsim::Result<()> {
+    let sys = System::load(system)?;
+    let out = output.unwrap_or_else(|| system.with_extension("ssp"));
+    let warnings = shipsim::format::ssp::write::write(&sys, &out)?;
     print_warnings(&warnings);
     eprintln!("wrote {}", out.display());
     Ok(())

@@ -8,6 +8,7 @@
 //! * `wheel`: the `shipsim` Python package (python/) as a wheel under target/wheels/.
 //! * `export-osp`: every system file of systems/ as target/osp/<name>/OspSystemStructure.xml
 //!   (+ scenario.json for its events) for libcosim / cosim-cli.
+//! * `export-ssp`: every system file of systems/ that SSP 1.0 can express as target/ssp/<name>.ssp.
 //! * `artifacts DIR` / `artifacts --compare A B`: captures the model descriptions, documentation,
 //!   system CSVs and report of a commit and compares two captures byte for byte (see artifacts.rs).
 
@@ -27,6 +28,7 @@ fn main() {
         Some("bench") => bench(&args[1..]),
         Some("report") => report(args.get(1).map(String::as_str)),
         Some("export-osp") => export_osp(),
+        Some("export-ssp") => export_ssp(),
         Some("wheel") => wheel(),
         Some("artifacts") => artifacts::main(&args[1..]),
         _ => {
@@ -39,6 +41,7 @@ fn main() {
                  wheel        build the shipsim Python package (python/) as a wheel in target/wheels\n  \
                  report [DIR] run every coupled system and write the validation report (target/report)\n  \
                  export-osp   every system of systems/ as target/osp/<name>/OspSystemStructure.xml for libcosim\n  \
+                 export-ssp   every system of systems/ that SSP 1.0 can express as target/ssp/<name>.ssp\n  \
                  bench        master overhead vs libcosim and FMPy, every system's speed and profile, campaigns (docs/bench.md)\n  \
                  artifacts DIR          FMU model descriptions, system CSVs and report into DIR\n  \
                  artifacts --compare A B  byte-compare two artifact folders (refactor check)"
@@ -260,11 +263,7 @@ fn export_osp() -> Result<()> {
     run(cargo()
         .current_dir(&root)
         .args(["build", "--release", "-p", "shipsim", "--bins"]))?;
-    let mut systems: Vec<PathBuf> = std::fs::read_dir(root.join("systems"))?
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
-        .collect();
-    systems.sort();
+    let systems = system_files(&root)?;
     for sys in &systems {
         let name = sys.file_stem().and_then(|s| s.to_str()).unwrap_or("system");
         let out = root
@@ -284,6 +283,60 @@ fn export_osp() -> Result<()> {
         systems.len(),
         root.join("target/osp").display()
     );
+    Ok(())
+}
+
+/// The system files of systems/ (`*.toml`), sorted.
+fn system_files(root: &Path) -> Result<Vec<PathBuf>> {
+    let mut systems: Vec<PathBuf> = std::fs::read_dir(root.join("systems"))?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+        .collect();
+    systems.sort();
+    Ok(systems)
+}
+
+/// Builds the FMUs and shipsim, then exports every systems/*.toml with `shipsim export-ssp` to
+/// target/ssp/<name>.ssp. A system that SSP 1.0 cannot express (shipsim refuses it, naming
+/// what) is listed at the end and does not fail the task.
+fn export_ssp() -> Result<()> {
+    let root = workspace_root();
+    fmu::build_fmus(&root)?;
+    run(cargo()
+        .current_dir(&root)
+        .args(["build", "--release", "-p", "shipsim", "--bins"]))?;
+    let mut refused = Vec::new();
+    let systems = system_files(&root)?;
+    for sys in &systems {
+        let name = sys.file_stem().and_then(|s| s.to_str()).unwrap_or("system");
+        let out = root.join("target/ssp").join(format!("{name}.ssp"));
+        // a refused system leaves no archive from an earlier export behind
+        let _ = std::fs::remove_file(&out);
+        let status = Command::new(root.join("target/release/shipsim"))
+            .current_dir(&root)
+            .arg("export-ssp")
+            .arg(sys)
+            .arg("-o")
+            .arg(&out)
+            .status()
+            .context("could not start target/release/shipsim")?;
+        if !status.success() {
+            refused.push(name.to_string());
+        }
+    }
+    eprintln!(
+        "xtask: {} of {} systems exported under {}; run one with libcosimpy's \
+         CosimExecution.from_ssp_file or `shipsim run target/ssp/<name>.ssp`",
+        systems.len() - refused.len(),
+        systems.len(),
+        root.join("target/ssp").display()
+    );
+    if !refused.is_empty() {
+        eprintln!(
+            "xtask: not exportable to SSP 1.0 (the errors above say why): {}",
+            refused.join(", ")
+        );
+    }
     Ok(())
 }
 

@@ -7,6 +7,7 @@
 //! - [`xml`]: the element tree over quick-xml; [`read`]: the SSD (systems, components,
 //!   connectors, connections, units, the default experiment and the fixed-step annotations);
 //!   [`params`]: parameter bindings, `.ssv` parameter sets and `.ssm` parameter mappings.
+//! - [`write`]: the export, a [`System`] as a self-contained `.ssp` archive.
 //!
 //! What is not supported is refused with an error naming the file, the line and the element
 //! (`docs/ssp.md` lists both).
@@ -18,6 +19,7 @@ use std::path::Path;
 mod connect;
 mod params;
 pub mod read;
+pub mod write;
 mod xml;
 
 /// Largest SSD, SSV or SSM file read (bytes): real ones are kilobytes.
