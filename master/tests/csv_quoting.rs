@@ -34,15 +34,15 @@ fn names_with_commas_and_quotes_are_quoted() {
 }
 
 /// A process killed with SIGKILL keeps the rows of all but about the last second: with rows
-/// coming slowly (one per 10^6 macro steps, a few a second, far less than the 64 kB
-/// buffer), the CSV has the header and rows while the run is still going. The old recorder
-/// wrote nothing until its buffer filled.
+/// coming slowly (one per 10^7 macro steps, a few a second, so that the 64 kB buffer would
+/// take minutes to fill), the CSV has the header and rows while the run is still going. The
+/// old recorder wrote nothing until its buffer filled (the wait below gives up after 120 s).
 #[test]
 fn rows_reach_the_file_while_the_run_goes_on() {
     let s = Sandbox::new();
     common::test_fmu(s.path());
     let text = system("testfmu.fmu", "a", "1e9", "0.001", "")
-        .replace("[output]\n", "[output]\ndecimation = 1000000\n");
+        .replace("[output]\n", "[output]\ndecimation = 10000000\n");
     std::fs::write(s.path().join("slow.toml"), text).unwrap();
     let mut child = s.spawn(
         &["run", "slow.toml", "-q", "-o", "slow.csv"],
@@ -64,7 +64,7 @@ fn rows_reach_the_file_while_the_run_goes_on() {
         Some("time,a.y,a.t_last,a.grid_error,a.y2,a.steps,a.n_out,a.enabled_out")
     );
     assert_eq!(it.next().unwrap().split(',').next(), Some("0"));
-    assert_eq!(it.next().unwrap().split(',').next(), Some("1000"));
+    assert_eq!(it.next().unwrap().split(',').next(), Some("10000"));
 }
 
 /// `-o` naming the system file or an input FMU (also through another path or a hard link)
