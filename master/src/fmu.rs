@@ -4,12 +4,16 @@
 //! co-simulation functions; the archive layout is section 2.3 "FMU Distribution").
 
 use crate::error::{Error, Result};
+use crate::limits::{Limits, MAX_MODEL_DESCRIPTION};
 use crate::model_description::{CoSimulation, ModelDescription, ScalarVariable};
 use fmi2::*;
 use libloading::os::unix::{Library, RTLD_GLOBAL, RTLD_LOCAL, RTLD_NOW};
 use std::collections::HashMap;
 use std::ffi::c_void;
+use std::io::{Read, Write};
+use std::os::unix::fs::{DirBuilderExt, OpenOptionsExt, PermissionsExt};
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 
 /// Platform folder inside `binaries/` (FMI 2.0 section 2.3).
@@ -80,17 +84,57 @@ impl std::fmt::Debug for Fmu {
 }
 
 /// Unpacks a zip archive (an FMU, or an SSP for the SSP reader) into a new temporary directory.
-pub fn unpack_archive(path: &Path) -> Result<tempfile::TempDir> {
+pub fn unpack_archive(path: &Path, unpack: &Unpack) -> Result<tempfile::TempDir> {
     let file =
         std::fs::File::open(path).map_err(|e| Error::fmu(path, format!("cannot open: {e}")))?;
+    if file.metadata().is_ok_and(|m| m.is_dir()) {
+        return Err(Error::fmu(
+                path,
+                "is a directory; an FMU is a zip archive (a .fmu file), an unpacked FMU folder cannot be used",
+            ));
+    }
+    let declared = declared_entries(&file);
     let mut zip = zip::ZipArchive::new(file)
         .map_err(|e| Error::fmu(path, format!("not a valid FMU (zip) archive: {e}")))?;
+    if declared.is_some_and(|n| n != zip.len() as u64) {
+        return Err(Error::fmu(
+                path,
+                format!(
+                    "cannot unpack the archive: it holds {} entries under {} names (a name appears twice; which copy is meant?); refused",
+                    declared.unwrap_or(0),
+                    zip.len()
+                ),
+            ));
+    }
+    let limits = &unpack.limits;
+    if zip.len() as u64 > limits.max_files {
+        return Err(Error::fmu(
+                path,
+                format!(
+                    "the archive has {} entries, more than the limit of {}; if it is genuine, raise the limit (CLI --max-fmu-files, library Limits::max_files)",
+                    zip.len(),
+                    limits.max_files
+                ),
+            ));
+    }
+    let parent = unpack.parent.clone().unwrap_or_else(std::env::temp_dir);
     let dir = tempfile::Builder::new()
         .prefix("shipsim-fmu-")
-        .tempdir()
-        .map_err(|e| Error::io("creating a temporary directory", e))?;
-    zip.extract(dir.path())
-        .map_err(|e| Error::fmu(path, format!("cannot unpack the archive: {e}")))?;
+        .permissions(std::fs::Permissions::from_mode(0o700))
+        .tempdir_in(&parent)
+        .map_err(|e| {
+            Error::io(
+                format!("creating a temporary directory in {}", parent.display()),
+                e,
+            )
+        })?;
+    Extraction {
+        fmu: path,
+        dir: dir.path(),
+        unpack,
+        total: 0,
+    }
+    .all(&mut zip)?;
     Ok(dir)
 }
 
@@ -101,26 +145,34 @@ pub struct UnpackedFmu {
     pub dir: tempfile::TempDir,
 }
 
+/// How an FMU archive is unpacked ([`UnpackedFmu::open_with`], [`Fmu::load_with`]).
+///
+/// Every FMU gets its own directory `shipsim-fmu-*` (mode 0700) in `parent`; files are written
+/// 0600 (0700 under `binaries/`), whatever modes the archive stores; directories 0700.
+/// Symbolic links, absolute paths and `..` are refused, and so is an archive beyond
+/// [`Limits`]. The directory is removed when the last user of the FMU drops it (also on an
+/// error and while a panic unwinds); a process that wants to remove it on a signal too puts
+/// `parent` (or `$TMPDIR`) in a directory of its own and removes that, as the CLI does.
+#[derive(Clone, Debug, Default)]
+pub struct Unpack {
+    pub limits: Limits,
+    /// Where the FMU's directory is created (default: the temporary directory, `$TMPDIR`).
+    pub parent: Option<PathBuf>,
+    /// Checked between entries and every 64 KiB of data: once set, unpacking stops with an
+    /// error (the CLI's Ctrl-C flag).
+    pub interrupt: Option<Arc<AtomicBool>>,
+}
+
 impl UnpackedFmu {
+    /// [`UnpackedFmu::open_with`] with the default [`Unpack`] options.
     pub fn open(path: &Path) -> Result<UnpackedFmu> {
-        let dir = unpack_archive(path)?;
-        let md_path = dir.path().join("modelDescription.xml");
-        let xml = std::fs::read_to_string(&md_path).map_err(|e| {
-            Error::fmu(
-                path,
-                if e.kind() == std::io::ErrorKind::NotFound {
-                    "the archive has no modelDescription.xml at its root".to_string()
-                } else {
-                    format!("cannot read modelDescription.xml: {e}")
-                },
-            )
-        })?;
-        let model_description = ModelDescription::parse(&xml).map_err(|e| {
-            Error::fmu(
-                path,
-                format!("modelDescription.xml does not parse as an FMI 2.0 model description: {e}"),
-            )
-        })?;
+        UnpackedFmu::open_with(path, &Unpack::default())
+    }
+
+    /// Unpacks the archive (see [`Unpack`]) and parses its `modelDescription.xml`.
+    pub fn open_with(path: &Path, unpack: &Unpack) -> Result<UnpackedFmu> {
+        let dir = unpack_archive(path, unpack)?;
+        let model_description = read_model_description(path, dir.path())?;
         Ok(UnpackedFmu {
             path: path.to_path_buf(),
             model_description,
@@ -131,7 +183,7 @@ impl UnpackedFmu {
     /// FMI version and co-simulation checks (FMI 2.0 sections 2.2.1 and 4.3.1).
     pub fn check(&self) -> Result<&CoSimulation> {
         let md = &self.model_description;
-        if !md.fmi_version.starts_with("2.") {
+        if !is_fmi2_version(&md.fmi_version) {
             return Err(Error::fmu(
                 &self.path,
                 format!(
@@ -150,6 +202,12 @@ impl UnpackedFmu {
                 },
             ));
         };
+        if let Some(name) = md.duplicate_variable_name() {
+            return Err(Error::fmu(
+                &self.path,
+                format!("modelDescription.xml declares the variable '{name}' twice (FMI 2.0, sec. 2.2.7: names are unique)"),
+            ));
+        }
         for (i, v) in md.model_variables.variables.iter().enumerate() {
             if v.var_type().is_none() {
                 return Err(Error::fmu(
@@ -165,15 +223,20 @@ impl UnpackedFmu {
         Ok(cs)
     }
 
+    /// `binaries/<platform>/<modelIdentifier>.<ext>`: a regular file inside the unpacked
+    /// directory (the identifier is checked to be a file name, and the resolved path to lie
+    /// inside the directory).
     pub fn binary_path(&self) -> Result<PathBuf> {
         let cs = self.check()?;
+        check_model_identifier(&self.path, &cs.model_identifier)?;
         let p = self
             .dir
             .path()
             .join("binaries")
             .join(PLATFORM)
             .join(format!("{}.{}", cs.model_identifier, LIB_EXT));
-        if !p.is_file() {
+        let regular = std::fs::symlink_metadata(&p).is_ok_and(|m| m.file_type().is_file());
+        if !regular {
             let mut found = Vec::new();
             if let Ok(rd) = std::fs::read_dir(self.dir.path().join("binaries")) {
                 for e in rd.flatten() {
@@ -193,7 +256,240 @@ impl UnpackedFmu {
                 ),
             ));
         }
+        let inside = match (p.canonicalize(), self.dir.path().canonicalize()) {
+            (Ok(bin), Ok(dir)) => bin.starts_with(dir),
+            _ => false,
+        };
+        if !inside {
+            return Err(Error::fmu(
+                &self.path,
+                format!(
+                    "binaries/{PLATFORM}/{}.{LIB_EXT} resolves outside the unpacked FMU; refused",
+                    cs.model_identifier
+                ),
+            ));
+        }
         Ok(p)
+    }
+}
+
+/// `fmiVersion` of FMI 2.0: "2.0" (FMI 2.0, sec. 2.2.1), also "2.0.x" as some tools of the
+/// 2.0.x maintenance releases write it.
+fn is_fmi2_version(v: &str) -> bool {
+    match v.strip_prefix("2.0") {
+        Some("") => true,
+        Some(rest) => rest
+            .strip_prefix('.')
+            .is_some_and(|r| !r.is_empty() && r.bytes().all(|b| b.is_ascii_digit())),
+        None => false,
+    }
+}
+
+/// `modelDescription.xml` at the root of the unpacked archive: a regular file (never followed
+/// through a link), read up to [`MAX_MODEL_DESCRIPTION`] bytes, parsed.
+fn read_model_description(fmu: &Path, dir: &Path) -> Result<ModelDescription> {
+    let md_path = dir.join("modelDescription.xml");
+    let err = |m: String| Error::fmu(fmu, m);
+    match std::fs::symlink_metadata(&md_path) {
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+            return Err(err(
+                "the archive has no modelDescription.xml at its root".into()
+            ))
+        }
+        Err(e) => return Err(err(format!("cannot read modelDescription.xml: {e}"))),
+        Ok(m) if !m.file_type().is_file() => {
+            return Err(err("modelDescription.xml is not a regular file".into()))
+        }
+        Ok(_) => {}
+    }
+    let file = std::fs::OpenOptions::new()
+        .read(true)
+        .custom_flags(libc::O_NOFOLLOW)
+        .open(&md_path)
+        .map_err(|e| err(format!("cannot read modelDescription.xml: {e}")))?;
+    let xml = crate::limits::read_limited_from(file, MAX_MODEL_DESCRIPTION)
+        .map_err(|e| err(format!("cannot read modelDescription.xml: {e}")))?;
+    ModelDescription::parse(&xml).map_err(|e| {
+        err(format!(
+            "modelDescription.xml does not parse as an FMI 2.0 model description: {e}"
+        ))
+    })
+}
+
+/// The number of entries the zip's end-of-central-directory record declares (APPNOTE.TXT
+/// 4.3.16), or `None` when it cannot be read or the archive is zip64. The `zip` crate indexes
+/// entries by name, so an archive that holds a name twice shows fewer entries than this.
+fn declared_entries(file: &std::fs::File) -> Option<u64> {
+    use std::os::unix::fs::FileExt;
+    let len = file.metadata().ok()?.len();
+    let tail_len = len.min(22 + 65_535);
+    let mut tail = vec![0u8; tail_len as usize];
+    file.read_exact_at(&mut tail, len - tail_len).ok()?;
+    let at = tail
+        .windows(4)
+        .rposition(|w| w == [0x50, 0x4b, 0x05, 0x06])
+        .filter(|&i| i + 22 <= tail.len())?;
+    let n = u16::from_le_bytes([tail[at + 10], tail[at + 11]]);
+    (n != 0xFFFF).then_some(u64::from(n))
+}
+
+/// Unpacking one archive into its private directory under [`Unpack`]'s rules.
+struct Extraction<'a> {
+    fmu: &'a Path,
+    dir: &'a Path,
+    unpack: &'a Unpack,
+    /// Bytes written so far.
+    total: u64,
+}
+
+impl Extraction<'_> {
+    fn err(&self, m: String) -> Error {
+        Error::fmu(self.fmu, m)
+    }
+
+    fn interrupted(&self) -> bool {
+        self.unpack
+            .interrupt
+            .as_ref()
+            .is_some_and(|f| f.load(Ordering::Relaxed))
+    }
+
+    fn all<R: Read + std::io::Seek>(&mut self, zip: &mut zip::ZipArchive<R>) -> Result<()> {
+        for i in 0..zip.len() {
+            if self.interrupted() {
+                return Err(self.err("unpacking interrupted".into()));
+            }
+            let entry = zip
+                .by_index(i)
+                .map_err(|e| self.err(format!("cannot unpack the archive: {e}")))?;
+            self.entry(entry)?;
+        }
+        Ok(())
+    }
+
+    /// One entry: a directory (created 0700) or a file (written 0600, 0700 under
+    /// `binaries/`), never a link, never outside the directory, never past the limits.
+    fn entry<R: Read>(&mut self, mut entry: zip::read::ZipFile<'_, R>) -> Result<()> {
+        let name = entry.name().to_string();
+        let Some(rel) = entry.enclosed_name() else {
+            return Err(self.err(format!(
+                "cannot unpack the archive: entry '{name}' is an absolute path or leaves the archive ('..'); refused"
+            )));
+        };
+        if entry.is_symlink() {
+            return Err(self.err(format!(
+                "cannot unpack the archive: entry '{name}' is a symbolic link; links are refused (one could point outside the FMU)"
+            )));
+        }
+        let out = self.dir.join(&rel);
+        if entry.is_dir() {
+            return self.create_dirs(&out);
+        }
+        if let Some(parent) = out.parent() {
+            self.create_dirs(parent)?;
+        }
+        let limit = self.entry_limit(&name, entry.size(), entry.compressed_size())?;
+        let mode = if rel.starts_with("binaries") {
+            0o700
+        } else {
+            0o600
+        };
+        let mut file = std::fs::OpenOptions::new()
+            .write(true)
+            .create_new(true)
+            .mode(mode)
+            .custom_flags(libc::O_NOFOLLOW)
+            .open(&out)
+            .map_err(|e| match e.kind() {
+                std::io::ErrorKind::AlreadyExists => self.err(format!(
+                    "cannot unpack the archive: entry '{name}' appears twice (or clashes with a directory); refused"
+                )),
+                _ => self.err(format!("cannot unpack '{name}': {e}")),
+            })?;
+        let mut buf = vec![0u8; 64 << 10];
+        let mut written = 0u64;
+        loop {
+            if self.interrupted() {
+                return Err(self.err("unpacking interrupted".into()));
+            }
+            let n = entry
+                .read(&mut buf)
+                .map_err(|e| self.err(format!("cannot unpack '{name}': {e}")))?;
+            if n == 0 {
+                return Ok(());
+            }
+            written += n as u64;
+            self.total += n as u64;
+            if written > limit {
+                return Err(self.over_limit(&name, written, entry.compressed_size()));
+            }
+            file.write_all(&buf[..n])
+                .map_err(|e| self.err(format!("cannot unpack '{name}': {e}")))?;
+        }
+    }
+
+    /// Directories inside the unpacked directory, 0700.
+    fn create_dirs(&self, dir: &Path) -> Result<()> {
+        std::fs::DirBuilder::new()
+            .recursive(true)
+            .mode(0o700)
+            .create(dir)
+            .map_err(|e| self.err(format!("cannot unpack the archive: {}: {e}", dir.display())))
+    }
+
+    /// The most bytes the entry may unpack to: what is left of the size limit, and for an
+    /// entry beyond [`Limits::RATIO_EXEMPT`] the ratio limit. Refused at once when the sizes
+    /// the archive declares already break a limit.
+    fn entry_limit(&self, name: &str, size: u64, compressed: u64) -> Result<u64> {
+        let l = &self.unpack.limits;
+        let by_ratio = l
+            .max_ratio
+            .saturating_mul(compressed.max(1))
+            .max(Limits::RATIO_EXEMPT);
+        let by_size = l.max_size.saturating_sub(self.total);
+        let limit = by_ratio.min(by_size);
+        if size > limit {
+            return Err(self.over_limit(name, size, compressed));
+        }
+        Ok(limit)
+    }
+
+    /// The error for an entry that unpacks (or declares it unpacks) to `size` bytes, past a
+    /// limit.
+    fn over_limit(&self, name: &str, size: u64, compressed: u64) -> Error {
+        let l = &self.unpack.limits;
+        let hs = crate::limits::human_bytes;
+        if size > Limits::RATIO_EXEMPT && size > l.max_ratio.saturating_mul(compressed.max(1)) {
+            self.err(format!(
+                "entry '{name}' unpacks to more than {} times its compressed size of {} bytes, the limit on the compression ratio (a zip bomb?); if the archive is genuine, raise the limit (CLI --max-fmu-ratio, library Limits::max_ratio)",
+                l.max_ratio, compressed
+            ))
+        } else {
+            self.err(format!(
+                "unpacking entry '{name}' takes the archive past {}, the limit on the unpacked size of one FMU; if it is genuine, raise the limit (CLI --max-fmu-size, library Limits::max_size)",
+                hs(l.max_size)
+            ))
+        }
+    }
+}
+
+/// A `modelIdentifier` names the binary `binaries/<platform>/<modelIdentifier>.<ext>` (FMI 2.0,
+/// sec. 2.3) and is "a short class name according to C-syntax" (FMI 2.0, sec. 4.3.1): a file
+/// name, never a path. Separators, `..`, control characters and an empty name are refused.
+fn check_model_identifier(fmu: &Path, id: &str) -> Result<()> {
+    let bad = id.is_empty()
+        || id == "."
+        || id == ".."
+        || id.contains(['/', '\\'])
+        || id.chars().any(char::is_control);
+    match bad {
+        true => Err(Error::fmu(
+            fmu,
+            format!(
+                "modelIdentifier {id:?} is not a file name (FMI 2.0, sec. 4.3.1: a C identifier); refused"
+            ),
+        )),
+        false => Ok(()),
     }
 }
 
@@ -207,11 +503,16 @@ pub fn load_count() -> usize {
 }
 
 impl Fmu {
-    /// Unpacks, parses, checks and loads an FMU.
+    /// Unpacks, parses, checks and loads an FMU (default [`Unpack`] options).
     pub fn load(path: impl AsRef<Path>) -> Result<Fmu> {
+        Fmu::load_with(path, &Unpack::default())
+    }
+
+    /// Unpacks (see [`Unpack`]), parses, checks and loads an FMU.
+    pub fn load_with(path: impl AsRef<Path>, unpack: &Unpack) -> Result<Fmu> {
         let path = path.as_ref();
         LOADS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-        let unpacked = UnpackedFmu::open(path)?;
+        let unpacked = UnpackedFmu::open_with(path, unpack)?;
         let cs = unpacked.check()?.clone();
         let bin = unpacked.binary_path()?;
         let (lib, uses_python) = open_binary(path, &unpacked, &cs, &bin)?;

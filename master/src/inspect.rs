@@ -10,7 +10,7 @@
 mod html;
 
 use crate::error::{Error, Result};
-use crate::fmu::UnpackedFmu;
+use crate::fmu::{Unpack, UnpackedFmu};
 use crate::model_description::{Causality, ModelDescription, ScalarVariable};
 use std::collections::HashMap;
 use std::fmt::Write;
@@ -20,8 +20,8 @@ use std::path::{Path, PathBuf};
 pub const WIDTH: usize = 100;
 
 /// Renders the model description of an FMU (without loading its binary).
-pub fn inspect(path: &Path) -> Result<String> {
-    let u = UnpackedFmu::open(path)?;
+pub fn inspect(path: &Path, unpack: &Unpack) -> Result<String> {
+    let u = UnpackedFmu::open_with(path, unpack)?;
     let cs = u.check()?;
     let bin = u.binary_path();
     let md = &u.model_description;
@@ -300,8 +300,8 @@ fn format_number(x: f64) -> String {
 
 /// The FMU's `documentation/index.html` as plain text, [`WIDTH`] columns wide. An FMU without
 /// one is an error that lists what its `documentation/` folder holds.
-pub fn doc_text(path: &Path) -> Result<String> {
-    let u = UnpackedFmu::open(path)?;
+pub fn doc_text(path: &Path, unpack: &Unpack) -> Result<String> {
+    let u = UnpackedFmu::open_with(path, unpack)?;
     let index = u.dir.path().join("documentation/index.html");
     let bytes = std::fs::read(&index).map_err(|_| no_index(path, &u))?;
     Ok(html::to_text(&String::from_utf8_lossy(&bytes), WIDTH))
@@ -349,8 +349,8 @@ fn doc_files(dir: &Path) -> Vec<PathBuf> {
 
 /// Copies the FMU's `documentation/` folder into `out` (created if needed); returns the files
 /// written. An FMU without documentation is an error.
-pub fn extract_doc(path: &Path, out: &Path) -> Result<Vec<PathBuf>> {
-    let u = UnpackedFmu::open(path)?;
+pub fn extract_doc(path: &Path, out: &Path, unpack: &Unpack) -> Result<Vec<PathBuf>> {
+    let u = UnpackedFmu::open_with(path, unpack)?;
     let src = u.dir.path().join("documentation");
     let files = doc_files(&src);
     if files.is_empty() {

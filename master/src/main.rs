@@ -4,13 +4,15 @@ mod cli;
 
 use clap::{Parser, Subcommand};
 use shipsim::error::Error;
-use shipsim::fmu::UnpackedFmu;
+use shipsim::fmu::{Unpack, UnpackedFmu};
+use shipsim::limits::Limits;
 use shipsim::run::{
-    checkpoint_step, prepare, resume, run, Checkpoint, CheckpointRequest, Output, RunOptions,
+    checkpoint_step, prepare_with, resume, run, Checkpoint, CheckpointRequest, Output, RunOptions,
     Sampling,
 };
 use shipsim::system::{Algorithm, System};
 use std::io::IsTerminal;
+use std::os::unix::fs::{MetadataExt, PermissionsExt};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -91,6 +93,8 @@ enum Command {
         /// --stop-time); the output has the rows from the checkpoint's time on.
         #[arg(long, value_name = "FILE")]
         resume: Option<PathBuf>,
+        #[command(flatten)]
+        limits: LimitArgs,
     },
     /// Validate a system without running it: everything `run` checks before the first step
     /// (names, types, units, declared ranges, connections, events, outputs).
@@ -105,6 +109,8 @@ enum Command {
         /// OspSystemStructure.xml only warns, as libcosim runs it; the native TOML always errs).
         #[arg(long)]
         strict_units: bool,
+        #[command(flatten)]
+        limits: LimitArgs,
     },
     /// Show an FMU's variables by causality (type, start, unit and display unit, range,
     /// description) and capabilities, or with --doc its documentation.
@@ -119,6 +125,8 @@ enum Command {
         /// DIR instead, to open index.html in a browser.
         #[arg(long, value_name = "DIR", requires = "doc")]
         html: Option<PathBuf>,
+        #[command(flatten)]
+        limits: LimitArgs,
     },
     /// Statistics of a recorded CSV per column over a time window: mean, variance, std, RMS,
     /// min, max and max |x|.
@@ -148,9 +156,106 @@ enum Command {
     },
 }
 
+/// Limits on unpacking FMU archives ([`Limits`]; their defaults in brackets).
+#[derive(clap::Args)]
+struct LimitArgs {
+    /// Refuse an FMU archive that unpacks to more than SIZE in total: bytes, or with K, M, G
+    /// or T (powers of 1024) [default: 1G].
+    #[arg(long, value_name = "SIZE", value_parser = parse_size_arg)]
+    max_fmu_size: Option<u64>,
+    /// Refuse an FMU archive of more than N entries [default: 10000].
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
+    max_fmu_files: Option<u64>,
+    /// Refuse an FMU archive with an entry of more than 1 MiB that unpacks to more than R
+    /// times its compressed size (a zip bomb) [default: 200].
+    #[arg(long, value_name = "R", value_parser = clap::value_parser!(u64).range(1..))]
+    max_fmu_ratio: Option<u64>,
+}
+
+fn parse_size_arg(s: &str) -> Result<u64, String> {
+    shipsim::limits::parse_size(s)
+}
+
+impl LimitArgs {
+    fn limits(&self) -> Limits {
+        let d = Limits::default();
+        Limits {
+            max_size: self.max_fmu_size.unwrap_or(d.max_size),
+            max_files: self.max_fmu_files.unwrap_or(d.max_files),
+            max_ratio: self.max_fmu_ratio.unwrap_or(d.max_ratio),
+        }
+    }
+}
+
+/// The process-wide state of the command line (the library has none): the flag the first
+/// SIGINT, SIGTERM or SIGHUP sets, and a private temporary directory.
+struct Session {
+    /// Set by the first signal: a run stops cleanly at its next step, an FMU being unpacked
+    /// stops at its next entry. A second signal removes [`Session::tmp`] and exits at once
+    /// (status 130): for an FMU that hangs in a call.
+    interrupt: Arc<AtomicBool>,
+    /// `$TMPDIR/shipsim-*` (mode 0700). `TMPDIR` is pointed into it, so every FMU the process
+    /// unpacks (and every temporary file of the process and of its children) lies inside.
+    /// Removed when `main` returns, while a panic unwinds out of it, and by the signal
+    /// handler before it exits.
+    tmp: Option<tempfile::TempDir>,
+}
+
+impl Session {
+    /// Creates the directory (first, while the process has one thread: `TMPDIR` is set
+    /// here) and installs the signal handler.
+    fn start() -> Session {
+        let tmp = tempfile::Builder::new()
+            .prefix("shipsim-")
+            .permissions(std::fs::Permissions::from_mode(0o700))
+            .tempdir()
+            .ok();
+        if let Some(t) = &tmp {
+            std::env::set_var("TMPDIR", t.path());
+        }
+        let interrupt = Arc::new(AtomicBool::new(false));
+        let (flag, dir) = (
+            interrupt.clone(),
+            tmp.as_ref().map(|t| t.path().to_path_buf()),
+        );
+        let _ = ctrlc::set_handler(move || {
+            if flag.swap(true, Ordering::SeqCst) {
+                if let Some(d) = &dir {
+                    remove_tree(d);
+                }
+                std::process::exit(130);
+            }
+        });
+        Session { interrupt, tmp }
+    }
+
+    /// How FMUs are unpacked: into [`Session::tmp`], under `limits`, stopped by a signal.
+    fn unpack(&self, limits: &LimitArgs) -> Unpack {
+        Unpack {
+            limits: limits.limits(),
+            parent: self.tmp.as_ref().map(|t| t.path().to_path_buf()),
+            interrupt: Some(self.interrupt.clone()),
+        }
+    }
+}
+
+/// Removes a directory tree that another thread may still be writing into (an FMU being
+/// unpacked): a few attempts.
+fn remove_tree(dir: &Path) {
+    for _ in 0..5 {
+        if std::fs::remove_dir_all(dir).is_ok() || !dir.exists() {
+            return;
+        }
+    }
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
-    match dispatch(cli.command) {
+    let session = Session::start();
+    let result = dispatch(cli.command, &session);
+    let interrupted = session.interrupt.load(Ordering::SeqCst);
+    drop(session);
+    match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(Error::Interrupted { time }) if time.is_nan() => {
             eprintln!("interrupted; finished runs are kept, run the same command again to resume");
@@ -162,6 +267,10 @@ fn main() -> ExitCode {
             );
             ExitCode::from(130)
         }
+        Err(e) if interrupted => {
+            eprintln!("interrupted: {e}");
+            ExitCode::from(130)
+        }
         Err(e) => {
             eprintln!("error: {e}");
             ExitCode::FAILURE
@@ -169,15 +278,21 @@ fn main() -> ExitCode {
     }
 }
 
-fn dispatch(cmd: Command) -> shipsim::Result<()> {
+fn dispatch(cmd: Command, session: &Session) -> shipsim::Result<()> {
     match cmd {
         Command::Plot(args) => plot(args),
-        Command::Inspect { fmu, doc, html } => inspect(&fmu, doc, html.as_deref()),
+        Command::Inspect {
+            fmu,
+            doc,
+            html,
+            limits,
+        } => inspect(&fmu, doc, html.as_deref(), &session.unpack(&limits)),
         Command::Check {
             system,
             set,
             strict_units,
-        } => check(&system, &set, strict_units),
+            limits,
+        } => check(&system, &set, strict_units, &session.unpack(&limits)),
         Command::Run {
             system,
             stop_time,
@@ -193,6 +308,7 @@ fn dispatch(cmd: Command) -> shipsim::Result<()> {
             quiet,
             checkpoint_at,
             resume,
+            limits,
         } => {
             let checkpoints = Checkpoints {
                 at: checkpoint_at.map(parse_checkpoint_at).transpose()?,
@@ -218,22 +334,24 @@ fn dispatch(cmd: Command) -> shipsim::Result<()> {
                 verbose,
                 quiet,
             };
-            run_cli(&sys, &flags, checkpoints)
+            run_cli(&sys, &flags, checkpoints, session, &limits)
         }
         Command::ExportOsp { system, output } => export_osp(&system, output),
         Command::ExportSsp { system, output } => export_ssp(&system, output),
-        Command::Campaign { command } => cli::campaign::dispatch(command, ctrl_c_flag),
+        Command::Campaign { command } => {
+            cli::campaign::dispatch(command, || session.interrupt.clone())
+        }
         Command::Stats(args) => cli::stats::run(&args),
     }
 }
 
 /// `shipsim inspect [--doc [--html DIR]]`.
-fn inspect(fmu: &Path, doc: bool, html: Option<&Path>) -> shipsim::Result<()> {
+fn inspect(fmu: &Path, doc: bool, html: Option<&Path>, unpack: &Unpack) -> shipsim::Result<()> {
     match (doc, html) {
-        (false, _) => print!("{}", shipsim::inspect::inspect(fmu)?),
-        (true, None) => print!("{}", shipsim::inspect::doc_text(fmu)?),
+        (false, _) => print!("{}", shipsim::inspect::inspect(fmu, unpack)?),
+        (true, None) => print!("{}", shipsim::inspect::doc_text(fmu, unpack)?),
         (true, Some(dir)) => {
-            let files = shipsim::inspect::extract_doc(fmu, dir)?;
+            let files = shipsim::inspect::extract_doc(fmu, dir, unpack)?;
             let index = dir.join("index.html");
             match index.is_file() {
                 true => println!("wrote {} files; open {}", files.len(), index.display()),
@@ -242,18 +360,6 @@ fn inspect(fmu: &Path, doc: bool, html: Option<&Path>) -> shipsim::Result<()> {
         }
     }
     Ok(())
-}
-
-/// A flag that the first Ctrl-C sets (to stop cleanly); a second one exits at once.
-fn ctrl_c_flag() -> Arc<AtomicBool> {
-    let flag = Arc::new(AtomicBool::new(false));
-    let f = flag.clone();
-    let _ = ctrlc::set_handler(move || {
-        if f.swap(true, Ordering::SeqCst) {
-            std::process::exit(130);
-        }
-    });
-    flag
 }
 
 /// The arguments of `shipsim plot`.
@@ -343,14 +449,19 @@ fn print_warnings(warnings: &[String]) {
 
 /// `shipsim check`: the system validated against the FMUs' model descriptions (binaries are
 /// not loaded).
-fn check(system: &Path, set: &[String], strict_units: bool) -> shipsim::Result<()> {
+fn check(
+    system: &Path,
+    set: &[String],
+    strict_units: bool,
+    unpack: &Unpack,
+) -> shipsim::Result<()> {
     let mut sys = System::load(system)?;
     sys.apply_overrides(set)?;
     sys.strict_units |= strict_units;
     let mut unpacked = Vec::new();
     for inst in &sys.instances {
         sys.require_fmu(inst)?;
-        let u = UnpackedFmu::open(&inst.fmu)?;
+        let u = UnpackedFmu::open_with(&inst.fmu, unpack)?;
         u.binary_path()?;
         unpacked.push(u);
     }
@@ -413,7 +524,13 @@ struct RunFlags {
 /// `shipsim run`: Ctrl-C stops the run cleanly (a second one exits at once); warnings, then
 /// the run, then its summary on stderr (and the profile, if asked for: a table on stderr or
 /// JSON on stdout).
-fn run_cli(sys: &System, flags: &RunFlags, checkpoints: Checkpoints) -> shipsim::Result<()> {
+fn run_cli(
+    sys: &System,
+    flags: &RunFlags,
+    checkpoints: Checkpoints,
+    session: &Session,
+    limits: &LimitArgs,
+) -> shipsim::Result<()> {
     let begin = Instant::now();
     let (verbose, quiet) = (flags.verbose, flags.quiet);
     let out_file = match flags.no_output {
@@ -424,20 +541,21 @@ fn run_cli(sys: &System, flags: &RunFlags, checkpoints: Checkpoints) -> shipsim:
         Some(p) => Output::File(p.clone()),
         None => Output::None,
     };
-    let flag = Arc::new(AtomicBool::new(false));
-    {
-        let f = flag.clone();
-        // A second Ctrl-C while shutting down falls back to the default behaviour.
-        let _ = ctrlc::set_handler(move || {
-            if f.swap(true, Ordering::SeqCst) {
-                std::process::exit(130);
-            }
-        });
+    for (what, file) in [
+        ("output file", out_file.as_deref()),
+        (
+            "checkpoint file",
+            checkpoints.at.as_ref().map(|(_, f)| f.as_path()),
+        ),
+    ] {
+        if let Some(f) = file {
+            refuse_input(sys, what, f)?;
+        }
     }
     let mut opts = RunOptions {
         verbose,
         progress: !quiet && std::io::stderr().is_terminal(),
-        interrupt: Some(flag),
+        interrupt: Some(session.interrupt.clone()),
         log_sink: None,
         checkpoint: None,
         profile: flags.profile.map(|(_, every)| match every {
@@ -445,7 +563,7 @@ fn run_cli(sys: &System, flags: &RunFlags, checkpoints: Checkpoints) -> shipsim:
             None => Sampling::default(),
         }),
     };
-    let (plan, fmus) = prepare(sys)?;
+    let (plan, fmus) = prepare_with(sys, &session.unpack(limits))?;
     print_warnings(&plan.warnings);
     if !quiet && !flags.no_output {
         output_note(sys, out_file.as_deref());
@@ -482,6 +600,26 @@ fn run_cli(sys: &System, flags: &RunFlags, checkpoints: Checkpoints) -> shipsim:
         _ => {}
     }
     Ok(())
+}
+
+/// A file the run writes (`what`: "output file") must not be one it reads: the system file or
+/// an instance's FMU (the same file, also through another path or a hard link).
+fn refuse_input(sys: &System, what: &str, file: &Path) -> shipsim::Result<()> {
+    let Ok(target) = std::fs::metadata(file) else {
+        return Ok(());
+    };
+    let same = |p: &Path| {
+        std::fs::metadata(p).is_ok_and(|m| m.dev() == target.dev() && m.ino() == target.ino())
+    };
+    let input = match sys.instances.iter().find(|i| same(&i.fmu)) {
+        _ if same(&sys.source) => format!("the system file {}", sys.source.display()),
+        Some(i) => format!("the FMU {} of instance '{}'", i.fmu.display(), i.name),
+        None => return Ok(()),
+    };
+    Err(Error::Other(format!(
+        "the {what} {} is {input}; refusing to overwrite it (choose another file)",
+        file.display()
+    )))
 }
 
 /// One line on stderr about the output before a run: that nothing will be written and how to

@@ -479,6 +479,16 @@ impl ModelDescription {
             .map_or(&[], |c| c.couplings.as_slice())
     }
 
+    /// The first variable name declared twice, if any (names are unique, FMI 2.0, sec. 2.2.7).
+    pub fn duplicate_variable_name(&self) -> Option<&str> {
+        let mut seen = std::collections::HashSet::new();
+        self.model_variables
+            .variables
+            .iter()
+            .map(|v| v.name.as_str())
+            .find(|&n| !seen.insert(n))
+    }
+
     /// Name -> index map of the model variables.
     pub fn variable_index(&self) -> HashMap<String, usize> {
         self.model_variables

@@ -281,8 +281,7 @@ struct Reader<'a> {
 impl CampaignSpec {
     /// Reads and checks a campaign file (the base system is read by [`super::Campaign::load`]).
     pub fn load(path: &Path) -> Result<CampaignSpec> {
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| Error::io(format!("cannot read campaign file {}", path.display()), e))?;
+        let text = crate::limits::read_text(path, crate::limits::MAX_SYSTEM_FILE, "campaign file")?;
         CampaignSpec::parse(path, &text)
     }
 

@@ -26,8 +26,7 @@ impl System {
             .extension()
             .map(|e| e.eq_ignore_ascii_case("xml"))
             .unwrap_or(false);
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| Error::system(path, None, format!("cannot read: {e}")))?;
+        let text = crate::limits::read_text(path, crate::limits::MAX_SYSTEM_FILE, "system file")?;
         if is_xml {
             osp::parse(path, &text)
         } else {

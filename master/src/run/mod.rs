@@ -164,6 +164,11 @@ fn off_grid_line(o: &OffGrid) -> String {
 
 /// Loads each distinct FMU once (instances of the same file share one loaded library).
 pub fn load_fmus(system: &System) -> Result<Vec<Arc<Fmu>>> {
+    load_fmus_with(system, &crate::fmu::Unpack::default())
+}
+
+/// [`load_fmus`] with the archives unpacked under `unpack` (limits, directory, interrupt).
+pub fn load_fmus_with(system: &System, unpack: &crate::fmu::Unpack) -> Result<Vec<Arc<Fmu>>> {
     let mut cache: HashMap<PathBuf, Arc<Fmu>> = HashMap::new();
     let mut out = Vec::new();
     for inst in &system.instances {
@@ -183,7 +188,7 @@ pub fn load_fmus(system: &System) -> Result<Vec<Arc<Fmu>>> {
             }
             None => {
                 system.require_fmu(inst)?;
-                let f = Arc::new(Fmu::load(&inst.fmu).map_err(|e| match e {
+                let f = Arc::new(Fmu::load_with(&inst.fmu, unpack).map_err(|e| match e {
                     Error::Fmu { path, message } => Error::Fmu {
                         path,
                         message: format!("(instance '{}') {message}", inst.name),
@@ -516,7 +521,12 @@ fn execute<A: Algorithm>(
 /// Loads a system's FMUs and validates it against their model descriptions. The plan's
 /// warnings are for the caller to show.
 pub fn prepare(system: &System) -> Result<(Plan, Vec<Arc<Fmu>>)> {
-    let fmus = load_fmus(system)?;
+    prepare_with(system, &crate::fmu::Unpack::default())
+}
+
+/// [`prepare`] with the archives unpacked under `unpack` (limits, directory, interrupt).
+pub fn prepare_with(system: &System, unpack: &crate::fmu::Unpack) -> Result<(Plan, Vec<Arc<Fmu>>)> {
+    let fmus = load_fmus_with(system, unpack)?;
     let mds: Vec<&ModelDescription> = fmus.iter().map(|f| &f.model_description).collect();
     let plan = system.validate(&mds)?;
     Ok((plan, fmus))

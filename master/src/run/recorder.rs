@@ -90,16 +90,78 @@ pub trait Recorder {
 }
 
 /// The CSV file of `shipsim run`: header `time,instance.variable,...`, one line per row.
-/// Numbers are written in Rust's shortest round-trip digits, so values survive the file exactly
-/// ([`write_real`]: plain decimal, with an exponent for very small and very large magnitudes);
-/// Booleans are written 0 or 1.
+/// Header fields are quoted as RFC 4180 says (by the `csv` crate: a name with a comma, a
+/// quote or a line break is enclosed in quotes, its quotes doubled), so a name never shifts
+/// the columns. Numbers are written in Rust's shortest round-trip digits, so values survive
+/// the file exactly ([`write_real`]: plain decimal, with an exponent for very small and very
+/// large magnitudes); Booleans are written 0 or 1.
+///
+/// The output is flushed at least once a second of wall time ([`FlushClock`]), so a process
+/// killed by a crashing FMU loses at most about the last second of rows.
 pub struct CsvRecorder {
     out: Box<dyn Write>,
+    clock: FlushClock,
 }
 
 impl CsvRecorder {
     pub fn new(out: Box<dyn Write>) -> CsvRecorder {
-        CsvRecorder { out }
+        CsvRecorder {
+            out,
+            clock: FlushClock::new(std::time::Duration::from_secs(1)),
+        }
+    }
+}
+
+/// When to flush a stream of rows: when `period` of wall time has passed since the last
+/// flush. The clock is read only every `every` rows, a number that adapts so that the reads
+/// are between about 10 ms and 100 ms of wall time apart (it doubles when they come faster,
+/// halves when slower): a fast run reads the clock once in up to 4,096 rows, a slow one at
+/// every row. No allocation.
+pub struct FlushClock {
+    period: std::time::Duration,
+    last_flush: std::time::Instant,
+    last_check: std::time::Instant,
+    every: u32,
+    rows: u32,
+}
+
+impl FlushClock {
+    pub fn new(period: std::time::Duration) -> FlushClock {
+        let now = std::time::Instant::now();
+        FlushClock {
+            period,
+            last_flush: now,
+            last_check: now,
+            every: 1,
+            rows: 0,
+        }
+    }
+
+    /// Counts one row; true when the stream is due to be flushed.
+    #[inline]
+    pub fn row(&mut self) -> bool {
+        self.rows += 1;
+        if self.rows < self.every {
+            return false;
+        }
+        self.rows = 0;
+        self.check(std::time::Instant::now())
+    }
+
+    #[cold]
+    fn check(&mut self, now: std::time::Instant) -> bool {
+        let since = now.duration_since(self.last_check);
+        self.last_check = now;
+        if since < std::time::Duration::from_millis(10) && self.every < 4096 {
+            self.every *= 2;
+        } else if since > std::time::Duration::from_millis(100) && self.every > 1 {
+            self.every /= 2;
+        }
+        let due = now.duration_since(self.last_flush) >= self.period;
+        if due {
+            self.last_flush = now;
+        }
+        due
     }
 }
 
@@ -131,15 +193,18 @@ fn write_error(e: std::io::Error) -> Error {
 
 impl Recorder for CsvRecorder {
     fn start(&mut self, columns: &[ColumnInfo], _expected_rows: u64) -> Result<()> {
-        let mut header = String::from("time");
-        for c in columns {
-            header.push(',');
-            header.push_str(&c.name);
-        }
-        header.push('\n');
-        self.out
-            .write_all(header.as_bytes())
-            .map_err(|e| Error::io("writing the output header", e))
+        let header_error = |e| Error::io("writing the output header", e);
+        let mut w = csv::WriterBuilder::new()
+            .terminator(csv::Terminator::Any(b'\n'))
+            .from_writer(Vec::new());
+        let names = std::iter::once("time").chain(columns.iter().map(|c| c.name.as_str()));
+        w.write_record(names)
+            .map_err(|e| header_error(std::io::Error::other(e)))?;
+        let header = w
+            .into_inner()
+            .map_err(|e| header_error(std::io::Error::other(e.to_string())))?;
+        self.out.write_all(&header).map_err(header_error)?;
+        self.out.flush().map_err(header_error)
     }
 
     #[inline]
@@ -156,7 +221,11 @@ impl Recorder for CsvRecorder {
             }
             .map_err(write_error)?;
         }
-        self.out.write_all(b"\n").map_err(write_error)
+        self.out.write_all(b"\n").map_err(write_error)?;
+        if self.clock.row() {
+            self.out.flush().map_err(write_error)?;
+        }
+        Ok(())
     }
 
     fn finish(&mut self) -> Result<()> {

@@ -64,12 +64,13 @@ pub fn load(path: &Path) -> Result<System> {
     if !path.is_file() {
         return Err(Error::system(path, None, "cannot read: no such file"));
     }
-    let dir = crate::fmu::unpack_archive(path).map_err(|e| match e {
-        Error::Fmu { message, .. } => {
-            Error::system(path, None, message.replace("FMU (zip)", "SSP (zip)"))
-        }
-        e => e,
-    })?;
+    let dir =
+        crate::fmu::unpack_archive(path, &crate::fmu::Unpack::default()).map_err(|e| match e {
+            Error::Fmu { message, .. } => {
+                Error::system(path, None, message.replace("FMU (zip)", "SSP (zip)"))
+            }
+            e => e,
+        })?;
     let ssd = dir.path().join(DEFAULT_SSD);
     if !ssd.is_file() {
         return Err(Error::system(

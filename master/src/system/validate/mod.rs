@@ -32,6 +32,23 @@ mod outputs;
 mod values;
 mod variability;
 
+/// The most base steps a run may have: 2^53, up to which every step index k is an exact
+/// double, so that t0 + k*h names distinct, ordered steps.
+pub const MAX_STEPS: u64 = 1 << 53;
+
+/// A run of more base steps than this (10^9) gets a warning that says how many.
+pub const WARN_STEPS: u64 = 1_000_000_000;
+
+/// A number for a message: plain when that is short (`0.01`, `3600`), else with an exponent
+/// (`1e300`, `5e-324`), never hundreds of digits.
+fn short(x: f64) -> String {
+    let a = x.abs();
+    match a != 0.0 && a.is_finite() && !(1e-6..1e15).contains(&a) {
+        true => format!("{x:e}"),
+        false => format!("{x}"),
+    }
+}
+
 /// The base-step grid of a run.
 struct Grid {
     /// Number of base steps: the run ends at t0 + n_steps*h.
@@ -73,6 +90,7 @@ impl System {
         let events = c.events(&grid, &driven);
         let outputs = c.outputs();
         let order = c.order(&connections);
+        c.step_multiple_range(&grid);
         c.step_multiples(grid.n_steps);
         c.shared_guids();
         c.invalid_variability();
@@ -129,50 +147,58 @@ impl<'a> Checker<'a> {
             .map(|v| v.name.as_str())
     }
 
-    /// The time grid: a positive step, a stop after the start, at least one step. A stop time
-    /// off the grid is a warning (the run ends at the last grid point before it), or with
-    /// `last_step = "short"` one more, shorter step to it ([`Checker::short_last_step`]).
+    /// The time grid: finite times, a positive finite step, a stop after the start, at least
+    /// one step and at most [`MAX_STEPS`] (more than [`WARN_STEPS`] is a warning that says
+    /// how many). A stop time off the grid is a warning (the run ends at the last grid point
+    /// before it), or with `last_step = "short"` one more, shorter step to it
+    /// ([`Checker::short_last_step`]). Numbers in messages are short ([`short`]).
     fn grid(&mut self) -> Grid {
         let sys = self.sys;
-        if !(sys.step_size > 0.0 && sys.step_size.is_finite()) {
-            let e = self.err(
-                None,
-                format!(
-                    "step_size = {}; it must be a positive number",
-                    sys.step_size
-                ),
-            );
-            self.errors.push(e);
-        }
-        let stop = sys.stop_time.unwrap_or(sys.start_time + 1.0);
-        if !(stop > sys.start_time) {
-            let e = self.err(
-                None,
-                format!(
-                    "stop_time = {stop} must be greater than start_time = {}",
-                    sys.start_time
-                ),
-            );
-            self.errors.push(e);
-        }
-        let ratio = (stop - sys.start_time) / sys.step_size;
-        let mut n_steps = if ratio.is_finite() && ratio > 0.0 {
-            (ratio + 1e-9 * ratio.max(1.0)).floor() as u64
-        } else {
-            0
+        let (t0, h) = (sys.start_time, sys.step_size);
+        let stop = sys.stop_time.unwrap_or(t0 + 1.0);
+        let fail = |c: &mut Self, m: String| {
+            let e = c.err(None, m);
+            c.errors.push(e);
         };
-        if n_steps == 0 && self.errors.is_empty() {
-            let e = self.err(
-                None,
+        if !(h > 0.0 && h.is_finite()) {
+            fail(
+                self,
+                format!("step_size = {}; it must be a positive number", short(h)),
+            );
+        }
+        if !t0.is_finite() {
+            fail(
+                self,
+                format!("start_time = {}; it must be a finite number", short(t0)),
+            );
+        } else if !stop.is_finite() && !stop.is_nan() {
+            fail(
+                self,
+                format!("stop_time = {}; it must be a finite number", short(stop)),
+            );
+        } else if !(stop > t0) {
+            fail(
+                self,
                 format!(
-                    "the run from {} to {stop} is shorter than one step of {}",
-                    sys.start_time, sys.step_size
+                    "stop_time = {} must be greater than start_time = {}",
+                    short(stop),
+                    short(t0)
                 ),
             );
-            self.errors.push(e);
+        }
+        let ratio = (stop - t0) / h;
+        let mut n_steps = 0;
+        if self.errors.is_empty() {
+            match self.step_count(t0, stop, h, ratio) {
+                Ok(n) => n_steps = n,
+                Err(m) => fail(self, m),
+            }
+        }
+        if n_steps == 0 {
+            // An error was reported; a grid of one step lets the other checks go on.
             n_steps = 1;
         }
-        let stop_on_grid = sys.start_time + n_steps as f64 * sys.step_size;
+        let stop_on_grid = t0 + n_steps as f64 * h;
         let off =
             self.errors.is_empty() && (stop_on_grid - stop).abs() > 1e-9 * stop.abs().max(1.0);
         let grid = Grid {
@@ -194,6 +220,49 @@ impl<'a> Checker<'a> {
             }
             (true, LastStep::Short) => self.short_last_step(grid, stop),
         }
+    }
+
+    /// The number of base steps from t0 to stop (finite, stop > t0, h > 0): at least one,
+    /// at most [`MAX_STEPS`], each long enough to move the time at t0 and at stop; more
+    /// than [`WARN_STEPS`] is a warning.
+    fn step_count(
+        &mut self,
+        t0: f64,
+        stop: f64,
+        h: f64,
+        ratio: f64,
+    ) -> std::result::Result<u64, String> {
+        let run = format!("the run from {} to {}", short(t0), short(stop));
+        if !(ratio < MAX_STEPS as f64) {
+            return Err(format!(
+                "{run} has {} steps of {} s, more than the {} a run can count exactly (t = t0 + k*h); use a larger step_size or a shorter run",
+                short(ratio.floor()),
+                short(h),
+                short(MAX_STEPS as f64)
+            ));
+        }
+        if t0 + h == t0 || stop - h == stop {
+            return Err(format!(
+                "{run}: a step of {} s does not change the time at t = {} (below the resolution of a double there); use a larger step_size",
+                short(h),
+                short(if t0 + h == t0 { t0 } else { stop })
+            ));
+        }
+        // A ratio a rounding below a whole number (0.3 / 0.1 = 2.9999999999999996) counts
+        // as that number: a relative 1e-9, at most 1e-3 of a step (uncapped, 1e10 steps
+        // gained 10 more).
+        let n = (ratio + (1e-9 * ratio.max(1.0)).min(1e-3)).floor() as u64;
+        if n == 0 {
+            return Err(format!("{run} is shorter than one step of {}", short(h)));
+        }
+        if n > WARN_STEPS {
+            self.warnings.push(format!(
+                "{}: {run} has {n} macro steps of {} s; it may take long (Ctrl-C stops it cleanly)",
+                self.loc(None),
+                short(h),
+            ));
+        }
+        Ok(n)
     }
 
     /// `last_step = "short"` with a stop time off the grid: one more base step, ending at the
@@ -225,6 +294,30 @@ impl<'a> Checker<'a> {
             n_steps: grid.n_steps + 1,
             stop_on_grid: stop,
             ..grid
+        }
+    }
+
+    /// Every instance steps every m base steps with 1 <= m <= the run's steps: a reader that
+    /// makes m from a step size (OSP `stepSize` / `BaseStepSize`) gives 0 for NaN and the
+    /// largest u32 for an infinite or huge one, and an instance whose step is longer than the
+    /// run would never step.
+    fn step_multiple_range(&mut self, grid: &Grid) {
+        let sys = self.sys;
+        for inst in &sys.instances {
+            let m = inst.step_multiple;
+            if m == 0 || u64::from(m) > grid.n_steps {
+                let step = f64::from(m) * sys.step_size;
+                let e = self.err(
+                    inst.line,
+                    format!(
+                        "instance '{}': step_multiple = {m} (a step of {} s); it must be a whole number of base steps from 1 to the run's {} (a step size that is not a number, infinite, or longer than the run?)",
+                        inst.name,
+                        short(step),
+                        grid.n_steps
+                    ),
+                );
+                self.errors.push(e);
+            }
         }
     }
 
