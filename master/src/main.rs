@@ -5,7 +5,7 @@ use clap::{Parser, Subcommand};
 use shipsim::error::Error;
 use shipsim::fmu::UnpackedFmu;
 use shipsim::run::{
-    checkpoint_step, prepare, resume, run, Checkpoint, CheckpointRequest, Output, RunOptions,
+    checkpoint_step, prepare_for, resume, run, Checkpoint, CheckpointRequest, Output, RunOptions,
     Sampling,
 };
 use shipsim::system::{Algorithm, System};
@@ -90,7 +90,21 @@ enum Command {
         /// --stop-time); the output has the rows from the checkpoint's time on.
         #[arg(long, value_name = "FILE")]
         resume: Option<PathBuf>,
+        /// Run FMU instances in their own processes, so that a crash, exit() or hang of an FMU
+        /// is an error naming it and every completed step is kept: all of them (--isolate),
+        /// those of FMUs not built by this project (--isolate=foreign) or the named ones
+        /// (--isolate=NAME,NAME). See docs/isolation.md.
+        #[arg(long, num_args = 0..=1, require_equals = true, default_missing_value = "all", value_name = "all|foreign|NAMES")]
+        isolate: Option<String>,
+        /// The longest wall time of one FMI call [s]: an isolated instance's process is then
+        /// killed and the run fails naming the call; in process, shipsim exits with a message.
+        /// Default: no limit.
+        #[arg(long, value_name = "SECONDS")]
+        call_timeout: Option<f64>,
     },
+    /// Host one isolated FMU instance for a master (internal: started by `run --isolate`).
+    #[command(hide = true)]
+    FmuHost { fmu: PathBuf },
     /// Validate a system without running it: everything `run` checks before the first step
     /// (names, types, units, declared ranges, connections, events, outputs).
     Check {
@@ -141,6 +155,9 @@ enum Command {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    if let Command::FmuHost { fmu } = &cli.command {
+        return ExitCode::from(shipsim::isolate::host::serve(fmu) as u8);
+    }
     match dispatch(cli.command) {
         Ok(()) => ExitCode::SUCCESS,
         Err(Error::Interrupted { time }) if time.is_nan() => {
@@ -184,6 +201,8 @@ fn dispatch(cmd: Command) -> shipsim::Result<()> {
             quiet,
             checkpoint_at,
             resume,
+            isolate,
+            call_timeout,
         } => {
             let checkpoints = Checkpoints {
                 at: checkpoint_at.map(parse_checkpoint_at).transpose()?,
@@ -208,12 +227,14 @@ fn dispatch(cmd: Command) -> shipsim::Result<()> {
                 profile: profile.map(|f| (f, profile_every)),
                 verbose,
                 quiet,
+                isolation: cli::isolate::isolation(isolate.as_deref(), call_timeout)?,
             };
             run_cli(&sys, &flags, checkpoints)
         }
         Command::ExportOsp { system, output } => export_osp(&system, output),
         Command::Campaign { command } => cli::campaign::dispatch(command, ctrl_c_flag),
         Command::Stats(args) => cli::stats::run(&args),
+        Command::FmuHost { .. } => Ok(()),
     }
 }
 
@@ -398,6 +419,7 @@ struct RunFlags {
     profile: Option<(ProfileFormat, Option<u64>)>,
     verbose: bool,
     quiet: bool,
+    isolation: shipsim::isolate::Isolation,
 }
 
 /// `shipsim run`: Ctrl-C stops the run cleanly (a second one exits at once); warnings, then
@@ -434,8 +456,11 @@ fn run_cli(sys: &System, flags: &RunFlags, checkpoints: Checkpoints) -> shipsim:
             Some(every) => Sampling { every },
             None => Sampling::default(),
         }),
+        isolation: flags.isolation.clone(),
+        // An FMU in process that calls exit() or hangs is named (cli/isolate.rs).
+        monitor: Some(cli::isolate::guard(flags.isolation.call_timeout)),
     };
-    let (plan, fmus) = prepare(sys)?;
+    let (plan, fmus) = prepare_for(sys, &flags.isolation)?;
     print_warnings(&plan.warnings);
     if !quiet && !flags.no_output {
         output_note(sys, out_file.as_deref());

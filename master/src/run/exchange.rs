@@ -37,6 +37,10 @@ pub trait Kind {
     fn map(value: Self::Value, map: Self::Map) -> Self::Value;
     fn set<S>(inst: &mut Instance<S>, vrs: &[VR], values: &[Self::Value]) -> Result<()>;
     fn get<S: Readable>(inst: &mut Instance<S>, vrs: &[VR], out: &mut [Self::Value]) -> Result<()>;
+    /// The value as text when it is not finite (a Real NaN or infinity), else None.
+    fn non_finite(_value: Self::Value) -> Option<String> {
+        None
+    }
 }
 
 /// `fmi2Real`.
@@ -73,6 +77,9 @@ impl Kind for Real {
     #[inline]
     fn get<S: Readable>(inst: &mut Instance<S>, vrs: &[VR], out: &mut [f64]) -> Result<()> {
         inst.get_real(vrs, out)
+    }
+    fn non_finite(value: f64) -> Option<String> {
+        (!value.is_finite()).then(|| value.to_string())
     }
 }
 
@@ -141,6 +148,8 @@ pub struct Port<K: Kind> {
     /// Connected inputs, in the order of the batched fmi2SetXxx.
     input_vrs: Vec<VR>,
     links: Vec<Link<K>>,
+    /// The connections' names ("a.y -> b.u"), for errors.
+    names: Vec<String>,
     scratch: Vec<K::Value>,
     observed: Observed,
 }
@@ -150,6 +159,7 @@ impl<K: Kind> Default for Port<K> {
         Port {
             input_vrs: Vec::new(),
             links: Vec::new(),
+            names: Vec::new(),
             scratch: Vec::new(),
             observed: Observed::default(),
         }
@@ -162,7 +172,8 @@ impl<K: Kind> Port<K> {
         self.input_vrs.is_empty() && self.observed.vrs.is_empty()
     }
 
-    fn connect(&mut self, vr: VR, source: usize, map: K::Map) {
+    fn connect(&mut self, vr: VR, source: usize, map: K::Map, name: &str) {
+        self.names.push(name.to_string());
         self.input_vrs.push(vr);
         self.links.push(Link { source, map });
         self.scratch.push(K::Value::default());
@@ -177,7 +188,28 @@ impl<K: Kind> Port<K> {
         for (x, l) in self.scratch.iter_mut().zip(&self.links) {
             *x = K::map(shared[l.source], l.map);
         }
-        K::set(inst, &self.input_vrs, &self.scratch)
+        K::set(inst, &self.input_vrs, &self.scratch).map_err(|e| self.blame_producer(e))
+    }
+
+    /// A refused set whose values hold a non-finite one: the error names the producer first
+    /// (the instance and variable the connection comes from), then the receiver's refusal.
+    #[cold]
+    #[inline(never)]
+    fn blame_producer(&self, e: crate::error::Error) -> crate::error::Error {
+        let bad = self
+            .scratch
+            .iter()
+            .zip(&self.names)
+            .find_map(|(v, name)| K::non_finite(*v).map(|v| (v, name)));
+        match bad {
+            Some((value, name)) => {
+                let from = name.split(" -> ").next().unwrap_or(name);
+                crate::error::Error::Other(format!(
+                    "'{from}' is {value} (its FMU returned it with fmi2OK), passed on by the connection {name}: {e}"
+                ))
+            }
+            None => e,
+        }
     }
 
     #[inline(always)]
@@ -318,9 +350,10 @@ impl Exchange {
                         gain: c.gain,
                         offset: c.offset,
                     },
+                    &c.name,
                 ),
-                VarType::Boolean => p.boolean.connect(c.to_vr, g, ()),
-                _ => p.integer.connect(c.to_vr, g, ()),
+                VarType::Boolean => p.boolean.connect(c.to_vr, g, (), &c.name),
+                _ => p.integer.connect(c.to_vr, g, (), &c.name),
             }
         }
         for p in ports.iter_mut() {
