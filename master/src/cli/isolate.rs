@@ -90,7 +90,7 @@ extern "C" fn on_exit() {
 /// Ends the process when one call stays in progress for `limit`.
 fn watchdog(monitor: &CallMonitor, limit: Duration) {
     let tick = (limit / 4).clamp(Duration::from_millis(10), Duration::from_millis(200));
-    let mut seen: Option<(u64, Instant)> = None;
+    let mut seen: Option<((u64, u64), Instant)> = None;
     loop {
         std::thread::sleep(tick);
         let Some(call) = monitor.in_progress() else {
@@ -98,7 +98,7 @@ fn watchdog(monitor: &CallMonitor, limit: Duration) {
             continue;
         };
         match seen {
-            Some((seq, since)) if seq == call.sequence => {
+            Some((key, since)) if key == call.key => {
                 if since.elapsed() + tick >= limit {
                     eprintln!(
                         "error: {call} did not return within {} s (--call-timeout); a call in process cannot be stopped, so shipsim exits (rows not yet written are lost; run with --isolate to stop only the FMU and keep every completed step)",
@@ -108,7 +108,7 @@ fn watchdog(monitor: &CallMonitor, limit: Duration) {
                     unsafe { libc::_exit(EXIT_FMU) };
                 }
             }
-            _ => seen = Some((call.sequence, Instant::now())),
+            _ => seen = Some((call.key, Instant::now())),
         }
     }
 }

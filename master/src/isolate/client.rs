@@ -146,7 +146,6 @@ impl Client {
     }
 
     /// Sends one call and waits for its reply; the status, or [`GONE`].
-    #[inline]
     fn request(&mut self, op: Op, args: impl FnOnce(&mut Vec<u8>)) -> fmi2Status {
         if self.failure.is_some() {
             return GONE;
@@ -450,7 +449,8 @@ impl Client {
         self.request(op, |_| {})
     }
 
-    #[inline]
+    // Out of line: the in-process path of the instance's calls stays small.
+    #[inline(never)]
     pub fn do_step(&mut self, t: f64, h: f64) -> i32 {
         self.time = t;
         let s = self.request(Op::DoStep, |o| {
@@ -463,7 +463,8 @@ impl Client {
         s
     }
 
-    #[inline]
+    // Out of line: the in-process path of the instance's calls stays small.
+    #[inline(never)]
     pub fn set<T: Copy>(&mut self, op: Op, vrs: &[u32], values: &[T]) -> i32
     where
         for<'a> &'a [T]: Put,
@@ -475,21 +476,22 @@ impl Client {
         })
     }
 
-    #[inline]
+    // Out of line: the in-process path of the instance's calls stays small.
+    #[inline(never)]
     pub fn get_real(&mut self, vrs: &[u32], out: &mut [f64]) -> i32 {
         let s = self.get(Op::GetReal, vrs);
         self.results().fill(out, Reader::f64);
         s
     }
 
-    #[inline]
+    // Out of line: the in-process path of the instance's calls stays small.
+    #[inline(never)]
     pub fn get_int(&mut self, op: Op, vrs: &[u32], out: &mut [i32]) -> i32 {
         let s = self.get(op, vrs);
         self.results().fill(out, Reader::i32);
         s
     }
 
-    #[inline]
     fn get(&mut self, op: Op, vrs: &[u32]) -> i32 {
         self.request(op, |o| {
             (vrs.len() as u32).put(o);

@@ -3,9 +3,9 @@
 //! `shipsim` with status 0) and its watchdog (`--call-timeout` in process). The library only
 //! records; it installs nothing.
 //!
-//! One writer (the thread that runs the instances) stores two words per call; readers on other
-//! threads (or in the `atexit` hook) load them. Nothing allocates after the instances are
-//! registered.
+//! One writer (the thread that runs the instances) stores one word before and one after each
+//! call (and the time at each step); readers on other threads (or in the `atexit` hook) load
+//! them. Nothing allocates after the instances are registered.
 
 use super::protocol::Op;
 use std::sync::atomic::{AtomicU64, Ordering::Relaxed};
@@ -14,7 +14,7 @@ use std::sync::Mutex;
 /// The call in progress of a run's in-process instances ([`crate::run::RunOptions::monitor`]).
 #[derive(Debug, Default)]
 pub struct CallMonitor {
-    /// `sequence << 24 | instance << 8 | op`; op 0: no call in progress.
+    /// `instance << 8 | op`; 0: no call in progress.
     state: AtomicU64,
     /// The simulation time of the instance's last step (its start time before the first).
     time: AtomicU64,
@@ -27,9 +27,9 @@ pub struct InProgress {
     pub instance: String,
     pub function: &'static str,
     pub time: f64,
-    /// Changes with every call: the same value seen twice, a while apart, is one call that
-    /// has not returned (the watchdog's test).
-    pub sequence: u64,
+    /// The call and the time as stored: the same key seen throughout a while is one call that
+    /// has not returned (the watchdog's test: the time changes with every step).
+    pub key: (u64, u64),
 }
 
 impl std::fmt::Display for InProgress {
@@ -57,9 +57,7 @@ impl CallMonitor {
     /// Instance `slot` starts call `op`.
     #[inline(always)]
     pub fn enter(&self, slot: u16, op: Op) {
-        let seq = (self.state.load(Relaxed) >> 24).wrapping_add(1);
-        self.state
-            .store(seq << 24 | (slot as u64) << 8 | op as u64, Relaxed);
+        self.state.store((slot as u64) << 8 | op as u64, Relaxed);
     }
 
     /// Instance `slot` starts a step from `t`.
@@ -72,7 +70,7 @@ impl CallMonitor {
     /// The call returned.
     #[inline(always)]
     pub fn leave(&self) {
-        self.state.store(self.state.load(Relaxed) & !0xff, Relaxed);
+        self.state.store(0, Relaxed);
     }
 
     /// Notes the simulation time (the start time at fmi2SetupExperiment, the end of a step).
@@ -84,6 +82,7 @@ impl CallMonitor {
     /// The call in progress, if any. Takes the names' lock: not for the step loop.
     pub fn in_progress(&self) -> Option<InProgress> {
         let s = self.state.load(Relaxed);
+        let time = self.time.load(Relaxed);
         let op = Op::from_u32((s & 0xff) as u32)?;
         let slot = ((s >> 8) & 0xffff) as usize;
         let instance = match self.names.try_lock() {
@@ -93,8 +92,8 @@ impl CallMonitor {
         Some(InProgress {
             instance,
             function: op.name(),
-            time: f64::from_bits(self.time.load(Relaxed)),
-            sequence: s >> 24,
+            time: f64::from_bits(time),
+            key: (s, time),
         })
     }
 }
@@ -124,6 +123,6 @@ mod tests {
             second.to_string(),
             "instance 'b' in fmi2DoStep at t = 1.25 s"
         );
-        assert_ne!(second.sequence, first.sequence);
+        assert_ne!(second.key, first.key);
     }
 }
