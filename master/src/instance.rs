@@ -558,15 +558,15 @@ impl<S> Instance<S> {
     #[inline(always)]
     fn local<T>(&self, op: Op, f: impl FnOnce(&Api, fmi2Component) -> T) -> T {
         // SAFETY: `monitor` points into `core.monitor`, an `Arc` the instance holds.
-        let monitor = unsafe { self.monitor.as_ref() };
-        if let Some(m) = monitor {
-            m.enter(self.slot, op);
+        match unsafe { self.monitor.as_ref() } {
+            None => f(self.api(), self.comp),
+            Some(m) => {
+                m.enter(self.slot, op);
+                let r = f(self.api(), self.comp);
+                m.leave();
+                r
+            }
         }
-        let r = f(self.api(), self.comp);
-        if let Some(m) = monitor {
-            m.leave();
-        }
-        r
     }
 
     /// fmi2EnterInitializationMode, fmi2ExitInitializationMode or fmi2Terminate.

@@ -93,6 +93,14 @@ variables = ["good.y", "evil.y"]
     )
 }
 
+/// `shipsim ARGS` in `dir` that fails with status 1: its stderr.
+fn failing(dir: &Path, args: &[&str]) -> String {
+    let out = shipsim(dir, args);
+    let err = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
+    err
+}
+
 fn shipsim(dir: &Path, args: &[&str]) -> ProcOutput {
     Command::new(SHIPSIM)
         .current_dir(dir)
@@ -139,9 +147,7 @@ fn isolated_failure(defines: &[&str], extra: &[&str]) -> (tempfile::TempDir, Str
     system(d.path());
     let mut args = vec!["run", "sys.toml", "-q", "--isolate"];
     args.extend_from_slice(extra);
-    let out = shipsim(d.path(), &args);
-    let err = String::from_utf8_lossy(&out.stderr).into_owned();
-    assert_eq!(out.status.code(), Some(1), "{defines:?}: {err}");
+    let err = failing(d.path(), &args);
     (d, err)
 }
 
@@ -156,28 +162,23 @@ fn assert_names_call(err: &str, what: &str) {
     assert!(err.contains("misbehaving now at t = 0.3"), "{err}");
 }
 
+/// A segfault, abort() and exit(0) in an isolated FMU: each an error naming the instance, the
+/// call, the time and how its process ended; every completed step kept; nothing left behind.
 #[test]
-fn isolated_segfault_is_an_error_and_keeps_every_completed_step() {
-    let (d, err) = isolated_failure(&["EVIL_SEGV"], &[]);
-    assert_names_call(&err, "was killed by signal 11 (SIGSEGV");
-    assert_three_steps_kept(d.path());
-    assert_no_temp_dirs(d.path());
-}
-
-#[test]
-fn isolated_abort_is_an_error_and_keeps_every_completed_step() {
-    let (d, err) = isolated_failure(&["EVIL_ABORT"], &[]);
-    assert_names_call(&err, "was killed by signal 6 (SIGABRT");
-    assert_three_steps_kept(d.path());
-    assert_no_temp_dirs(d.path());
-}
-
-#[test]
-fn isolated_exit_0_is_an_error_and_keeps_every_completed_step() {
-    let (d, err) = isolated_failure(&["EVIL_EXIT=0"], &[]);
-    assert_names_call(&err, "exited with status 0 (the FMU called exit())");
-    assert_three_steps_kept(d.path());
-    assert_no_temp_dirs(d.path());
+fn isolated_crashes_are_errors_and_keep_every_completed_step() {
+    for (define, how) in [
+        ("EVIL_SEGV", "was killed by signal 11 (SIGSEGV"),
+        ("EVIL_ABORT", "was killed by signal 6 (SIGABRT"),
+        (
+            "EVIL_EXIT=0",
+            "exited with status 0 (the FMU called exit())",
+        ),
+    ] {
+        let (d, err) = isolated_failure(&[define], &[]);
+        assert_names_call(&err, how);
+        assert_three_steps_kept(d.path());
+        assert_no_temp_dirs(d.path());
+    }
 }
 
 #[test]
@@ -210,9 +211,7 @@ fn a_refused_nan_is_blamed_on_its_producer() {
         if isolate {
             args.push("--isolate");
         }
-        let out = shipsim(d.path(), &args);
-        let err = String::from_utf8_lossy(&out.stderr);
-        assert_eq!(out.status.code(), Some(1), "{err}");
+        let err = failing(d.path(), &args);
         assert!(
             err.contains("error: 'evil.y' is NaN (its FMU returned it with fmi2OK), passed on by the connection evil.y -> recv.u: instance 'recv': fmi2SetReal returned fmi2Error"),
             "{err}"
@@ -225,9 +224,7 @@ fn in_process_exit_0_is_not_success() {
     let d = tempfile::tempdir().unwrap();
     evil_fmu(d.path(), "evil", &["EVIL_EXIT=0"]);
     system(d.path());
-    let out = shipsim(d.path(), &["run", "sys.toml", "-q"]);
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(1), "{err}");
+    let err = failing(d.path(), &["run", "sys.toml", "-q"]);
     assert!(
         err.contains("error: instance 'evil' in fmi2DoStep at t = 0.3 s: the FMU ended the process (it called exit())"),
         "{err}"
@@ -239,12 +236,10 @@ fn in_process_hang_ends_the_process_after_the_call_timeout() {
     let d = tempfile::tempdir().unwrap();
     evil_fmu(d.path(), "evil", &["EVIL_HANG"]);
     system(d.path());
-    let out = shipsim(
+    let err = failing(
         d.path(),
         &["run", "sys.toml", "-q", "--call-timeout", "0.3"],
     );
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(1), "{err}");
     assert!(
         err.contains("error: instance 'evil' in fmi2DoStep at t = 0.3 s did not return within 0.3 s (--call-timeout)"),
         "{err}"
@@ -271,9 +266,7 @@ fn failed_initialization_frees_without_terminate() {
         if isolate {
             args.push("--isolate");
         }
-        let out = shipsim(d.path(), &args);
-        let err = String::from_utf8_lossy(&out.stderr);
-        assert_eq!(out.status.code(), Some(1), "{err}");
+        let err = failing(d.path(), &args);
         assert!(
             err.contains("error: instance 'broken': fmi2ExitInitializationMode returned fmi2Error"),
             "{err}"

@@ -290,8 +290,9 @@ fn export_osp() -> Result<()> {
 /// `cargo xtask bench`: master overhead against libcosim and FMPy (bench_master.py, extra
 /// arguments are passed on to it), every system's speed and per-instance profile with the
 /// pure-Rust RRS model loop (bench_systems.py), campaign throughput, fixed cost and warm-up
-/// forks (bench_campaign.py), and the Python package's overhead over the CLI
-/// (bench_python.py); printed, and written to docs/bench.md (committed).
+/// forks (bench_campaign.py), the Python package's overhead over the CLI (bench_python.py),
+/// and the cost of crash isolation (bench_isolated.py); printed, and written to docs/bench.md
+/// (committed).
 fn bench(extra: &[String]) -> Result<()> {
     let root = workspace_root();
     fmu::build_fmus(&root)?;
@@ -324,11 +325,12 @@ fn bench(extra: &[String]) -> Result<()> {
     let systems = script("bench_systems.py", &[])?;
     let campaigns = script("bench_campaign.py", &[])?;
     let python_pkg = script("bench_python.py", &[])?;
+    let isolated = script("bench_isolated.py", &[])?;
     let doc = format!(
         "# Benchmarks\n\nWritten by `cargo xtask bench` (do not edit by hand). Ratios are \
          measured in one run on one machine; absolute times depend on it.\n\n\
          ## Master overhead per FMU-step (master/bench/bench_master.py)\n\n```text\n{master}```\n\n\
-         {systems}\n{campaigns}\n{python_pkg}"
+         {systems}\n{campaigns}\n{python_pkg}\n{isolated}"
     );
     std::fs::write(root.join("docs/bench.md"), doc)?;
     println!("wrote docs/bench.md");
