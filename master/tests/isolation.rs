@@ -422,3 +422,36 @@ fn a_campaign_survives_a_foreign_fmu_that_segfaults() {
     );
     assert_no_temp_dirs(d.path());
 }
+
+/// Ctrl-C stops a run whose isolated FMU hangs, without a call time limit: the master kills
+/// the host and ends as interrupted (status 130), with the completed steps in the CSV.
+#[test]
+fn ctrl_c_stops_a_hung_isolated_fmu() {
+    let d = tempfile::tempdir().unwrap();
+    evil_fmu(d.path(), "evil", &["EVIL_HANG"]);
+    system(d.path());
+    let mut child = Command::new(SHIPSIM)
+        .current_dir(d.path())
+        .env("TMPDIR", d.path())
+        .args(["run", "sys.toml", "-q", "--isolate"])
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    // The evil FMU logs a warning, shown on stderr, just before it hangs in its fourth step.
+    let mut stderr = std::io::BufReader::new(child.stderr.take().unwrap());
+    let mut err = String::new();
+    while !err.contains("[evil] fmi2Warning logAll: misbehaving now") {
+        let mut line = String::new();
+        let n = std::io::BufRead::read_line(&mut stderr, &mut line).unwrap();
+        assert!(n > 0, "the run ended before the hang: {err}");
+        err.push_str(&line);
+    }
+    // SAFETY: signalling the child this test started.
+    unsafe { libc::kill(child.id() as i32, libc::SIGINT) };
+    std::io::Read::read_to_string(&mut stderr, &mut err).unwrap();
+    let status = child.wait().unwrap();
+    assert_eq!(status.code(), Some(130), "{err}");
+    assert!(err.contains("interrupted at t = 0.3 s"), "{err}");
+    assert_three_steps_kept(d.path());
+    assert_no_temp_dirs(d.path());
+}
