@@ -455,3 +455,31 @@ fn ctrl_c_stops_a_hung_isolated_fmu() {
     assert_three_steps_kept(d.path());
     assert_no_temp_dirs(d.path());
 }
+
+/// The probe's case (issue 19, defect 5): `--set autopilot.t_v0=0` makes RrsAutopilot output
+/// a NaN rudder command. The error names the autopilot, not the steering gear that refused the
+/// value, and the six other instances, left in Initialization Mode, get no fmi2Terminate.
+#[test]
+fn rrs_nan_rudder_command_is_blamed_on_the_autopilot() {
+    let d = tempfile::tempdir().unwrap();
+    our_fmu("RrsAutopilot");
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let text = std::fs::read_to_string(root.join("systems/rrs.toml")).unwrap();
+    let dir = format!("{}/", fmu_dir().display());
+    write_system(d.path(), "rrs.toml", &text.replace("../target/fmu/", &dir));
+    let err = failing(
+        d.path(),
+        &[
+            "run",
+            "rrs.toml",
+            "-q",
+            "--no-output",
+            "--set",
+            "autopilot.t_v0=0",
+        ],
+    );
+    let blamed = err.contains("error: 'autopilot.rudder_command' is NaN")
+        || err.contains("error: instance 'autopilot'");
+    assert!(blamed, "{err}");
+    assert!(!err.contains("fmi2Terminate is not allowed"), "{err}");
+}
