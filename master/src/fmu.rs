@@ -53,7 +53,8 @@ unsafe fn resolve(lib: &Library) -> std::result::Result<Api, String> {
 /// The loaded binary plus the unpacked directory it lives in. Instances keep it alive through
 /// an `Arc`; field order makes the library unload before the directory is removed.
 pub(crate) struct FmuLibrary {
-    pub api: Api,
+    /// None for an FMU opened without its binary ([`Fmu::open_unloaded`]).
+    pub api: Option<Api>,
     lib: Option<Library>,
     _dir: tempfile::TempDir,
 }
@@ -541,12 +542,38 @@ impl Fmu {
             model_description: md,
             unpacked: unpacked_dir,
             lib: Arc::new(FmuLibrary {
-                api,
+                api: Some(api),
                 lib,
                 _dir: unpacked.dir,
             }),
             index,
         })
+    }
+
+    /// Unpacks, parses and checks an FMU (its binary must be there) without loading the binary:
+    /// its instances run in FMU host processes ([`crate::isolate`]), so a crash in the binary's
+    /// initializers cannot take this process down.
+    pub fn open_unloaded(path: impl AsRef<Path>, unpack: &Unpack) -> Result<Fmu> {
+        let path = path.as_ref();
+        let unpacked = UnpackedFmu::open_with(path, unpack)?;
+        unpacked.binary_path()?;
+        let index = unpacked.model_description.variable_index();
+        Ok(Fmu {
+            path: path.to_path_buf(),
+            model_description: unpacked.model_description,
+            unpacked: unpacked.dir.path().to_path_buf(),
+            lib: Arc::new(FmuLibrary {
+                api: None,
+                lib: None,
+                _dir: unpacked.dir,
+            }),
+            index,
+        })
+    }
+
+    /// The binary is loaded in this process (not so after [`Fmu::open_unloaded`]).
+    pub fn is_loaded(&self) -> bool {
+        self.lib.api.is_some()
     }
 
     pub fn co_simulation(&self) -> &CoSimulation {

@@ -6,18 +6,28 @@
 //! [`Instance<Stepping>`] -- `do_step`* -- `terminate`.
 //!
 //! A state transition consumes the instance, so no function can be called out of order. Dropping
-//! an instance in any state calls `fmi2Terminate` (if initialized and not failed) and
-//! `fmi2FreeInstance` (unless the FMU returned fmi2Fatal, after which the standard allows no more
-//! calls), so every path, including errors and Ctrl-C, cleans up.
+//! an instance in any state calls `fmi2Terminate` (only in Step Mode: FMI 2.0, sec. 4.2.4 allows
+//! only fmi2FreeInstance or fmi2Reset in Instantiated and Initialization Mode, and nothing but
+//! them after fmi2Error) and `fmi2FreeInstance` (unless the FMU returned fmi2Fatal, after which
+//! the standard allows no more calls), so every path, including errors and Ctrl-C, cleans up.
+//!
+//! An instance runs in this process (the FMU's functions are called directly) or, isolated,
+//! in a `shipsim fmu-host` child process ([`crate::isolate`]): each call then goes to the
+//! child's [`Client`], and a crash, exit or hang of the child is an error naming the instance,
+//! the call and the time. The state machine, the status checks and the errors are the same.
 
 use crate::error::{Error, Result};
 use crate::fmu::{Api, Fmu, FmuLibrary, VR};
+use crate::isolate::client::{Client, GONE};
+use crate::isolate::protocol::Op;
+use crate::isolate::{CallMonitor, Isolation};
 use crate::model_description::CoSimulation;
 use fmi2::*;
 use std::collections::VecDeque;
 use std::ffi::{c_char, c_int, c_void, CString};
 use std::marker::PhantomData;
 use std::path::PathBuf;
+use std::sync::atomic::AtomicBool;
 use std::sync::{Arc, Mutex};
 
 /// Type states.
@@ -56,7 +66,8 @@ pub fn stderr_sink(verbose: bool) -> LogSink {
     })
 }
 
-struct LogCtx {
+/// An instance's log: the sink and the last messages (for error reports).
+pub(crate) struct LogCtx {
     name: String,
     sink: LogSink,
     recent: Mutex<VecDeque<String>>,
@@ -86,6 +97,41 @@ impl LogCtx {
     fn is_empty(&self) -> bool {
         self.recent.lock().map(|r| r.is_empty()).unwrap_or(true)
     }
+
+    /// The last messages.
+    pub(crate) fn recent_lines(&self) -> Vec<String> {
+        self.recent
+            .lock()
+            .map(|r| r.iter().cloned().collect())
+            .unwrap_or_default()
+    }
+
+    /// One message of the FMU (`instance` as it named itself, empty for this instance): kept
+    /// among the last ones and passed to the sink.
+    pub(crate) fn deliver(&self, instance: String, status: i32, category: String, message: String) {
+        let rec = LogRecord {
+            instance: if instance.is_empty() {
+                self.name.clone()
+            } else {
+                instance
+            },
+            status,
+            category,
+            message,
+        };
+        if let Ok(mut r) = self.recent.lock() {
+            if r.len() == RECENT {
+                r.pop_front();
+            }
+            r.push_back(format!(
+                "{} {}: {}",
+                status_name(rec.status),
+                rec.category,
+                rec.message
+            ));
+        }
+        (self.sink)(&rec);
+    }
 }
 
 /// What an error report says when an FMU with debug logging off logged nothing.
@@ -104,29 +150,12 @@ unsafe extern "C" fn log_sink(
     // Never unwind into the FMU.
     let _ = std::panic::catch_unwind(|| {
         let ctx = &*(ctx as *const LogCtx);
-        let inst = lossy_str(instance);
-        let rec = LogRecord {
-            instance: if inst.is_empty() {
-                ctx.name.clone()
-            } else {
-                inst
-            },
+        ctx.deliver(
+            lossy_str(instance),
             status,
-            category: lossy_str(category),
-            message: lossy_str(message),
-        };
-        if let Ok(mut r) = ctx.recent.lock() {
-            if r.len() == RECENT {
-                r.pop_front();
-            }
-            r.push_back(format!(
-                "{} {}: {}",
-                status_name(rec.status),
-                rec.category,
-                rec.message
-            ));
-        }
-        (ctx.sink)(&rec);
+            lossy_str(category),
+            lossy_str(message),
+        );
     });
 }
 
@@ -169,10 +198,15 @@ fn state_support_error(fmu: &std::path::Path, instance: &str, cap: &str) -> Erro
 #[derive(Clone, Copy, PartialEq, Eq, Debug)]
 enum Phase {
     Instantiated,
+    /// In Initialization Mode: fmi2Terminate is not allowed (FMI 2.0, sec. 4.2.4).
+    Initializing,
+    /// In Step Mode.
     Initialized,
     Terminated,
     Failed,
     Fatal,
+    /// fmi2FreeInstance was called (an isolated instance's [`Instance::terminate`]).
+    Freed,
 }
 
 struct Core {
@@ -180,16 +214,20 @@ struct Core {
     lib: Arc<FmuLibrary>,
     comp: fmi2Component,
     phase: Phase,
-    // Kept alive for the FMU, which may hold pointers to them.
-    _callbacks: Box<fmi2CallbackFunctions>,
-    _target: Box<LogTarget>,
-    log: Box<LogCtx>,
+    // Kept alive for the FMU, which may hold pointers to them (none for an isolated instance).
+    _callbacks: Option<Box<fmi2CallbackFunctions>>,
+    _target: Option<Box<LogTarget>>,
+    log: Arc<LogCtx>,
     _name_c: CString,
     /// The `.fmu` file, for errors about its capabilities.
     fmu_path: PathBuf,
     /// Which of canGetAndSetFMUstate and canSerializeFMUstate the FMU lacks (FMI 2.0,
     /// sec. 4.3.1), if any.
     missing_state_capability: Option<&'static str>,
+    /// The child process of an isolated instance.
+    remote: Option<Box<Client>>,
+    /// Where an in-process instance notes its calls, and its number there.
+    monitor: Option<(Arc<CallMonitor>, u16)>,
 }
 
 impl Core {
@@ -217,6 +255,13 @@ impl Core {
         status: fmi2Status,
         time: Option<f64>,
     ) -> Result<()> {
+        if status == GONE {
+            // The isolated instance's process died, hung or was stopped: no more calls.
+            self.phase = Phase::Fatal;
+            if let Some(r) = &self.remote {
+                return Err(r.error());
+            }
+        }
         if status == fmi2Fatal {
             self.phase = Phase::Fatal;
         } else if status == fmi2Error || !(0..=5).contains(&status) {
@@ -238,14 +283,42 @@ impl Core {
 
 impl Drop for Core {
     fn drop(&mut self) {
-        let api = &self.lib.api;
+        let (terminate, free) = match self.phase {
+            Phase::Initialized => (true, true),
+            Phase::Fatal | Phase::Freed => (false, false),
+            _ => (false, true),
+        };
+        if let Some(r) = self.remote.as_mut() {
+            if terminate {
+                r.simple(Op::Terminate);
+            }
+            if free {
+                r.free_instance();
+            }
+            // Dropping the client ends the child (without calls after fmi2Fatal).
+            return;
+        }
+        let Some(api) = self.lib.api.as_ref() else {
+            return;
+        };
+        let monitor = self.monitor.as_ref();
+        let note = |op| {
+            if let Some((m, slot)) = monitor {
+                m.enter(*slot, op);
+            }
+        };
         unsafe {
-            if self.phase == Phase::Initialized {
+            if terminate {
+                note(Op::Terminate);
                 (api.fmi2Terminate)(self.comp);
             }
-            if self.phase != Phase::Fatal {
+            if free {
+                note(Op::FreeInstance);
                 (api.fmi2FreeInstance)(self.comp);
             }
+        }
+        if let Some((m, _)) = monitor {
+            m.leave();
         }
     }
 }
@@ -254,9 +327,14 @@ impl Drop for Core {
 pub struct Instance<S> {
     core: Box<Core>,
     /// `core.comp` and the library's function table, kept next to the instance: a call in the
-    /// step loop loads them without going through the box and the `Arc`.
+    /// step loop loads them without going through the box and the `Arc` (null when isolated).
     comp: fmi2Component,
     api: *const Api,
+    /// The client in `core.remote`, or null in process.
+    remote: *mut Client,
+    /// The monitor in `core.monitor`, or null, and this instance's number there.
+    monitor: *const CallMonitor,
+    slot: u16,
     _s: PhantomData<S>,
 }
 
@@ -274,6 +352,18 @@ pub enum StepOutcome {
     },
 }
 
+/// Where an instance runs, and what watches it ([`Fmu::instantiate_on`]).
+#[derive(Clone, Default)]
+pub struct Backend<'a> {
+    /// Run it in a `shipsim fmu-host` process with these options ([`crate::isolate`]).
+    pub isolate: Option<&'a Isolation>,
+    /// While a call of the isolated instance runs, the flag is checked every 100 ms; when set,
+    /// the child is killed and the call fails with [`Error::Interrupted`].
+    pub interrupt: Option<Arc<AtomicBool>>,
+    /// In process: note each call here ([`CallMonitor`]).
+    pub monitor: Option<Arc<CallMonitor>>,
+}
+
 impl Fmu {
     /// `fmi2Instantiate` as co-simulation slave (FMI 2.0 section 4.2.1), with the logger proxy,
     /// `calloc`/`free`, and the resources URI. A NULL result is an error naming the instance.
@@ -283,20 +373,91 @@ impl Fmu {
         logging_on: bool,
         sink: LogSink,
     ) -> Result<Instance<Instantiated>> {
+        self.instantiate_on(name, logging_on, sink, Backend::default())
+    }
+
+    /// [`Fmu::instantiate`] in this process or, with [`Backend::isolate`], in a child process.
+    pub fn instantiate_on(
+        &self,
+        name: &str,
+        logging_on: bool,
+        sink: LogSink,
+        backend: Backend,
+    ) -> Result<Instance<Instantiated>> {
         let name_c = CString::new(name)
             .map_err(|_| Error::Other(format!("instance name '{name}' contains a NUL byte")))?;
-        let guid = CString::new(self.guid())
-            .map_err(|_| Error::fmu(&self.path, "GUID contains a NUL byte"))?;
-        let res = CString::new(self.resource_uri()).expect("no NUL in a path URI");
-        let log = Box::new(LogCtx {
+        let log = Arc::new(LogCtx {
             name: name.to_string(),
             sink,
             recent: Mutex::new(VecDeque::new()),
             debug_logging: logging_on,
         });
+        let mut core = Box::new(Core {
+            name: name.to_string(),
+            lib: self.lib.clone(),
+            comp: std::ptr::null_mut(),
+            phase: Phase::Instantiated,
+            _callbacks: None,
+            _target: None,
+            log: log.clone(),
+            _name_c: name_c,
+            fmu_path: self.path.clone(),
+            missing_state_capability: missing_state_capability(self.co_simulation()),
+            remote: None,
+            monitor: None,
+        });
+        match backend.isolate {
+            Some(iso) => {
+                let c = Client::spawn(&self.path, name, logging_on, log, iso, backend.interrupt)?;
+                core.remote = Some(Box::new(c));
+            }
+            None => self.instantiate_here(&mut core, logging_on, backend.monitor)?,
+        }
+        let remote = match core.remote.as_mut() {
+            Some(r) => &mut **r as *mut Client,
+            None => std::ptr::null_mut(),
+        };
+        let (monitor, slot) = match &core.monitor {
+            Some((m, slot)) => (Arc::as_ptr(m), *slot),
+            None => (std::ptr::null(), 0),
+        };
+        Ok(Instance {
+            comp: core.comp,
+            api: self
+                .lib
+                .api
+                .as_ref()
+                .map_or(std::ptr::null(), |a| a as *const Api),
+            core,
+            remote,
+            monitor,
+            slot,
+            _s: PhantomData,
+        })
+    }
+
+    /// `fmi2Instantiate` in this process into `core`.
+    fn instantiate_here(
+        &self,
+        core: &mut Core,
+        logging_on: bool,
+        monitor: Option<Arc<CallMonitor>>,
+    ) -> Result<()> {
+        let Some(api) = self.lib.api.as_ref() else {
+            return Err(Error::fmu(
+                &self.path,
+                format!(
+                    "instance '{}': the FMU was opened for isolated instances only (its binary is not loaded in this process)",
+                    core.name
+                ),
+            ));
+        };
+        let guid = CString::new(self.guid())
+            .map_err(|_| Error::fmu(&self.path, "GUID contains a NUL byte"))?;
+        let res = CString::new(self.resource_uri()).expect("no NUL in a path URI");
         let mut target = Box::new(LogTarget {
             sink: Some(log_sink),
-            ctx: &*log as *const LogCtx as *mut c_void,
+            ctx: Arc::as_ptr(&core.log) as *mut c_void,
         });
         let callbacks = Box::new(fmi2CallbackFunctions {
             logger: logger_proxy(),
@@ -305,38 +466,34 @@ impl Fmu {
             stepFinished: None,
             componentEnvironment: &mut *target as *mut LogTarget as *mut c_void,
         });
+        let slot = monitor.as_ref().map(|m| m.register(&core.name));
         let call = |logging_on: bool| unsafe {
-            (self.lib.api.fmi2Instantiate)(
-                name_c.as_ptr(),
+            if let (Some(m), Some(slot)) = (&monitor, slot) {
+                m.enter(slot, Op::Instantiate);
+            }
+            let c = (api.fmi2Instantiate)(
+                core._name_c.as_ptr(),
                 fmi2CoSimulation,
                 guid.as_ptr(),
                 res.as_ptr(),
                 &*callbacks,
                 fmi2False,
                 if logging_on { fmi2True } else { fmi2False },
-            )
+            );
+            if let Some(m) = &monitor {
+                m.leave();
+            }
+            c
         };
         let comp = call(logging_on);
         if comp.is_null() {
-            return Err(self.instantiate_failed(name, &log, call));
+            return Err(self.instantiate_failed(&core.name, &core.log, call));
         }
-        Ok(Instance {
-            comp,
-            api: &self.lib.api,
-            core: Box::new(Core {
-                name: name.to_string(),
-                lib: self.lib.clone(),
-                comp,
-                phase: Phase::Instantiated,
-                _callbacks: callbacks,
-                _target: target,
-                log,
-                _name_c: name_c,
-                fmu_path: self.path.clone(),
-                missing_state_capability: missing_state_capability(self.co_simulation()),
-            }),
-            _s: PhantomData,
-        })
+        core.comp = comp;
+        core._callbacks = Some(callbacks);
+        core._target = Some(target);
+        core.monitor = monitor.zip(slot);
+        Ok(())
     }
 }
 
@@ -361,7 +518,9 @@ impl Fmu {
             let comp = again(true);
             if !comp.is_null() {
                 // The failure with loggingOn = fmi2False stands; this instance is not used.
-                unsafe { (self.lib.api.fmi2FreeInstance)(comp) };
+                if let Some(api) = self.lib.api.as_ref() {
+                    unsafe { (api.fmi2FreeInstance)(comp) };
+                }
                 note = " (it succeeded with loggingOn = true)";
             }
         }
@@ -385,9 +544,64 @@ impl Fmu {
     }
 }
 
+/// The raw FMI calls, in process or through the child's client: each returns the status (or
+/// [`GONE`]); the typed wrappers below check it.
+impl<S> Instance<S> {
+    /// The isolated instance's client.
+    #[inline(always)]
+    fn remote(&mut self) -> Option<&mut Client> {
+        // SAFETY: `remote` points into `core.remote`, a box that lives as long as the instance.
+        unsafe { self.remote.as_mut() }
+    }
+
+    /// Calls `f` with the function table and the component, noting the call in the monitor.
+    #[inline(always)]
+    fn local<T>(&self, op: Op, f: impl FnOnce(&Api, fmi2Component) -> T) -> T {
+        // SAFETY: `monitor` points into `core.monitor`, an `Arc` the instance holds.
+        match unsafe { self.monitor.as_ref() } {
+            None => f(self.api(), self.comp),
+            Some(m) => {
+                m.enter(self.slot, op);
+                let r = f(self.api(), self.comp);
+                m.leave();
+                r
+            }
+        }
+    }
+
+    /// fmi2EnterInitializationMode, fmi2ExitInitializationMode or fmi2Terminate.
+    fn raw_simple(&mut self, op: Op) -> fmi2Status {
+        match self.remote() {
+            Some(r) => r.simple(op),
+            None => self.local(op, |api, c| unsafe {
+                match op {
+                    Op::EnterInitializationMode => (api.fmi2EnterInitializationMode)(c),
+                    Op::ExitInitializationMode => (api.fmi2ExitInitializationMode)(c),
+                    _ => (api.fmi2Terminate)(c),
+                }
+            }),
+        }
+    }
+
+    /// The (name, component) pair the FMU host calls with ([`crate::isolate::host`]).
+    pub(crate) fn raw(&self) -> (&Api, fmi2Component) {
+        (self.api(), self.comp)
+    }
+
+    /// Drops the instance without another FMI call (the host, when its master left).
+    pub(crate) fn abandon(mut self) {
+        self.core.phase = Phase::Fatal;
+    }
+}
+
 impl<S> Instance<S> {
     pub fn name(&self) -> &str {
         &self.core.name
+    }
+
+    /// The process id of an isolated instance's host (None in process).
+    pub fn host_pid(&self) -> Option<u32> {
+        self.core.remote.as_ref().map(|r| r.pid())
     }
 
     fn transition<T>(self) -> Instance<T> {
@@ -395,26 +609,25 @@ impl<S> Instance<S> {
             core: self.core,
             comp: self.comp,
             api: self.api,
+            remote: self.remote,
+            monitor: self.monitor,
+            slot: self.slot,
             _s: PhantomData,
         }
     }
 
-    /// The library's function table.
+    /// The library's function table (only in process: `local` calls it).
     #[inline(always)]
     fn api(&self) -> &Api {
         // SAFETY: `api` points into the `FmuLibrary` that `core.lib` (an `Arc`) keeps alive for
-        // as long as this instance exists.
+        // as long as this instance exists; it is only read for an in-process instance, whose
+        // library is loaded.
         unsafe { &*self.api }
     }
 
     /// The last few log messages of this instance (for error reports).
     pub fn recent_log(&self) -> Vec<String> {
-        self.core
-            .log
-            .recent
-            .lock()
-            .map(|r| r.iter().cloned().collect())
-            .unwrap_or_default()
+        self.core.log.recent_lines()
     }
 
     /// `fmi2SetReal`, batched.
@@ -424,8 +637,11 @@ impl<S> Instance<S> {
         if vrs.is_empty() {
             return Ok(());
         }
-        let s = unsafe {
-            (self.api().fmi2SetReal)(self.comp, vrs.as_ptr(), vrs.len(), values.as_ptr())
+        let s = match self.remote() {
+            Some(r) => r.set(Op::SetReal, vrs, values),
+            None => self.local(Op::SetReal, |api, c| unsafe {
+                (api.fmi2SetReal)(c, vrs.as_ptr(), vrs.len(), values.as_ptr())
+            }),
         };
         self.core.check("fmi2SetReal", s, None)
     }
@@ -436,8 +652,11 @@ impl<S> Instance<S> {
         if vrs.is_empty() {
             return Ok(());
         }
-        let s = unsafe {
-            (self.api().fmi2SetInteger)(self.comp, vrs.as_ptr(), vrs.len(), values.as_ptr())
+        let s = match self.remote() {
+            Some(r) => r.set(Op::SetInteger, vrs, values),
+            None => self.local(Op::SetInteger, |api, c| unsafe {
+                (api.fmi2SetInteger)(c, vrs.as_ptr(), vrs.len(), values.as_ptr())
+            }),
         };
         self.core.check("fmi2SetInteger", s, None)
     }
@@ -448,8 +667,11 @@ impl<S> Instance<S> {
         if vrs.is_empty() {
             return Ok(());
         }
-        let s = unsafe {
-            (self.api().fmi2SetBoolean)(self.comp, vrs.as_ptr(), vrs.len(), values.as_ptr())
+        let s = match self.remote() {
+            Some(r) => r.set(Op::SetBoolean, vrs, values),
+            None => self.local(Op::SetBoolean, |api, c| unsafe {
+                (api.fmi2SetBoolean)(c, vrs.as_ptr(), vrs.len(), values.as_ptr())
+            }),
         };
         self.core.check("fmi2SetBoolean", s, None)
     }
@@ -463,9 +685,14 @@ impl<S> Instance<S> {
                     .map_err(|_| Error::Other(format!("string value {v:?} contains a NUL byte")))
             })
             .collect::<Result<_>>()?;
-        let ptrs: Vec<fmi2String> = cs.iter().map(|c| c.as_ptr()).collect();
-        let s = unsafe {
-            (self.api().fmi2SetString)(self.comp, vrs.as_ptr(), vrs.len(), ptrs.as_ptr())
+        let s = match self.remote() {
+            Some(r) => r.set_string(vrs, values),
+            None => {
+                let ptrs: Vec<fmi2String> = cs.iter().map(|c| c.as_ptr()).collect();
+                self.local(Op::SetString, |api, c| unsafe {
+                    (api.fmi2SetString)(c, vrs.as_ptr(), vrs.len(), ptrs.as_ptr())
+                })
+            }
         };
         self.core.check("fmi2SetString", s, None)
     }
@@ -479,8 +706,11 @@ impl<S: Readable> Instance<S> {
         if vrs.is_empty() {
             return Ok(());
         }
-        let s = unsafe {
-            (self.api().fmi2GetReal)(self.comp, vrs.as_ptr(), vrs.len(), out.as_mut_ptr())
+        let s = match self.remote() {
+            Some(r) => r.get_real(vrs, out),
+            None => self.local(Op::GetReal, |api, c| unsafe {
+                (api.fmi2GetReal)(c, vrs.as_ptr(), vrs.len(), out.as_mut_ptr())
+            }),
         };
         self.core.check("fmi2GetReal", s, None)
     }
@@ -491,8 +721,11 @@ impl<S: Readable> Instance<S> {
         if vrs.is_empty() {
             return Ok(());
         }
-        let s = unsafe {
-            (self.api().fmi2GetInteger)(self.comp, vrs.as_ptr(), vrs.len(), out.as_mut_ptr())
+        let s = match self.remote() {
+            Some(r) => r.get_int(Op::GetInteger, vrs, out),
+            None => self.local(Op::GetInteger, |api, c| unsafe {
+                (api.fmi2GetInteger)(c, vrs.as_ptr(), vrs.len(), out.as_mut_ptr())
+            }),
         };
         self.core.check("fmi2GetInteger", s, None)
     }
@@ -503,20 +736,29 @@ impl<S: Readable> Instance<S> {
         if vrs.is_empty() {
             return Ok(());
         }
-        let s = unsafe {
-            (self.api().fmi2GetBoolean)(self.comp, vrs.as_ptr(), vrs.len(), out.as_mut_ptr())
+        let s = match self.remote() {
+            Some(r) => r.get_int(Op::GetBoolean, vrs, out),
+            None => self.local(Op::GetBoolean, |api, c| unsafe {
+                (api.fmi2GetBoolean)(c, vrs.as_ptr(), vrs.len(), out.as_mut_ptr())
+            }),
         };
         self.core.check("fmi2GetBoolean", s, None)
     }
 
     /// `fmi2GetString` (copies the strings, which the FMU owns only until the next call).
     pub fn get_string(&mut self, vrs: &[VR]) -> Result<Vec<String>> {
-        let mut ptrs: Vec<fmi2String> = vec![std::ptr::null(); vrs.len()];
-        let s = unsafe {
-            (self.api().fmi2GetString)(self.comp, vrs.as_ptr(), vrs.len(), ptrs.as_mut_ptr())
+        let (s, values) = match self.remote() {
+            Some(r) => r.get_string(vrs),
+            None => {
+                let mut ptrs: Vec<fmi2String> = vec![std::ptr::null(); vrs.len()];
+                let s = self.local(Op::GetString, |api, c| unsafe {
+                    (api.fmi2GetString)(c, vrs.as_ptr(), vrs.len(), ptrs.as_mut_ptr())
+                });
+                (s, ptrs.iter().map(|p| unsafe { lossy_str(*p) }).collect())
+            }
         };
         self.core.check("fmi2GetString", s, None)?;
-        Ok(ptrs.iter().map(|p| unsafe { lossy_str(*p) }).collect())
+        Ok(values)
     }
 }
 
@@ -528,24 +770,29 @@ impl Instance<Instantiated> {
         start_time: f64,
         stop_time: Option<f64>,
     ) -> Result<Instance<Initializing>> {
-        let lib = self.core.lib.clone();
-        let api = &lib.api;
-        let s = unsafe {
-            (api.fmi2SetupExperiment)(
-                self.comp,
-                tolerance.is_some() as fmi2Boolean,
-                tolerance.unwrap_or(0.0),
-                start_time,
-                stop_time.is_some() as fmi2Boolean,
-                stop_time.unwrap_or(0.0),
-            )
+        // SAFETY: as in `local`.
+        if let Some(m) = unsafe { self.monitor.as_ref() } {
+            m.at(start_time);
+        }
+        let s = match self.remote() {
+            Some(r) => r.setup_experiment(tolerance, start_time, stop_time),
+            None => self.local(Op::SetupExperiment, |api, c| unsafe {
+                (api.fmi2SetupExperiment)(
+                    c,
+                    tolerance.is_some() as fmi2Boolean,
+                    tolerance.unwrap_or(0.0),
+                    start_time,
+                    stop_time.is_some() as fmi2Boolean,
+                    stop_time.unwrap_or(0.0),
+                )
+            }),
         };
         self.core
             .check("fmi2SetupExperiment", s, Some(start_time))?;
-        let s = unsafe { (api.fmi2EnterInitializationMode)(self.comp) };
+        let s = self.raw_simple(Op::EnterInitializationMode);
         self.core
             .check("fmi2EnterInitializationMode", s, Some(start_time))?;
-        self.core.phase = Phase::Initialized;
+        self.core.phase = Phase::Initializing;
         Ok(self.transition())
     }
 }
@@ -553,8 +800,9 @@ impl Instance<Instantiated> {
 impl Instance<Initializing> {
     /// `fmi2ExitInitializationMode`: the slave is then at its first communication point.
     pub fn exit_initialization_mode(mut self) -> Result<Instance<Stepping>> {
-        let s = unsafe { (self.api().fmi2ExitInitializationMode)(self.comp) };
+        let s = self.raw_simple(Op::ExitInitializationMode);
         self.core.check("fmi2ExitInitializationMode", s, None)?;
+        self.core.phase = Phase::Initialized;
         Ok(self.transition())
     }
 }
@@ -566,7 +814,22 @@ impl Instance<Stepping> {
     /// the instance, the time and the status, with the FMU's last log lines.
     #[inline(always)]
     pub fn do_step(&mut self, t: f64, h: f64) -> Result<StepOutcome> {
-        let s = unsafe { (self.api().fmi2DoStep)(self.comp, t, h, fmi2True) };
+        let s = match self.remote() {
+            Some(r) => r.do_step(t, h),
+            None => {
+                // SAFETY: as in `local`.
+                let monitor = unsafe { self.monitor.as_ref() };
+                if let Some(m) = monitor {
+                    m.enter_step(self.slot, t);
+                }
+                let s = unsafe { (self.api().fmi2DoStep)(self.comp, t, h, fmi2True) };
+                if let Some(m) = monitor {
+                    m.at(t + h);
+                    m.leave();
+                }
+                s
+            }
+        };
         if s == fmi2OK || s == fmi2Warning {
             return Ok(StepOutcome::Ok);
         }
@@ -578,19 +841,14 @@ impl Instance<Stepping> {
     #[cold]
     #[inline(never)]
     fn step_not_ok(&mut self, t: f64, s: fmi2Status) -> Result<StepOutcome> {
-        let api = self.api();
         if s == fmi2Discard {
-            let mut terminated: fmi2Boolean = fmi2False;
-            let st =
-                unsafe { (api.fmi2GetBooleanStatus)(self.comp, fmi2Terminated, &mut terminated) };
-            if st <= fmi2Warning && terminated != fmi2False {
-                let mut last = t;
-                let st = unsafe {
-                    (api.fmi2GetRealStatus)(self.comp, fmi2LastSuccessfulTime, &mut last)
+            let (st, terminated) = self.status_query(Op::GetBooleanStatus, fmi2Terminated);
+            if (fmi2OK..=fmi2Warning).contains(&st) && terminated != 0.0 {
+                let (st, last) = self.status_query(Op::GetRealStatus, fmi2LastSuccessfulTime);
+                let last = match (fmi2OK..=fmi2Warning).contains(&st) {
+                    true => last,
+                    false => t,
                 };
-                if st > fmi2Warning {
-                    last = t;
-                }
                 self.core.phase = Phase::Initialized;
                 return Ok(StepOutcome::Terminated {
                     last_successful_time: last,
@@ -601,6 +859,24 @@ impl Instance<Stepping> {
         Err(self.core.fmi_error("fmi2DoStep", s, Some(t)))
     }
 
+    /// fmi2GetBooleanStatus (as 0.0 or 1.0) or fmi2GetRealStatus of `kind`.
+    fn status_query(&mut self, op: Op, kind: fmi2StatusKind) -> (fmi2Status, f64) {
+        if let Some(r) = self.remote() {
+            return r.status_query(op, kind);
+        }
+        self.local(op, |api, c| unsafe {
+            if op == Op::GetBooleanStatus {
+                let mut v: fmi2Boolean = fmi2False;
+                let s = (api.fmi2GetBooleanStatus)(c, kind, &mut v);
+                (s, (v != fmi2False) as i32 as f64)
+            } else {
+                let mut v = 0.0;
+                let s = (api.fmi2GetRealStatus)(c, kind, &mut v);
+                (s, v)
+            }
+        })
+    }
+
     /// The instance's complete state as bytes (FMI 2.0, sec. 2.1.8): `fmi2GetFMUstate`,
     /// `fmi2SerializedFMUstateSize`, `fmi2SerializeFMUstate`, then `fmi2FreeFMUstate` (also when
     /// serializing fails). The bytes are the FMU's own format; [`Self::restore_state`] of an
@@ -609,7 +885,16 @@ impl Instance<Stepping> {
     pub fn serialize_state(&mut self) -> Result<Vec<u8>> {
         self.require_state_support()?;
         let mut state: fmi2FMUstate = std::ptr::null_mut();
-        let s = unsafe { (self.api().fmi2GetFMUstate)(self.comp, &mut state) };
+        let s = match self.remote() {
+            Some(r) => {
+                let (s, h) = r.state_call(Op::GetFmuState, 0, 0);
+                state = h as usize as fmi2FMUstate;
+                s
+            }
+            None => self.local(Op::GetFmuState, |api, c| unsafe {
+                (api.fmi2GetFMUstate)(c, &mut state)
+            }),
+        };
         if let Err(e) = self.core.check("fmi2GetFMUstate", s, None) {
             let _ = self.free_state(&mut state);
             return Err(e);
@@ -626,19 +911,31 @@ impl Instance<Stepping> {
     pub fn restore_state(&mut self, bytes: &[u8]) -> Result<()> {
         self.require_state_support()?;
         let mut state: fmi2FMUstate = std::ptr::null_mut();
-        let s = unsafe {
-            (self.api().fmi2DeSerializeFMUstate)(
-                self.comp,
-                bytes.as_ptr() as *const fmi2Byte,
-                bytes.len(),
-                &mut state,
-            )
+        let s = match self.remote() {
+            Some(r) => {
+                let (s, h) = r.deserialize(bytes);
+                state = h as usize as fmi2FMUstate;
+                s
+            }
+            None => self.local(Op::Deserialize, |api, c| unsafe {
+                (api.fmi2DeSerializeFMUstate)(
+                    c,
+                    bytes.as_ptr() as *const fmi2Byte,
+                    bytes.len(),
+                    &mut state,
+                )
+            }),
         };
         if let Err(e) = self.core.check("fmi2DeSerializeFMUstate", s, None) {
             let _ = self.free_state(&mut state);
             return Err(e);
         }
-        let s = unsafe { (self.api().fmi2SetFMUstate)(self.comp, state) };
+        let s = match self.remote() {
+            Some(r) => r.state_call(Op::SetFmuState, state as usize as u64, 0).0,
+            None => self.local(Op::SetFmuState, |api, c| unsafe {
+                (api.fmi2SetFMUstate)(c, state)
+            }),
+        };
         let set = self.core.check("fmi2SetFMUstate", s, None);
         let freed = self.free_state(&mut state);
         set?;
@@ -660,7 +957,16 @@ impl Instance<Stepping> {
     /// Serializes a state got by `fmi2GetFMUstate`.
     fn serialize_held(&mut self, state: fmi2FMUstate) -> Result<Vec<u8>> {
         let mut size = 0usize;
-        let s = unsafe { (self.api().fmi2SerializedFMUstateSize)(self.comp, state, &mut size) };
+        let s = match self.remote() {
+            Some(r) => {
+                let (s, n) = r.state_call(Op::SerializedSize, state as usize as u64, 0);
+                size = n as usize;
+                s
+            }
+            None => self.local(Op::SerializedSize, |api, c| unsafe {
+                (api.fmi2SerializedFMUstateSize)(c, state, &mut size)
+            }),
+        };
         self.core.check("fmi2SerializedFMUstateSize", s, None)?;
         if size > MAX_STATE_BYTES {
             return Err(Error::Other(format!(
@@ -668,16 +974,24 @@ impl Instance<Stepping> {
                 self.core.name
             )));
         }
-        let mut bytes = vec![0u8; size];
-        let s = unsafe {
-            (self.api().fmi2SerializeFMUstate)(
-                self.comp,
-                state,
-                bytes.as_mut_ptr() as *mut fmi2Byte,
-                size,
-            )
+        let (s, bytes) = match self.remote() {
+            Some(r) => r.serialize(state as usize as u64, size),
+            None => {
+                let mut bytes = vec![0u8; size];
+                let s = self.local(Op::Serialize, |api, c| unsafe {
+                    (api.fmi2SerializeFMUstate)(c, state, bytes.as_mut_ptr() as *mut fmi2Byte, size)
+                });
+                (s, bytes)
+            }
         };
         self.core.check("fmi2SerializeFMUstate", s, None)?;
+        if bytes.len() != size {
+            return Err(Error::Other(format!(
+                "instance '{}': fmi2SerializeFMUstate gave {} bytes, expected {size}",
+                self.core.name,
+                bytes.len()
+            )));
+        }
         Ok(bytes)
     }
 
@@ -686,14 +1000,30 @@ impl Instance<Stepping> {
         if state.is_null() || self.core.phase == Phase::Fatal {
             return Ok(());
         }
-        let s = unsafe { (self.api().fmi2FreeFMUstate)(self.comp, state) };
+        let s = match self.remote() {
+            Some(r) => {
+                let (s, h) = r.state_call(Op::FreeFmuState, *state as usize as u64, 0);
+                *state = h as usize as fmi2FMUstate;
+                s
+            }
+            None => self.local(Op::FreeFmuState, |api, c| unsafe {
+                (api.fmi2FreeFMUstate)(c, state)
+            }),
+        };
         self.core.check("fmi2FreeFMUstate", s, None)
     }
 
-    /// `fmi2Terminate` then `fmi2FreeInstance`.
+    /// `fmi2Terminate` then `fmi2FreeInstance` (for an isolated instance the free is checked
+    /// too: its process may die in it).
     pub fn terminate(mut self) -> Result<()> {
-        let s = unsafe { (self.api().fmi2Terminate)(self.comp) };
+        let s = self.raw_simple(Op::Terminate);
         self.core.phase = Phase::Terminated;
-        self.core.check("fmi2Terminate", s, None)
+        self.core.check("fmi2Terminate", s, None)?;
+        if let Some(r) = self.remote() {
+            let s = r.free_instance();
+            self.core.phase = Phase::Freed;
+            self.core.check("fmi2FreeInstance", s, None)?;
+        }
+        Ok(())
     }
 }

@@ -31,6 +31,7 @@ pub mod fmu;
 pub mod format;
 pub mod inspect;
 pub mod instance;
+pub mod isolate;
 pub mod limits;
 pub mod model_description;
 pub mod plot;

@@ -95,7 +95,21 @@ enum Command {
         resume: Option<PathBuf>,
         #[command(flatten)]
         limits: LimitArgs,
+        /// Run FMU instances in their own processes, so that a crash, exit() or hang of an FMU
+        /// is an error naming it and every completed step is kept: all of them (--isolate),
+        /// those of FMUs not built by this project (--isolate=foreign) or the named ones
+        /// (--isolate=NAME,NAME). See docs/isolation.md.
+        #[arg(long, num_args = 0..=1, require_equals = true, default_missing_value = "all", value_name = "all|foreign|NAMES")]
+        isolate: Option<String>,
+        /// The longest wall time of one FMI call [s]: an isolated instance's process is then
+        /// killed and the run fails naming the call; in process, shipsim exits with a message.
+        /// Default: no limit.
+        #[arg(long, value_name = "SECONDS")]
+        call_timeout: Option<f64>,
     },
+    /// Host one isolated FMU instance for a master (internal: started by `run --isolate`).
+    #[command(hide = true)]
+    FmuHost { fmu: PathBuf },
     /// Validate a system without running it: everything `run` checks before the first step
     /// (names, types, units, declared ranges, connections, events, outputs).
     Check {
@@ -251,6 +265,9 @@ fn remove_tree(dir: &Path) {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    if let Command::FmuHost { fmu } = &cli.command {
+        return ExitCode::from(shipsim::isolate::host::serve(fmu) as u8);
+    }
     let session = Session::start();
     let result = dispatch(cli.command, &session);
     let interrupted = session.interrupt.load(Ordering::SeqCst);
@@ -309,6 +326,8 @@ fn dispatch(cmd: Command, session: &Session) -> shipsim::Result<()> {
             checkpoint_at,
             resume,
             limits,
+            isolate,
+            call_timeout,
         } => {
             let checkpoints = Checkpoints {
                 at: checkpoint_at.map(parse_checkpoint_at).transpose()?,
@@ -333,6 +352,7 @@ fn dispatch(cmd: Command, session: &Session) -> shipsim::Result<()> {
                 profile: profile.map(|f| (f, profile_every)),
                 verbose,
                 quiet,
+                isolation: cli::isolate::isolation(isolate.as_deref(), call_timeout)?,
             };
             run_cli(&sys, &flags, checkpoints, session, &limits)
         }
@@ -342,6 +362,7 @@ fn dispatch(cmd: Command, session: &Session) -> shipsim::Result<()> {
             cli::campaign::dispatch(command, || session.interrupt.clone())
         }
         Command::Stats(args) => cli::stats::run(&args),
+        Command::FmuHost { .. } => Ok(()),
     }
 }
 
@@ -519,6 +540,7 @@ struct RunFlags {
     profile: Option<(ProfileFormat, Option<u64>)>,
     verbose: bool,
     quiet: bool,
+    isolation: shipsim::isolate::Isolation,
 }
 
 /// `shipsim run`: Ctrl-C stops the run cleanly (a second one exits at once); warnings, then
@@ -562,8 +584,11 @@ fn run_cli(
             Some(every) => Sampling { every },
             None => Sampling::default(),
         }),
+        isolation: flags.isolation.clone(),
+        // An FMU in process that calls exit() or hangs is named (cli/isolate.rs).
+        monitor: Some(cli::isolate::guard(flags.isolation.call_timeout)),
     };
-    let (plan, fmus) = prepare_with(sys, &session.unpack(limits))?;
+    let (plan, fmus) = prepare_with(sys, &session.unpack(limits), &flags.isolation)?;
     print_warnings(&plan.warnings);
     if !quiet && !flags.no_output {
         output_note(sys, out_file.as_deref());

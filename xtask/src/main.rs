@@ -343,10 +343,10 @@ fn export_ssp() -> Result<()> {
 /// `cargo xtask bench`: master overhead against libcosim and FMPy (bench_master.py, extra
 /// arguments are passed on to it), every system's speed and per-instance profile with the
 /// pure-Rust RRS model loop (bench_systems.py), campaign throughput, fixed cost and warm-up
-/// forks (bench_campaign.py), and the Python package's overhead over the CLI
-/// (bench_python.py), and what checks compiled into the FMUs cost: the RRS system against a
-/// variant of its FMUs built without per-call logging (bench_variants.py); printed, and written
-/// to docs/bench.md (committed).
+/// forks (bench_campaign.py), the Python package's overhead over the CLI (bench_python.py),
+/// the cost of crash isolation (bench_isolated.py), and what checks compiled into the FMUs
+/// cost: the RRS system against a variant of its FMUs built without per-call logging
+/// (bench_variants.py); printed, and written to docs/bench.md (committed).
 /// `cargo xtask bench --only variants` runs and prints that section alone.
 fn bench(extra: &[String]) -> Result<()> {
     let only = match extra {
@@ -407,12 +407,13 @@ fn bench(extra: &[String]) -> Result<()> {
     let systems = script("bench_systems.py", &[])?;
     let campaigns = script("bench_campaign.py", &[])?;
     let python_pkg = script("bench_python.py", &[])?;
+    let isolated = script("bench_isolated.py", &[])?;
     let variants = variants()?;
     let doc = format!(
         "# Benchmarks\n\nWritten by `cargo xtask bench` (do not edit by hand). Ratios are \
          measured in one run on one machine; absolute times depend on it.\n\n\
          ## Master overhead per FMU-step (master/bench/bench_master.py)\n\n```text\n{master}```\n\n\
-         {systems}\n{campaigns}\n{python_pkg}\n{variants}"
+         {systems}\n{campaigns}\n{python_pkg}\n{isolated}\n{variants}"
     );
     std::fs::write(root.join("docs/bench.md"), doc)?;
     println!("wrote docs/bench.md");

@@ -23,6 +23,7 @@ use super::Campaign;
 use crate::error::{Error, Result};
 use crate::fmu::Fmu;
 use crate::instance::LogSink;
+use crate::isolate::Isolation;
 use crate::model_description::ModelDescription;
 use crate::run::{self, ColumnInfo, CsvRecorder, Recorder, Row, RunOptions};
 use crate::system::System;
@@ -377,7 +378,7 @@ pub fn run(campaign: &Campaign, opts: &CampaignOptions) -> Result<CampaignOutcom
         .map_err(|e| Error::io(format!("cannot create output folder {}", dir.display()), e))?;
     output::check_or_write_provenance(campaign, dir, opts.shard)?;
     let journal = Journal::open(dir)?;
-    let fmus = run::load_fmus(&campaign.system)?;
+    let fmus = run::load_fmus_for(&campaign.system, &foreign_isolation())?;
     let (jobs, jobs_note) = jobs_for(&fmus, opts.jobs);
     let mut outcome = CampaignOutcome {
         total: campaign.runs.len(),
@@ -427,18 +428,32 @@ pub(super) fn to_do(journal: &Journal, run: &Run, retry_failed: bool) -> bool {
     }
 }
 
-/// The worker threads to use (every core by default), and why they were limited: an FMU that
-/// can be instantiated only once per process allows one.
+/// The isolation of a campaign's runs: the instances of FMUs not built by this project run in
+/// their own processes ([`crate::isolate`]), so one that crashes, exits or hangs fails its run
+/// only. Our FMUs run in process (their calls are tested and fuzzed, and in process is faster).
+/// Without a `shipsim` executable to host them (the library in another program, and no
+/// `$SHIPSIM_FMU_HOST`), every FMU runs in process.
+fn foreign_isolation() -> Isolation {
+    let iso = Isolation::foreign();
+    match iso.host_executable() {
+        Ok(_) => iso,
+        Err(_) => Isolation::default(),
+    }
+}
+
+/// The worker threads to use (every core by default), and why they were limited: an FMU in
+/// process that can be instantiated only once per process allows one (isolated, each instance
+/// has a process of its own).
 fn jobs_for(fmus: &[Arc<Fmu>], jobs: Option<usize>) -> (usize, Option<String>) {
     let jobs = jobs.unwrap_or_else(rayon::current_num_threads).max(1);
     match fmus
         .iter()
-        .find(|f| f.co_simulation().can_be_instantiated_only_once_per_process)
+        .find(|f| f.is_loaded() && f.co_simulation().can_be_instantiated_only_once_per_process)
     {
         Some(f) if jobs > 1 => (
             1,
             Some(format!(
-                "{} declares canBeInstantiatedOnlyOncePerProcess: one job, until the out-of-process mode exists",
+                "{} declares canBeInstantiatedOnlyOncePerProcess: one job (it is built by this project, so it runs in process)",
                 f.path.display()
             )),
         ),
@@ -462,6 +477,7 @@ impl<'a> Context<'a> {
             run_opts: RunOptions {
                 interrupt: opts.interrupt.clone(),
                 log_sink: opts.log_sink.clone(),
+                isolation: foreign_isolation(),
                 ..Default::default()
             },
             sink: Mutex::new(sink),

@@ -50,6 +50,10 @@ pub trait Kind {
     fn add(sum: Self::Value, term: Self::Value) -> Self::Value;
     fn set<S>(inst: &mut Instance<S>, vrs: &[VR], values: &[Self::Value]) -> Result<()>;
     fn get<S: Readable>(inst: &mut Instance<S>, vrs: &[VR], out: &mut [Self::Value]) -> Result<()>;
+    /// The value as text when it is not finite (a Real NaN or infinity), else None.
+    fn non_finite(_value: Self::Value) -> Option<String> {
+        None
+    }
 }
 
 /// `fmi2Real`.
@@ -103,6 +107,9 @@ impl Kind for Real {
     #[inline]
     fn get<S: Readable>(inst: &mut Instance<S>, vrs: &[VR], out: &mut [f64]) -> Result<()> {
         inst.get_real(vrs, out)
+    }
+    fn non_finite(value: f64) -> Option<String> {
+        (!value.is_finite()).then(|| value.to_string())
     }
 }
 
@@ -197,6 +204,8 @@ pub struct Port<K: Kind> {
     links: Vec<Link<K>>,
     /// The second and further terms of summed inputs, in plan order (empty without sums).
     terms: Vec<Term<K>>,
+    /// The connections' names ("a.y -> b.u"), for errors: of `links`, then of `terms`.
+    names: Vec<String>,
     scratch: Vec<K::Value>,
     observed: Observed,
 }
@@ -207,6 +216,7 @@ impl<K: Kind> Default for Port<K> {
             input_vrs: Vec::new(),
             links: Vec::new(),
             terms: Vec::new(),
+            names: Vec::new(),
             scratch: Vec::new(),
             observed: Observed::default(),
         }
@@ -220,7 +230,8 @@ impl<K: Kind> Port<K> {
     }
 
     /// Connects input `vr` (its first or only term); returns its index among the inputs.
-    fn connect(&mut self, vr: VR, source: usize, map: K::Map) -> usize {
+    fn connect(&mut self, vr: VR, source: usize, map: K::Map, name: &str) -> usize {
+        self.names.insert(self.links.len(), name.to_string());
         self.input_vrs.push(vr);
         self.links.push(Link { source, map });
         self.scratch.push(K::Value::default());
@@ -229,12 +240,20 @@ impl<K: Kind> Port<K> {
 
     /// Connects input `vr`, or adds a further term to the summed input `first` (after the
     /// terms it has); returns the input's index.
-    fn connect_term(&mut self, first: Option<usize>, vr: VR, source: usize, map: K::Map) -> usize {
+    fn connect_term(
+        &mut self,
+        first: Option<usize>,
+        vr: VR,
+        source: usize,
+        map: K::Map,
+        name: &str,
+    ) -> usize {
         let Some(input) = first else {
-            return self.connect(vr, source, map);
+            return self.connect(vr, source, map, name);
         };
         let link = Link { source, map };
         self.terms.push(Term { input, link });
+        self.names.push(name.to_string());
         input
     }
 
@@ -251,7 +270,28 @@ impl<K: Kind> Port<K> {
             let x = &mut self.scratch[t.input];
             *x = K::add(*x, K::map(shared[t.link.source], &t.link.map));
         }
-        K::set(inst, &self.input_vrs, &self.scratch)
+        K::set(inst, &self.input_vrs, &self.scratch).map_err(|e| self.blame_producer(e, shared))
+    }
+
+    /// A refused set whose values hold a non-finite one: the error names the producer first
+    /// (the instance and variable the connection comes from), then the receiver's refusal.
+    #[cold]
+    #[inline(never)]
+    fn blame_producer(&self, e: crate::error::Error, shared: &[K::Value]) -> crate::error::Error {
+        // The sources of the links, then of the further terms of sums: `names` is in this order.
+        let sources = self.links.iter().chain(self.terms.iter().map(|t| &t.link));
+        let bad = sources
+            .zip(&self.names)
+            .find_map(|(l, name)| K::non_finite(shared[l.source]).map(|v| (v, name)));
+        match bad {
+            Some((value, name)) => {
+                let from = name.split(" -> ").next().unwrap_or(name);
+                crate::error::Error::Other(format!(
+                    "'{from}' is {value} (its FMU returned it with fmi2OK), passed on by the connection {name}: {e}"
+                ))
+            }
+            None => e,
+        }
     }
 
     #[inline(always)]
@@ -392,10 +432,15 @@ impl Exchange {
             let input = match t {
                 VarType::Real => {
                     p.real
-                        .connect_term(first, c.to_vr, g, Linear::of(c.gain, c.offset))
+                        .connect_term(first, c.to_vr, g, Linear::of(c.gain, c.offset), &c.name)
                 }
-                VarType::Boolean => p.boolean.connect_term(first, c.to_vr, g, c.mapping.clone()),
-                _ => p.integer.connect_term(first, c.to_vr, g, c.mapping.clone()),
+                VarType::Boolean => {
+                    p.boolean
+                        .connect_term(first, c.to_vr, g, c.mapping.clone(), &c.name)
+                }
+                _ => p
+                    .integer
+                    .connect_term(first, c.to_vr, g, c.mapping.clone(), &c.name),
             };
             if c.sum {
                 summed.insert(key, input);

@@ -6,7 +6,11 @@
 //! (as libcosim does) -> fmi2ExitInitializationMode -> outputs read at t_0.
 //!
 //! Each phase runs over all instances before the next begins. On an error the instances made
-//! so far are dropped, which terminates and frees them ([`crate::instance`]).
+//! so far are dropped, which frees them, terminating only those in Step Mode (FMI 2.0, sec.
+//! 4.2.4: no fmi2Terminate in Initialization Mode; [`crate::instance`]).
+//!
+//! An instance that [`RunOptions::isolation`] names is instantiated in its own process
+//! ([`crate::isolate`]); the rest of the run does not see the difference.
 
 use super::algorithm::Algorithm;
 use super::exchange::{Ports, Values};
@@ -14,7 +18,7 @@ use super::slot::{set_value, Slot};
 use super::RunOptions;
 use crate::error::{Error, Result};
 use crate::fmu::Fmu;
-use crate::instance::{stderr_sink, Instance, Stepping};
+use crate::instance::{stderr_sink, Backend, Instance, Stepping};
 use crate::system::{Plan, PlanInstance};
 use std::sync::Arc;
 
@@ -33,7 +37,13 @@ pub fn initialize<A: Algorithm>(
         .unwrap_or_else(|| stderr_sink(opts.verbose));
     let mut instantiated = Vec::with_capacity(plan.instances.len());
     for ((pi, fmu), ports) in plan.instances.iter().zip(fmus).zip(ports) {
-        let mut inst = fmu.instantiate(&pi.name, opts.verbose, sink.clone())?;
+        let isolated = opts.isolation.applies(&pi.name, &fmu.model_description);
+        let backend = Backend {
+            isolate: isolated.then_some(&opts.isolation),
+            interrupt: opts.interrupt.clone(),
+            monitor: opts.monitor.clone(),
+        };
+        let mut inst = fmu.instantiate_on(&pi.name, opts.verbose, sink.clone(), backend)?;
         apply_start_values(&mut inst, pi, true)?;
         instantiated.push(Slot {
             inst,

@@ -24,6 +24,7 @@
 use crate::error::{Error, Result};
 use crate::fmu::Fmu;
 use crate::instance::LogSink;
+use crate::isolate::{CallMonitor, IsolateMode, Isolation};
 use crate::model_description::ModelDescription;
 use crate::system::{Algorithm as AlgorithmChoice, Plan, System};
 use std::collections::HashMap;
@@ -68,6 +69,12 @@ pub struct RunOptions {
     /// Time where the step loop goes per instance, on these steps ([`Summary::profile`],
     /// [`profile`]).
     pub profile: Option<Sampling>,
+    /// Which instances run in their own processes ([`crate::isolate`]); the FMUs must be
+    /// loaded for it ([`load_fmus_for`]).
+    pub isolation: Isolation,
+    /// Where in-process instances note the call in progress (for a caller's exit hook or
+    /// watchdog, [`crate::isolate::monitor`]).
+    pub monitor: Option<Arc<CallMonitor>>,
 }
 
 /// Where and when a run writes its checkpoint.
@@ -164,18 +171,46 @@ fn off_grid_line(o: &OffGrid) -> String {
 
 /// Loads each distinct FMU once (instances of the same file share one loaded library).
 pub fn load_fmus(system: &System) -> Result<Vec<Arc<Fmu>>> {
-    load_fmus_with(system, &crate::fmu::Unpack::default())
+    load_fmus_with(
+        system,
+        &crate::fmu::Unpack::default(),
+        &Isolation::default(),
+    )
 }
 
-/// [`load_fmus`] with the archives unpacked under `unpack` (limits, directory, interrupt).
-pub fn load_fmus_with(system: &System, unpack: &crate::fmu::Unpack) -> Result<Vec<Arc<Fmu>>> {
+/// [`load_fmus`] for a run with `isolation` (archives unpacked with the default options).
+pub fn load_fmus_for(system: &System, isolation: &Isolation) -> Result<Vec<Arc<Fmu>>> {
+    load_fmus_with(system, &crate::fmu::Unpack::default(), isolation)
+}
+
+/// [`load_fmus`] with the archives unpacked under `unpack` (limits, directory, interrupt), for
+/// a run with `isolation`: an FMU whose instances all run in their own processes is opened
+/// without loading its binary here ([`Fmu::open_unloaded`]).
+pub fn load_fmus_with(
+    system: &System,
+    unpack: &crate::fmu::Unpack,
+    isolation: &Isolation,
+) -> Result<Vec<Arc<Fmu>>> {
     let mut cache: HashMap<PathBuf, Arc<Fmu>> = HashMap::new();
     let mut out = Vec::new();
+    let key_of = |inst: &crate::system::InstanceSpec| {
+        inst.fmu.canonicalize().unwrap_or_else(|_| inst.fmu.clone())
+    };
+    // The files with an instance that is not isolated by name.
+    let named_in_process: Vec<PathBuf> = match &isolation.mode {
+        IsolateMode::Instances(names) => system
+            .instances
+            .iter()
+            .filter(|i| !names.contains(&i.name))
+            .map(key_of)
+            .collect(),
+        _ => Vec::new(),
+    };
     for inst in &system.instances {
-        let key = inst.fmu.canonicalize().unwrap_or_else(|_| inst.fmu.clone());
+        let key = key_of(inst);
         let fmu = match cache.get(&key) {
             Some(f) => {
-                if f.co_simulation().can_be_instantiated_only_once_per_process {
+                if f.is_loaded() && f.co_simulation().can_be_instantiated_only_once_per_process {
                     return Err(Error::fmu(
                         &inst.fmu,
                         format!(
@@ -188,7 +223,23 @@ pub fn load_fmus_with(system: &System, unpack: &crate::fmu::Unpack) -> Result<Ve
             }
             None => {
                 system.require_fmu(inst)?;
-                let f = Arc::new(Fmu::load_with(&inst.fmu, unpack).map_err(|e| match e {
+                let unloaded = match &isolation.mode {
+                    IsolateMode::None => false,
+                    IsolateMode::Instances(_) => !named_in_process.contains(&key),
+                    _ => true,
+                };
+                let opened = match unloaded {
+                    true => Fmu::open_unloaded(&inst.fmu, unpack).and_then(|f| {
+                        match isolation.mode == IsolateMode::Foreign
+                            && crate::isolate::is_ours(&f.model_description)
+                        {
+                            true => Fmu::load_with(&inst.fmu, unpack),
+                            false => Ok(f),
+                        }
+                    }),
+                    false => Fmu::load_with(&inst.fmu, unpack),
+                };
+                let f = Arc::new(opened.map_err(|e| match e {
                     Error::Fmu { path, message } => Error::Fmu {
                         path,
                         message: format!("(instance '{}') {message}", inst.name),
@@ -521,12 +572,21 @@ fn execute<A: Algorithm>(
 /// Loads a system's FMUs and validates it against their model descriptions. The plan's
 /// warnings are for the caller to show.
 pub fn prepare(system: &System) -> Result<(Plan, Vec<Arc<Fmu>>)> {
-    prepare_with(system, &crate::fmu::Unpack::default())
+    prepare_with(
+        system,
+        &crate::fmu::Unpack::default(),
+        &Isolation::default(),
+    )
 }
 
-/// [`prepare`] with the archives unpacked under `unpack` (limits, directory, interrupt).
-pub fn prepare_with(system: &System, unpack: &crate::fmu::Unpack) -> Result<(Plan, Vec<Arc<Fmu>>)> {
-    let fmus = load_fmus_with(system, unpack)?;
+/// [`prepare`] with the archives unpacked under `unpack` (limits, directory, interrupt), for a
+/// run with `isolation` ([`load_fmus_with`]).
+pub fn prepare_with(
+    system: &System,
+    unpack: &crate::fmu::Unpack,
+    isolation: &Isolation,
+) -> Result<(Plan, Vec<Arc<Fmu>>)> {
+    let fmus = load_fmus_with(system, unpack, isolation)?;
     let mds: Vec<&ModelDescription> = fmus.iter().map(|f| &f.model_description).collect();
     let plan = system.validate(&mds)?;
     Ok((plan, fmus))
