@@ -48,9 +48,14 @@ SCHEMA_DIR = pathlib.Path(fmpy.__file__).parent / "ssp" / "schema"
 
 # Systems SSP 1.0 cannot express: {system file: what the refusal must name}. SSP has no scenario
 # form, so a system with [[events]] is refused (export-osp writes them as a libcosim scenario).
+# system -> (what is named, why SSP 1.0 cannot express it)
 NOT_EXPORTABLE = {
-    "dgps_stopping.toml": "event at t = 60 s setting ship.shaft_speed_command = 1",
-    "steering_gear_classification.toml": "event at t = 5 s setting slow.rudder_command",
+    "dgps_stopping.toml": ("event at t = 60 s setting ship.shaft_speed_command = 1",
+                           "SSP 1.0 has no scenario form"),
+    "steering_gear_classification.toml": ("event at t = 5 s setting slow.rudder_command",
+                                          "SSP 1.0 has no scenario form"),
+    "container_ship_seaway_autopilot.toml": ("summed input ship.yaw_moment",
+                                             "it has no sum of several"),
 }
 
 # The system FMPy's simulate_ssp runs here: no gain or offset on a connection (FMPy ignores the
@@ -104,8 +109,9 @@ def test_refused_with_what_ssp_cannot_express(system, tmp_path):
     toml, _ = localise(system, tmp_path)
     ssp = tmp_path / "out.ssp"
     r = shipsim("export-ssp", toml, "-o", ssp, check=False)
-    assert r.returncode != 0, f"{system}: export-ssp accepted a system with events"
-    assert NOT_EXPORTABLE[system] in r.stderr and "SSP 1.0 has no scenario form" in r.stderr, r.stderr
+    named, why = NOT_EXPORTABLE[system]
+    assert r.returncode != 0, f"{system}: export-ssp accepted it ({named})"
+    assert named in r.stderr and why in r.stderr, r.stderr
     assert not ssp.exists() and not list(tmp_path.glob("*.partial"))
 
 
