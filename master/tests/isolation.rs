@@ -380,7 +380,7 @@ fn isolated_step_loop_allocates_nothing() {
 fn foreign_means_not_built_by_this_project() {
     let d = tempfile::tempdir().unwrap();
     let fmu = test_fmu(d.path());
-    let f = shipsim::fmu::Fmu::open_unloaded(&fmu).unwrap();
+    let f = shipsim::fmu::Fmu::open_unloaded(&fmu, &Default::default()).unwrap();
     // tests/c/testfmu.xml: generationTool="shipsim tests".
     assert!(!shipsim::isolate::is_ours(&f.model_description));
     let mut md = f.model_description.clone();
