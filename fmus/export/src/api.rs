@@ -1020,22 +1020,31 @@ fn check_snapshot<M: FmuModel>(snap: &Snapshot<M>) -> Result<(), String> {
             ));
         }
     }
-    // The loops of a step of length 0 from the state's time: only a grid lagging behind it, a
-    // length that is not positive or a NaN take any passes.
-    work(m, core.time, 0.0)?;
-    // A loop's length where the model keeps a copy of the parameter that sets it (a noise grid's
-    // step, a sample interval) obeys the parameter's declared minimum, as `fmi2SetReal` does.
-    let mut below = None;
+    // Every loop's length is a positive number and, where the model keeps a copy of the
+    // parameter that sets it (a noise grid's step, a sample interval), obeys the parameter's
+    // declared minimum, as `fmi2SetReal` does.
+    let mut bad = None;
     m.internal_steps(core.time, 0.0, &mut |name, length, _| {
-        if let Some(lo) = declared_min_seconds::<M>(name) {
-            if !(length >= lo) && below.is_none() {
-                below = Some(format!(
-                    "internal step {name} = {length:?} s is below its declared minimum {lo:?} s"
-                ));
-            }
+        let lo = declared_min_seconds::<M>(name).unwrap_or(0.0);
+        if bad.is_none() && !(length > 0.0) {
+            bad = Some(format!(
+                "internal step {name} = {length:?} s is not a positive number"
+            ));
+        } else if bad.is_none() && !(length >= lo) {
+            bad = Some(format!(
+                "internal step {name} = {length:?} s is below its declared minimum {lo:?} s"
+            ));
         }
     });
-    below.map_or(Ok(()), Err)?;
+    bad.map_or(Ok(()), Err)?;
+    // After initialization the loops are at the state's time: a step of length 0 from it takes
+    // no passes but those of a grid that lags behind (before, `initialize` rebuilds them).
+    if !matches!(
+        core.state,
+        LifeState::Instantiated | LifeState::InitializationMode
+    ) {
+        work(m, core.time, 0.0)?;
+    }
     m.check_restored(core.time)
 }
 
@@ -1058,7 +1067,7 @@ fn real_range(min: Option<f64>, max: Option<f64>) -> String {
         min.unwrap_or(f64::NEG_INFINITY),
         max.unwrap_or(f64::INFINITY),
     );
-    format!("[{lo}, {hi}]")
+    format!("[{lo:?}, {hi:?}]")
 }
 
 /// A restored state refused by [`check_snapshot`]; the instance is left as it was.
@@ -1294,9 +1303,9 @@ pub unsafe fn do_step<M: FmuModel>(
     })
 }
 
-/// The work bound of one `fmi2DoStep`: the passes of the model's internal loops
-/// ([`FmuModel::internal_steps`]) over `[t, t + h]` are at most [`MAX_INTERNAL_STEPS`] in all,
-/// and each loop's length is a positive number. Refused before the model is touched: the
+/// The work bound of one `fmi2DoStep`: each of the model's internal loops
+/// ([`FmuModel::internal_steps`]) takes at most [`MAX_INTERNAL_STEPS`] passes over
+/// `[t, t + h]`, and its length is a positive number. Refused before the model is touched: the
 /// instance stays in StepComplete (as for a refused step size), so a master may retry with a
 /// smaller step.
 #[inline(always)]
@@ -1307,19 +1316,15 @@ fn check_work<M: FmuModel>(inst: &Instance<M>, t: f64, h: f64) -> Result<(), fmi
     }
 }
 
-/// [`check_work`] of a model: the message names the step size, the largest loop and its length.
+/// [`check_work`] of a model: the message names the step size, the longest loop and its length.
 #[inline(always)]
 fn work<M: FmuModel>(m: &M, t: f64, h: f64) -> Result<(), String> {
-    let mut total = 0.0;
+    let mut within = true;
     m.internal_steps(t, h, &mut |_, length, passes| {
-        // A length that is not positive, NaN passes or h / length overflowing make +inf or NaN.
-        total += if length > 0.0 {
-            passes.max(0.0)
-        } else {
-            f64::NAN
-        };
+        // NaN passes fail the comparison, like a length that is not a positive number.
+        within &= length > 0.0 && passes <= MAX_INTERNAL_STEPS;
     });
-    if total <= MAX_INTERNAL_STEPS {
+    if within {
         Ok(())
     } else {
         Err(work_message(m, t, h))
@@ -1329,7 +1334,7 @@ fn work<M: FmuModel>(m: &M, t: f64, h: f64) -> Result<(), String> {
 #[cold]
 #[inline(never)]
 fn work_message<M: FmuModel>(m: &M, t: f64, h: f64) -> String {
-    let (mut total, mut worst) = (0.0, None::<(&str, f64, f64)>);
+    let mut worst = None::<(&str, f64, f64)>;
     let mut not_positive = None;
     m.internal_steps(t, h, &mut |name, length, passes| {
         if !(length > 0.0) {
@@ -1338,9 +1343,8 @@ fn work_message<M: FmuModel>(m: &M, t: f64, h: f64) -> String {
         let passes = if passes.is_nan() {
             f64::INFINITY
         } else {
-            passes.max(0.0)
+            passes
         };
-        total += passes;
         if !worst.is_some_and(|(_, _, most)| most >= passes) {
             worst = Some((name, length, passes));
         }
@@ -1351,13 +1355,13 @@ fn work_message<M: FmuModel>(m: &M, t: f64, h: f64) -> String {
     let (name, length, passes) = worst.unwrap_or(("?", f64::NAN, f64::NAN));
     if h == 0.0 {
         return format!(
-            "the internal loops lag {total:.3e} steps behind the time {t} s ({passes:.3e} of \
-             {name} = {length:?} s)"
+            "the internal steps of {name} = {length:?} s lag {passes:.3e} steps behind the \
+             time {t} s"
         );
     }
     format!(
-        "communicationStepSize = {h} s would take {total:.3e} internal steps ({passes:.3e} of \
-         {name} = {length:?} s); at most {MAX_INTERNAL_STEPS:e} per fmi2DoStep: use a smaller \
+        "communicationStepSize = {h} s would take {passes:.3e} internal steps of {name} = \
+         {length:?} s; at most {MAX_INTERNAL_STEPS:e} per fmi2DoStep: use a smaller \
          communication step size or a larger {name}"
     )
 }

@@ -122,9 +122,10 @@ pub trait FmuModel: FmuDescription + Clone + Default + Serialize + DeserializeOw
     /// parameter that sets it, and `passes` how many times the loop will run over `[t, t + h]`
     /// ([`passes`]`(h, length)` for a loop of `ceil(h / length)` sub-steps; more for a grid that
     /// lags behind `t`). Before each step the layer refuses, with fmi2Error naming the step size
-    /// and the largest loop, a step of more than [`MAX_INTERNAL_STEPS`] passes in all; a restored
-    /// state is refused if a length is not a positive number or the loops lag behind its time by
-    /// more than that ([`FmuModel::check_restored`]). Default: no such loop.
+    /// and the loop, a step in which a loop would take more than [`MAX_INTERNAL_STEPS`] passes;
+    /// a restored state is refused if a length is not a positive number, is below the declared
+    /// minimum of its parameter, or a loop lags behind the state's time by more than that
+    /// ([`FmuModel::check_restored`]). Default: no such loop.
     fn internal_steps(&self, _t: f64, _h: f64, _each: &mut dyn FnMut(&'static str, f64, f64)) {}
 
     /// Checks a restored FMU state (`fmi2SetFMUstate`, `fmi2DeSerializeFMUstate`) beyond what
@@ -148,10 +149,10 @@ pub fn passes(h: f64, length: f64) -> f64 {
     }
 }
 
-/// The most internal loop passes (sub-steps, samples, grid steps; [`FmuModel::internal_steps`])
-/// one `fmi2DoStep` may take. The costliest pass of the 24 FMUs (a ContainerShip RK4 sub-step,
-/// about 0.55 µs) makes this about half a second; the default experiments take at most a few
-/// hundred passes per step.
+/// The most passes one internal loop ([`FmuModel::internal_steps`]: sub-steps, samples, grid
+/// steps) may take in one `fmi2DoStep`. The costliest pass of the 24 FMUs (a ContainerShip RK4
+/// sub-step, about 0.55 µs) makes this about half a second; a noise grid's pass costs about
+/// 10 ns. The default experiments take at most a few hundred passes per step.
 pub const MAX_INTERNAL_STEPS: f64 = 1e6;
 
 /// Emits the FMI 2.0 C API for a model type: the 34 `fmi2*` functions of

@@ -475,9 +475,9 @@ impl<M: FmuModel> Harness<M> {
             .collect()
     }
 
-    /// Sets `integers`, then `reals`, in Initialization Mode (each checked), leaves it at t = 0
-    /// and takes `steps` steps of `h`: the first status that is not fmi2OK, with the last log
-    /// message and the number of steps taken (fmi2OK: all taken).
+    /// Sets `integers`, then `reals`, in Initialization Mode, leaves it at t = 0 and takes
+    /// `steps` steps of `h`: the first status that is not fmi2OK (of a setter, the exit or a
+    /// step), with the last log message and the number of steps taken (fmi2OK: all taken).
     pub fn run_probe(
         &mut self,
         integers: &[(&str, i32)],
@@ -490,10 +490,16 @@ impl<M: FmuModel> Harness<M> {
         let s = self.enter_initialization();
         self.check("fmi2EnterInitializationMode", s);
         for &(name, value) in integers {
-            self.set(name, value);
+            let s = self.try_set(name, value);
+            if s != fmi2OK {
+                return (s, self.log().last(), 0);
+            }
         }
         for &(name, value) in reals {
-            self.set(name, value);
+            let s = self.try_set(name, value);
+            if s != fmi2OK {
+                return (s, self.log().last(), 0);
+            }
         }
         let s = self.exit_initialization();
         if s != fmi2OK {
@@ -542,23 +548,34 @@ pub fn check_probe<M: FmuModel>(
     }
 }
 
+/// How a corrupt serialized state must end (see [`check_corrupt_state`]).
+#[derive(Clone, Copy, Debug)]
+pub enum Corrupt {
+    /// `fmi2DeSerializeFMUstate` refuses it with a message that contains this text.
+    Refused(&'static str),
+    /// It is within the declared ranges (as `fmi2SetReal` would accept it): it restores, and
+    /// the next step of the default experiment returns fmi2Error with a message that contains
+    /// this text (the bound on the work of one step).
+    StepRefused(&'static str),
+}
+
 /// A corrupt serialized FMU state, as a file or a network could deliver it: `M` initialized at
 /// t = 0 (with `integers` set first) takes three steps of its default experiment; its state is
 /// serialized, and the `occurrence`-th (0-based; `None`: every) 8-byte little-endian copy of
-/// `find` in the bytes is replaced by `replace`. `fmi2DeSerializeFMUstate` must refuse the
-/// bytes with fmi2Error and a message that contains `text`; the instance keeps stepping.
+/// `find` in the bytes is replaced by `replace`. The outcome must be `expect`.
 pub fn check_corrupt_state<M: FmuModel>(
     functions: Fmi2Functions,
     integers: &[(&str, i32)],
     find: f64,
     occurrence: Option<usize>,
     replace: f64,
-    text: &str,
+    expect: Corrupt,
 ) {
+    let id = M::MODEL_IDENTIFIER;
     let mut fmu = Harness::<M>::instantiate(functions, "corrupt");
     let h = M::DEFAULT_EXPERIMENT.step_size;
     let (status, last, _) = fmu.run_probe(integers, &[], h, 3);
-    assert_eq!(status, fmi2OK, "{}: {last}", M::MODEL_IDENTIFIER);
+    assert_eq!(status, fmi2OK, "{id}: {last}");
     let state = fmu.get_state();
     let mut bytes = fmu.serialize(state);
     let at: Vec<usize> = (0..bytes.len().saturating_sub(7))
@@ -570,31 +587,36 @@ pub fn check_corrupt_state<M: FmuModel>(
     };
     assert!(
         !chosen.is_empty(),
-        "{}: occurrence {occurrence:?} of {find:?} in the state: found at {at:?}",
-        M::MODEL_IDENTIFIER
+        "{id}: occurrence {occurrence:?} of {find:?} in the state: found at {at:?}"
     );
     for i in chosen {
         bytes[i..i + 8].copy_from_slice(&replace.to_le_bytes());
     }
     let (status, restored) = fmu.deserialize(&bytes);
     let last = fmu.log().last();
-    assert_eq!(
-        status,
-        fmi2Error,
-        "{}: a state with {find:?} -> {replace:?} was accepted",
-        M::MODEL_IDENTIFIER
-    );
-    assert!(
-        restored.0.is_null(),
-        "{}: a state was created",
-        M::MODEL_IDENTIFIER
-    );
-    assert!(
-        last.contains(text),
-        "{}: {last:?} lacks {text:?}",
-        M::MODEL_IDENTIFIER
-    );
-    fmu.step(3.0 * h, h);
+    let case = format!("{id}: a state with {find:?} -> {replace:?}");
+    match expect {
+        Corrupt::Refused(text) => {
+            assert_eq!(status, fmi2Error, "{case} was accepted");
+            assert!(restored.0.is_null(), "{case}: a state was created");
+            assert!(last.contains(text), "{case}: {last:?} lacks {text:?}");
+            fmu.step(3.0 * h, h);
+        }
+        Corrupt::StepRefused(text) => {
+            assert_eq!(status, fmi2OK, "{case} was refused: {last}");
+            assert_eq!(
+                fmu.set_state(restored),
+                fmi2OK,
+                "{case}: {}",
+                fmu.log().last()
+            );
+            let s = fmu.try_step(3.0 * h, h);
+            let last = fmu.log().last();
+            assert_eq!(s, fmi2Error, "{case}: the step returned {}", status_name(s));
+            assert!(last.contains(text), "{case}: {last:?} lacks {text:?}");
+            fmu.free_state(restored);
+        }
+    }
     fmu.free_state(state);
 }
 
