@@ -1,0 +1,88 @@
+//! The cases of the issue-19 reliability probe (of main 616074e, `../shared/reliability/`) for
+//! NomotoShip, through the symbols its crate exports: one step of 10^9 s, tiny sub-step or sample
+//! parameters, extreme in-range parameters that gave fmi2OK with non-finite outputs (or a
+//! hang or a panic) and a corrupt serialized state. Each must end with the error named (or
+//! finite outputs): a case that hung ends with the error of the bound on the work of one step.
+
+use fmi2_export::testing::{check_corrupt_state, check_probe, Corrupt, Outcome, Outcome::*};
+
+fmi2_export::fmi2::declare_fmi2_functions!();
+
+type Fmu = nomoto_ship_fmu::NomotoShipFmu;
+
+/// `integers` and `reals` set in Initialization Mode, then `steps` steps of `h` from t = 0.
+fn probe(integers: &[(&str, i32)], reals: &[(&str, f64)], h: f64, steps: usize, expect: Outcome) {
+    check_probe::<Fmu>(linked_fmi2_functions(), integers, reals, h, steps, expect);
+}
+
+/// bigstep_all.txt: one fmi2DoStep of 1e9 s.
+#[test]
+fn one_step_of_1e9_s_ends() {
+    probe(
+        &[],
+        &[],
+        1000000000.0,
+        1,
+        Error("internal steps of max_substep = "),
+    );
+}
+
+/// tinystep_all.txt: a 1 s step with a tiny positive sub-step or sample parameter.
+#[test]
+fn tiny_internal_steps_end() {
+    probe(
+        &[],
+        &[("max_substep", 1e-300)],
+        1.0,
+        1,
+        Error("internal steps of max_substep = "),
+    );
+}
+
+/// param_sweep_all.txt: extreme in-range parameters that gave fmi2OK with NaN or inf (50 steps of the default experiment).
+#[test]
+fn extreme_parameters_give_an_error_not_nan() {
+    probe(
+        &[],
+        &[("t_prime", 1e-300)],
+        0.1,
+        50,
+        Error("output \"yaw_rate\" = NaN is not a finite number"),
+    );
+    probe(
+        &[],
+        &[("length", 1e-300)],
+        0.1,
+        50,
+        Error("output \"yaw_rate\" = NaN is not a finite number"),
+    );
+    probe(
+        &[],
+        &[("speed", 1e+300)],
+        0.1,
+        50,
+        Error("output \"speed_over_ground\" = inf is not a finite number"),
+    );
+}
+
+/// param_sweep_all.txt: extreme in-range parameters that hung (50 steps of the default experiment).
+#[test]
+fn extreme_parameters_that_hung_end() {
+    probe(
+        &[],
+        &[("max_substep", 1e-300)],
+        0.1,
+        50,
+        Error("internal steps of max_substep = "),
+    );
+}
+
+/// fuzz_state_all.txt: a serialized state whose sub-step or sample interval (every copy of
+/// 0.1) is 1.5e-40 (the mutated states that hung) is refused, or, where the declared
+/// range allows it, restores and its next step is refused by the bound.
+#[test]
+fn a_corrupt_state_is_refused_or_bounded() {
+    let (find, replace) = (0.1, 1.5e-40);
+    let expect = Corrupt::StepRefused("internal steps of max_substep = ");
+    check_corrupt_state::<Fmu>(linked_fmi2_functions(), &[], find, None, replace, expect);
+}

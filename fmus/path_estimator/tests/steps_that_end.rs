@@ -1,0 +1,125 @@
+//! The cases of the issue-19 reliability probe (of main 616074e, `../shared/reliability/`) for
+//! PathEstimator, through the symbols its crate exports: one step of 10^9 s, tiny sub-step or sample
+//! parameters, extreme in-range parameters that gave fmi2OK with non-finite outputs (or a
+//! hang or a panic) and a corrupt serialized state. Each must end with the error named (or
+//! finite outputs): a case that hung ends with the error of the bound on the work of one step.
+
+use fmi2_export::testing::{check_probe, Outcome, Outcome::*};
+
+fmi2_export::fmi2::declare_fmi2_functions!();
+
+type Fmu = path_estimator_fmu::PathEstimatorFmu;
+
+/// `integers` and `reals` set in Initialization Mode, then `steps` steps of `h` from t = 0.
+fn probe(integers: &[(&str, i32)], reals: &[(&str, f64)], h: f64, steps: usize, expect: Outcome) {
+    check_probe::<Fmu>(linked_fmi2_functions(), integers, reals, h, steps, expect);
+}
+
+/// bigstep_all.txt: one fmi2DoStep of 1e9 s.
+#[test]
+fn one_step_of_1e9_s_ends() {
+    probe(&[], &[], 1000000000.0, 1, Finite);
+}
+
+/// param_sweep_all.txt: extreme in-range parameters that gave fmi2OK with NaN or inf (50 steps of the default experiment).
+#[test]
+fn extreme_parameters_give_an_error_not_nan() {
+    probe(
+        &[],
+        &[("sigma_heading", 1e+300)],
+        0.2349,
+        50,
+        Error("output \"f22_estimate\" = NaN is not a finite number"),
+    );
+    probe(
+        &[],
+        &[("sigma_yaw_rate", 1e+300)],
+        0.2349,
+        50,
+        Error("output \"f22_estimate\" = NaN is not a finite number"),
+    );
+    probe(
+        &[],
+        &[("sigma_drift_angle", 1e+300)],
+        0.2349,
+        50,
+        Error("output \"f22_estimate\" = NaN is not a finite number"),
+    );
+    probe(
+        &[],
+        &[("sigma_cross_track", 1e+300)],
+        0.2349,
+        50,
+        Error("output \"f22_estimate\" = NaN is not a finite number"),
+    );
+    probe(
+        &[],
+        &[("q_n", 1e+300)],
+        0.2349,
+        50,
+        Error("output \"f22_estimate\" = NaN is not a finite number"),
+    );
+    probe(
+        &[],
+        &[("q_y", 1e+300)],
+        0.2349,
+        50,
+        Error("output \"f22_estimate\" = NaN is not a finite number"),
+    );
+    probe(
+        &[],
+        &[("ship_length", 1e-300)],
+        0.2349,
+        50,
+        Error("output \"f22_estimate\" = NaN is not a finite number"),
+    );
+    probe(
+        &[],
+        &[("ship_speed", 1e+300)],
+        0.2349,
+        50,
+        Error("output \"f22_estimate\" = NaN is not a finite number"),
+    );
+    probe(
+        &[],
+        &[("yaw_rate", 1e+300)],
+        0.2349,
+        50,
+        Error("output \"f22_estimate\" = NaN is not a finite number"),
+    );
+    probe(
+        &[],
+        &[("yaw_rate", -1e+300)],
+        0.2349,
+        50,
+        Error("output \"f22_estimate\" = NaN is not a finite number"),
+    );
+    probe(
+        &[],
+        &[("drift_angle", 1e+300)],
+        0.2349,
+        50,
+        Error("output \"f22_estimate\" = NaN is not a finite number"),
+    );
+    probe(
+        &[],
+        &[("drift_angle", -1e+300)],
+        0.2349,
+        50,
+        Error("output \"f22_estimate\" = NaN is not a finite number"),
+    );
+    probe(
+        &[],
+        &[("rudder_angle", 1e+300)],
+        0.2349,
+        50,
+        Error("output \"f22_estimate\" = NaN is not a finite number"),
+    );
+    probe(
+        &[],
+        &[("rudder_angle", -1e+300)],
+        0.2349,
+        50,
+        Error("output \"f22_estimate\" = NaN is not a finite number"),
+    );
+}
