@@ -66,10 +66,13 @@ fn install_panic_hook() {
 /// the panic hook of [`install_panic_hook`] keeps a panic off the importer's stderr.
 #[inline(always)]
 fn guarded<R>(f: impl FnOnce() -> R) -> std::thread::Result<R> {
-    let outer = IN_FMI_CALL.with(|flag| flag.replace(true));
-    let result = catch_unwind(AssertUnwindSafe(f));
-    IN_FMI_CALL.with(|flag| flag.set(outer));
-    result
+    // One thread-local access per call (in a shared library each costs a `__tls_get_addr`).
+    IN_FMI_CALL.with(|flag| {
+        let outer = flag.replace(true);
+        let result = catch_unwind(AssertUnwindSafe(f));
+        flag.set(outer);
+        result
+    })
 }
 
 /// Runs `f` on the instance behind `c` if `function` is legal in its state; a panic becomes
@@ -332,6 +335,7 @@ pub unsafe fn exit_initialization_mode<M: FmuModel>(c: fmi2Component) -> fmi2Sta
         |inst| match inst.model.initialize(inst.core.start_time) {
             Ok(()) => {
                 inst.dirty = false;
+                inst.work_limit = 0.0;
                 if let Some(vr) = inst.fast.non_finite_output(&inst.model) {
                     inst.core.state = LifeState::Error;
                     let at = format_args!("at t = {}", inst.core.start_time);
@@ -379,6 +383,7 @@ pub unsafe fn reset<M: FmuModel>(c: fmi2Component) -> fmi2Status {
             stop_time: None,
         };
         inst.dirty = true;
+        inst.work_limit = 0.0;
         inst.log(fmi2OK, CAT_EVENTS, "reset to the start values");
         fmi2OK
     })
@@ -537,7 +542,7 @@ pub unsafe fn get_real<M: FmuModel>(
     n: usize,
     out: *mut fmi2Real,
 ) -> fmi2Status {
-    get_values::<M, f64>(
+    let status = get_values::<M, f64>(
         c,
         "fmi2GetReal",
         crate::BaseType::Real,
@@ -552,7 +557,36 @@ pub unsafe fn get_real<M: FmuModel>(
             Access::Real { get, .. } => get(m),
             _ => unreachable!("type checked by lookup"),
         },
-    )
+    );
+    if status != fmi2OK || n == 0 {
+        return status;
+    }
+    // No non-finite value leaves the FMU with fmi2OK: x - x is 0 for a finite x and NaN for
+    // NaN and the infinities, so the common path is two operations per value and one test.
+    let values = std::slice::from_raw_parts(out, n);
+    let sum = values.iter().fold(0.0, |sum, &x| sum + (x - x));
+    if sum == 0.0 {
+        return fmi2OK;
+    }
+    non_finite_value::<M>(c, std::slice::from_raw_parts(vr, n), values)
+}
+
+/// A value `fmi2GetReal` read is not a finite number: fmi2Error naming the variable, its value
+/// and the time; the instance moves to the Error state (the FMU produced it).
+#[cold]
+#[inline(never)]
+unsafe fn non_finite_value<M: FmuModel>(
+    c: fmi2Component,
+    vrs: &[fmi2ValueReference],
+    values: &[f64],
+) -> fmi2Status {
+    let inst = &mut *(c as *mut Instance<M>);
+    let Some(k) = values.iter().position(|x| !x.is_finite()) else {
+        return fmi2OK;
+    };
+    inst.core.state = LifeState::Error;
+    let at = format_args!("at t = {}", inst.core.time);
+    non_finite_output(inst, "fmi2GetReal", at, vrs[k])
 }
 
 /// # Safety
@@ -700,6 +734,7 @@ fn set_by_table<M: FmuModel, T: Copy>(
         }
     };
     inst.dirty = true;
+    inst.work_limit = 0.0;
     if inst.core.state == LifeState::StepComplete && v.causality == Causality::Parameter {
         return tunable_changed(inst, function, v, old, apply);
     }
@@ -943,6 +978,7 @@ pub unsafe fn set_fmu_state<M: FmuModel>(c: fmi2Component, s: fmi2FMUstate) -> f
                 inst.model = b.snapshot.model.clone();
                 inst.core = b.snapshot.core.clone();
                 inst.dirty = false;
+                inst.work_limit = 0.0;
                 inst.log_fmt(
                     fmi2OK,
                     CAT_EVENTS,
@@ -1284,18 +1320,15 @@ pub unsafe fn do_step<M: FmuModel>(
                 return past_stop(inst, end, stop);
             }
         }
-        if let Err(status) = check_work(inst, t, h) {
-            return status;
+        if !(h <= inst.work_limit) {
+            if let Err(status) = check_work(inst, t, h) {
+                return status;
+            }
         }
         match inst.model.do_step(t, h) {
             Ok(()) => {
-                inst.dirty = false;
-                if let Some(vr) = inst.fast.non_finite_output(&inst.model) {
-                    inst.core.state = LifeState::Error;
-                    let at = format_args!("at t = {t}, h = {h}");
-                    return non_finite_output(inst, "fmi2DoStep", at, vr);
-                }
                 inst.core.time = t + h;
+                inst.dirty = false;
                 fmi2OK
             }
             Err(msg) => step_failed(inst, t, h, &msg),
@@ -1308,10 +1341,20 @@ pub unsafe fn do_step<M: FmuModel>(
 /// `[t, t + h]`, and its length is a positive number. Refused before the model is touched: the
 /// instance stays in StepComplete (as for a refused step size), so a master may retry with a
 /// smaller step.
-#[inline(always)]
-fn check_work<M: FmuModel>(inst: &Instance<M>, t: f64, h: f64) -> Result<(), fmi2Status> {
+///
+/// A step that passes sets [`Instance::work_limit`] to half the bound's passes of the shortest
+/// loop: later steps up to that size skip the check (their loops' lengths are unchanged until
+/// the limit is reset, and a loop lags at most one pass behind after a step).
+#[inline(never)]
+fn check_work<M: FmuModel>(inst: &mut Instance<M>, t: f64, h: f64) -> Result<(), fmi2Status> {
     match work(&inst.model, t, h) {
-        Ok(()) => Ok(()),
+        Ok(()) => {
+            let mut shortest = f64::INFINITY;
+            inst.model
+                .internal_steps(t, h, &mut |_, length, _| shortest = shortest.min(length));
+            inst.work_limit = 0.5 * MAX_INTERNAL_STEPS * shortest;
+            Ok(())
+        }
         Err(msg) => Err(too_much_work(inst, t, h, &msg)),
     }
 }

@@ -476,8 +476,9 @@ impl<M: FmuModel> Harness<M> {
     }
 
     /// Sets `integers`, then `reals`, in Initialization Mode, leaves it at t = 0 and takes
-    /// `steps` steps of `h`: the first status that is not fmi2OK (of a setter, the exit or a
-    /// step), with the last log message and the number of steps taken (fmi2OK: all taken).
+    /// `steps` steps of `h`, reading every Real output after each: the first status that is not
+    /// fmi2OK (of a setter, the exit, a step or a read), with the last log message and the
+    /// number of steps taken (fmi2OK: all taken).
     pub fn run_probe(
         &mut self,
         integers: &[(&str, i32)],
@@ -505,10 +506,23 @@ impl<M: FmuModel> Harness<M> {
         if s != fmi2OK {
             return (s, self.log().last(), 0);
         }
+        let outputs: Vec<fmi2ValueReference> = M::variables()
+            .iter()
+            .enumerate()
+            .filter(|(_, v)| v.causality == Causality::Output && v.base_type() == BaseType::Real)
+            .map(|(vr, _)| vr as fmi2ValueReference)
+            .collect();
+        let mut values = vec![0.0; outputs.len()];
         for k in 0..steps {
             let s = self.try_step(k as f64 * h, h);
             if s != fmi2OK {
                 return (s, self.log().last(), k);
+            }
+            // The outputs, as a master reads them after each step.
+            let (n, vrs, out) = (outputs.len(), outputs.as_ptr(), values.as_mut_ptr());
+            let s = unsafe { (self.f.fmi2GetReal)(self.c, vrs, n, out) };
+            if s != fmi2OK {
+                return (s, self.log().last(), k + 1);
             }
         }
         (fmi2OK, self.log().last(), steps)
@@ -618,6 +632,44 @@ pub fn check_corrupt_state<M: FmuModel>(
         }
     }
     fmu.free_state(state);
+}
+
+/// For a test file of an FMU crate with the cases of the reliability probe: declares the FMI
+/// symbols the crate exports and, over them, `probe(integers, reals, h, steps, expect)`
+/// ([`check_probe`]) and `corrupt(integers, find, replace, expect)` ([`check_corrupt_state`] of
+/// every copy of `find`). Use once per test file: `fmi2_export::probe_cases!(my_fmu::MyFmu);`.
+#[macro_export]
+macro_rules! probe_cases {
+    ($model:ty) => {
+        $crate::fmi2::declare_fmi2_functions!();
+
+        /// `integers` and `reals` set in Initialization Mode, then `steps` steps of `h` from 0.
+        #[allow(dead_code)]
+        fn probe(
+            integers: &[(&str, i32)],
+            reals: &[(&str, f64)],
+            h: f64,
+            steps: usize,
+            expect: $crate::testing::Outcome,
+        ) {
+            let f = linked_fmi2_functions();
+            $crate::testing::check_probe::<$model>(f, integers, reals, h, steps, expect);
+        }
+
+        /// The serialized state after three default steps with every copy of `find` replaced.
+        #[allow(dead_code)]
+        fn corrupt(
+            integers: &[(&str, i32)],
+            find: f64,
+            replace: f64,
+            expect: $crate::testing::Corrupt,
+        ) {
+            let f = linked_fmi2_functions();
+            $crate::testing::check_corrupt_state::<$model>(
+                f, integers, find, None, replace, expect,
+            );
+        }
+    };
 }
 
 /// One variable as `modelDescription.xml` declares it, in a form both the table and an

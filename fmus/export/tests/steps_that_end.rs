@@ -102,7 +102,7 @@ fn a_step_of_more_than_a_million_sub_steps_is_refused_and_the_instance_keeps_goi
 }
 
 #[test]
-fn a_non_finite_output_after_initialization_or_a_step_is_an_error_naming_it() {
+fn a_non_finite_output_after_initialization_or_read_is_an_error_naming_it() {
     // The declared minimum divisor = 0 gives ratio = inf at initialization.
     let mut fmu = stepper();
     fmu.set("divisor", 0.0);
@@ -116,16 +116,26 @@ fn a_non_finite_output_after_initialization_or_a_step_is_an_error_naming_it() {
     );
     assert_eq!(fmu.try_step(0.0, 0.1), fmi2Error);
     assert!(fmu.log().last().contains("not allowed in state Error"));
-    // y turns NaN in the step from t = 0.2.
+    // y turns NaN in the step from t = 0.2: reading it is an error naming it, and the instance
+    // is in the Error state.
     let mut fmu = stepper();
     fmu.set("nan_at", 0.2).initialize(0.0);
-    fmu.step(0.0, 0.1).step(0.1, 0.1);
-    assert_eq!(fmu.try_step(0.2, 0.1), fmi2Error);
+    fmu.step(0.0, 0.1).step(0.1, 0.1).step(0.2, 0.1);
+    assert_eq!(fmu.try_get::<f64>("x").0, fmi2OK);
+    let vrs = [fmu.vr("x"), fmu.vr("y")];
+    let mut out = [0.0; 2];
+    let (f, c) = (fmu.functions(), fmu.component());
+    assert_eq!(
+        unsafe { (f.fmi2GetReal)(c, vrs.as_ptr(), 2, out.as_mut_ptr()) },
+        fmi2Error
+    );
     assert_eq!(
         fmu.log().last(),
-        "fmi2DoStep at t = 0.2, h = 0.1: instance \"s\": output \"y\" = NaN is not a finite \
-         number (parameters or inputs outside what the model can handle?)"
+        "fmi2GetReal at t = 0.30000000000000004: instance \"s\": output \"y\" = NaN is not a \
+         finite number (parameters or inputs outside what the model can handle?)"
     );
+    assert_eq!(fmu.try_step(0.3, 0.1), fmi2Error);
+    assert!(fmu.log().last().contains("not allowed in state Error"));
     assert_eq!(fmu.terminate(), fmi2Error);
 }
 
