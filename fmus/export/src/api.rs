@@ -66,13 +66,10 @@ fn install_panic_hook() {
 /// the panic hook of [`install_panic_hook`] keeps a panic off the importer's stderr.
 #[inline(always)]
 fn guarded<R>(f: impl FnOnce() -> R) -> std::thread::Result<R> {
-    // One thread-local access per call (in a shared library each costs a `__tls_get_addr`).
-    IN_FMI_CALL.with(|flag| {
-        let outer = flag.replace(true);
-        let result = catch_unwind(AssertUnwindSafe(f));
-        flag.set(outer);
-        result
-    })
+    let outer = IN_FMI_CALL.with(|flag| flag.replace(true));
+    let result = catch_unwind(AssertUnwindSafe(f));
+    IN_FMI_CALL.with(|flag| flag.set(outer));
+    result
 }
 
 /// Runs `f` on the instance behind `c` if `function` is legal in its state; a panic becomes
@@ -88,6 +85,21 @@ unsafe fn with_instance<M: FmuModel>(
     legal: u32,
     f: impl FnOnce(&mut Instance<M>) -> fmi2Status,
 ) -> fmi2Status {
+    with_instance_flagged::<M, true>(c, function, legal, f)
+}
+
+/// [`with_instance`] with the panic hook's thread-local flag set (`FLAG`) or not. The getters
+/// and setters (`fmi2Get*`, `fmi2Set*`, a master's most frequent calls) run without it: in a
+/// shared library each thread-local access is a `__tls_get_addr` call, and the two per call
+/// cost about 1 % of the RRS system (callgrind). A panic there is still caught and logged, and
+/// also goes to the host's panic hook.
+#[inline(always)]
+unsafe fn with_instance_flagged<M: FmuModel, const FLAG: bool>(
+    c: fmi2Component,
+    function: &str,
+    legal: u32,
+    f: impl FnOnce(&mut Instance<M>) -> fmi2Status,
+) -> fmi2Status {
     if c.is_null() {
         return fmi2Error;
     }
@@ -96,7 +108,12 @@ unsafe fn with_instance<M: FmuModel>(
     if let Err(status) = (*inst).check_state(function, legal) {
         return status;
     }
-    match guarded(|| f(&mut *inst)) {
+    let result = if FLAG {
+        guarded(|| f(&mut *inst))
+    } else {
+        catch_unwind(AssertUnwindSafe(|| f(&mut *inst)))
+    };
+    match result {
         Ok(status) => status,
         Err(p) => panicked(&mut *inst, function, p.as_ref()),
     }
@@ -496,7 +513,7 @@ unsafe fn get_values<M: FmuModel, T>(
     fast: impl Fn(&Instance<M>, fmi2ValueReference) -> Option<T>,
     read: impl Fn(&Variable<M>, &M) -> T,
 ) -> fmi2Status {
-    with_instance::<M>(c, function, mask::GET, |inst| {
+    with_instance_flagged::<M, false>(c, function, mask::GET, |inst| {
         if n == 0 {
             return fmi2OK;
         }
@@ -676,7 +693,7 @@ unsafe fn set_values<M: FmuModel, T: Copy>(
     fast: impl Fn(&mut Instance<M>, fmi2ValueReference, T) -> bool,
     apply: impl Fn(&Variable<M>, &mut M, T) -> Result<Option<T>, String>,
 ) -> fmi2Status {
-    with_instance::<M>(c, function, legal, |inst| {
+    with_instance_flagged::<M, false>(c, function, legal, |inst| {
         if n == 0 {
             return fmi2OK;
         }
