@@ -1,19 +1,10 @@
-//! The cases of the issue-19 reliability probe (of main 616074e, `../shared/reliability/`) for
-//! DpController, through the symbols its crate exports: one step of 10^9 s, tiny sub-step or sample
-//! parameters, extreme in-range parameters that gave fmi2OK with non-finite outputs (or a
-//! hang or a panic) and a corrupt serialized state. Each must end with the error named (or
-//! finite outputs): a case that hung ends with the error of the bound on the work of one step.
+//! The issue-19 reliability probe's cases (`../shared/reliability/`, main 616074e) for DpController:
+//! each ends with the error named or finite outputs (a case that hung, with the error of the
+//! bound on the work of one step). See `fmi2_export::testing::check_probe`.
 
-use fmi2_export::testing::{check_probe, Outcome, Outcome::*};
+use fmi2_export::testing::Outcome::*;
 
-fmi2_export::fmi2::declare_fmi2_functions!();
-
-type Fmu = dp_controller_fmu::DpControllerFmu;
-
-/// `integers` and `reals` set in Initialization Mode, then `steps` steps of `h` from t = 0.
-fn probe(integers: &[(&str, i32)], reals: &[(&str, f64)], h: f64, steps: usize, expect: Outcome) {
-    check_probe::<Fmu>(linked_fmi2_functions(), integers, reals, h, steps, expect);
-}
+fmi2_export::probe_cases!(dp_controller_fmu::DpControllerFmu);
 
 /// bigstep_all.txt: one fmi2DoStep of 1e9 s.
 #[test]

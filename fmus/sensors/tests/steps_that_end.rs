@@ -1,19 +1,10 @@
-//! The cases of the issue-19 reliability probe (of main 616074e, `../shared/reliability/`) for
-//! Sensors, through the symbols its crate exports: one step of 10^9 s, tiny sub-step or sample
-//! parameters, extreme in-range parameters that gave fmi2OK with non-finite outputs (or a
-//! hang or a panic) and a corrupt serialized state. Each must end with the error named (or
-//! finite outputs): a case that hung ends with the error of the bound on the work of one step.
+//! The issue-19 reliability probe's cases (`../shared/reliability/`, main 616074e) for Sensors:
+//! each ends with the error named or finite outputs (a case that hung, with the error of the
+//! bound on the work of one step). See `fmi2_export::testing::check_probe`.
 
-use fmi2_export::testing::{check_corrupt_state, check_probe, Corrupt, Outcome, Outcome::*};
+use fmi2_export::testing::{Corrupt, Outcome::*};
 
-fmi2_export::fmi2::declare_fmi2_functions!();
-
-type Fmu = sensors_fmu::SensorsFmu;
-
-/// `integers` and `reals` set in Initialization Mode, then `steps` steps of `h` from t = 0.
-fn probe(integers: &[(&str, i32)], reals: &[(&str, f64)], h: f64, steps: usize, expect: Outcome) {
-    check_probe::<Fmu>(linked_fmi2_functions(), integers, reals, h, steps, expect);
-}
+fmi2_export::probe_cases!(sensors_fmu::SensorsFmu);
 
 /// bigstep_all.txt: one fmi2DoStep of 1e9 s.
 #[test]
@@ -33,12 +24,15 @@ fn tiny_internal_steps_end() {
     probe(&[], &[("heading_interval", 1e-06)], 1.0, 1, Finite);
 }
 
-/// fuzz_state_all.txt: a serialized state whose sub-step or sample interval (every copy of
-/// 0.23488120950323976) is 1.5e-40 (the mutated states that hung) is refused, or, where the declared
-/// range allows it, restores and its next step is refused by the bound.
+/// fuzz_state_all.txt: a state whose sub-step or sample interval (every copy of 0.23488120950323976) is
+/// 1.5e-40 (the mutated states that hung) is refused, or restores within the declared range and
+/// its next step is refused by the bound.
 #[test]
 fn a_corrupt_state_is_refused_or_bounded() {
-    let (find, replace) = (0.23488120950323976, 1.5e-40);
-    let expect = Corrupt::Refused("is not a finite number in [1e-6, inf]");
-    check_corrupt_state::<Fmu>(linked_fmi2_functions(), &[], find, None, replace, expect);
+    corrupt(
+        &[],
+        0.23488120950323976,
+        1.5e-40,
+        Corrupt::Refused("is not a finite number in [1e-6, inf]"),
+    );
 }
