@@ -581,6 +581,7 @@ pub unsafe fn get_real<M: FmuModel>(
     // No non-finite value leaves the FMU with fmi2OK: x - x is 0 for a finite x and NaN for
     // NaN and the infinities, so the common path is two operations per value and one test.
     let values = std::slice::from_raw_parts(out, n);
+    #[allow(clippy::eq_op)] // x - x: 0 or NaN, the point of the test
     let sum = values.iter().fold(0.0, |sum, &x| sum + (x - x));
     if sum == 0.0 {
         return fmi2OK;
@@ -1079,11 +1080,11 @@ fn check_snapshot<M: FmuModel>(snap: &Snapshot<M>) -> Result<(), String> {
     let mut bad = None;
     m.internal_steps(core.time, 0.0, &mut |name, length, _| {
         let lo = declared_min_seconds::<M>(name).unwrap_or(0.0);
-        if bad.is_none() && !(length > 0.0) {
+        if bad.is_none() && !positive(length) {
             bad = Some(format!(
                 "internal step {name} = {length:?} s is not a positive number"
             ));
-        } else if bad.is_none() && !(length >= lo) {
+        } else if bad.is_none() && !length.ge(&lo) {
             bad = Some(format!(
                 "internal step {name} = {length:?} s is below its declared minimum {lo:?} s"
             ));
@@ -1113,6 +1114,12 @@ fn declared_min_seconds<M: FmuModel>(name: &str) -> Option<f64> {
         } if v.causality == Causality::Parameter => min,
         _ => None,
     }
+}
+
+/// Whether `x` is a positive number (false for NaN).
+#[inline(always)]
+fn positive(x: f64) -> bool {
+    x > 0.0
 }
 
 fn real_range(min: Option<f64>, max: Option<f64>) -> String {
@@ -1337,7 +1344,7 @@ pub unsafe fn do_step<M: FmuModel>(
                 return past_stop(inst, end, stop);
             }
         }
-        if !(h <= inst.work_limit) {
+        if h > inst.work_limit {
             if let Err(status) = check_work(inst, t, h) {
                 return status;
             }
@@ -1397,7 +1404,7 @@ fn work_message<M: FmuModel>(m: &M, t: f64, h: f64) -> String {
     let mut worst = None::<(&str, f64, f64)>;
     let mut not_positive = None;
     m.internal_steps(t, h, &mut |name, length, passes| {
-        if !(length > 0.0) {
+        if !positive(length) {
             not_positive.get_or_insert((name, length));
         }
         let passes = if passes.is_nan() {
