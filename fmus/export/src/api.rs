@@ -498,12 +498,35 @@ fn update_outputs<M: FmuModel>(inst: &mut Instance<M>) {
     }
 }
 
+/// A value a getter hands out: `x - x` for a Real (0 when finite, NaN for NaN and the
+/// infinities), 0 for the other types, summed over the values of a call.
+trait Handed: Copy {
+    fn not_finite(self) -> f64;
+}
+
+impl Handed for f64 {
+    #[inline(always)]
+    #[allow(clippy::eq_op)] // x - x: 0 or NaN, the point of the test
+    fn not_finite(self) -> f64 {
+        self - self
+    }
+}
+
+impl Handed for i32 {
+    #[inline(always)]
+    fn not_finite(self) -> f64 {
+        0.0
+    }
+}
+
 /// Shared body of the typed getters. `fast` reads a value reference that the fast path knows
 /// (Real variables, [`crate::fast`]); any other goes through the table, which checks its type and
-/// names a wrong one, and `read` reads it.
+/// names a wrong one, and `read` reads it. No non-finite Real leaves with fmi2OK: the values'
+/// [`Handed::not_finite`] are summed in the same loop (two operations per Real, none for the
+/// other types) and a NaN sum is an error naming the variable.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
-unsafe fn get_values<M: FmuModel, T>(
+unsafe fn get_values<M: FmuModel, T: Handed>(
     c: fmi2Component,
     function: &str,
     base: crate::BaseType,
@@ -524,16 +547,24 @@ unsafe fn get_values<M: FmuModel, T>(
             update_outputs(inst);
         }
         let vrs = std::slice::from_raw_parts(vr, n);
+        let mut sum = 0.0;
         for (i, &r) in vrs.iter().enumerate() {
-            *out.add(i) = match fast(inst, r) {
+            let x = match fast(inst, r) {
                 Some(x) => x,
                 None => match get_by_table(inst, function, base, r, &read) {
                     Ok(x) => x,
                     Err(s) => return s,
                 },
             };
+            sum += x.not_finite();
+            *out.add(i) = x;
         }
-        fmi2OK
+        if sum == 0.0 {
+            fmi2OK
+        } else {
+            let values = std::slice::from_raw_parts(out, n);
+            non_finite_value(inst, vrs, values)
+        }
     })
 }
 
@@ -559,7 +590,7 @@ pub unsafe fn get_real<M: FmuModel>(
     n: usize,
     out: *mut fmi2Real,
 ) -> fmi2Status {
-    let status = get_values::<M, f64>(
+    get_values::<M, f64>(
         c,
         "fmi2GetReal",
         crate::BaseType::Real,
@@ -574,32 +605,19 @@ pub unsafe fn get_real<M: FmuModel>(
             Access::Real { get, .. } => get(m),
             _ => unreachable!("type checked by lookup"),
         },
-    );
-    if status != fmi2OK || n == 0 {
-        return status;
-    }
-    // No non-finite value leaves the FMU with fmi2OK: x - x is 0 for a finite x and NaN for
-    // NaN and the infinities, so the common path is two operations per value and one test.
-    let values = std::slice::from_raw_parts(out, n);
-    #[allow(clippy::eq_op)] // x - x: 0 or NaN, the point of the test
-    let sum = values.iter().fold(0.0, |sum, &x| sum + (x - x));
-    if sum == 0.0 {
-        return fmi2OK;
-    }
-    non_finite_value::<M>(c, std::slice::from_raw_parts(vr, n), values)
+    )
 }
 
 /// A value `fmi2GetReal` read is not a finite number: fmi2Error naming the variable, its value
 /// and the time; the instance moves to the Error state (the FMU produced it).
 #[cold]
 #[inline(never)]
-unsafe fn non_finite_value<M: FmuModel>(
-    c: fmi2Component,
+fn non_finite_value<M: FmuModel, T: Handed>(
+    inst: &mut Instance<M>,
     vrs: &[fmi2ValueReference],
-    values: &[f64],
+    values: &[T],
 ) -> fmi2Status {
-    let inst = &mut *(c as *mut Instance<M>);
-    let Some(k) = values.iter().position(|x| !x.is_finite()) else {
+    let Some(k) = values.iter().position(|x| x.not_finite() != 0.0) else {
         return fmi2OK;
     };
     inst.core.state = LifeState::Error;
