@@ -22,7 +22,19 @@
 //!   is the GUID, a constant of the binary computed once on first use);
 //! * FMU state get/set/free and serialization implemented for real (a snapshot is a clone of the
 //!   model plus the instance's time and state); `fmi2Reset` returns to the start values;
-//! * NaN/infinite Real values are refused with a message naming the variable;
+//! * NaN/infinite Real values are refused with a message naming the variable, on the way in
+//!   (`fmi2SetReal`) and on the way out: the Real outputs are checked after
+//!   `fmi2ExitInitializationMode`, and `fmi2GetReal` returns fmi2Error naming the variable
+//!   instead of fmi2OK with a non-finite value (issue 19);
+//! * every step ends: a model declares its internal loops ([`FmuModel::internal_steps`]) and
+//!   `fmi2DoStep` refuses a step in which one would take more than [`MAX_INTERNAL_STEPS`]
+//!   passes, naming the step size and the parameter;
+//! * a restored FMU state (`fmi2SetFMUstate`, `fmi2DeSerializeFMUstate`) is validated like the
+//!   setters validate values: finite times, parameters and inputs in their declared ranges,
+//!   internal loops of positive length, at least their parameter's minimum, not lagging;
+//! * a panic inside an FMI call goes to the instance's logger with its location, not to the
+//!   host's stderr (a panic hook installed once per FMU library, silent inside the library's
+//!   FMI calls but for the getters and setters, deferring to the previous hook otherwise);
 //! * `fmi2SetReal` and `fmi2GetReal` take the Real accessors from a per-instance table indexed
 //!   by value reference (`fast.rs`): a Real input within its range is written after one bounds
 //!   test and two comparisons; every other value goes through the variable table, which gives
