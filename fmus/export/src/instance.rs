@@ -93,6 +93,11 @@ pub struct Instance<M> {
     pub magic: u64,
     /// The Real accessors by value reference, for `fmi2GetReal` and `fmi2SetReal`.
     pub fast: FastAccess<M>,
+    /// A step size up to which `fmi2DoStep` needs no work-bound check: half the bound's passes
+    /// of the shortest internal loop, taken when a step passed the check; 0 (check every
+    /// step) after anything that may change a loop (a parameter set through the table, a
+    /// restored state, initialization, reset).
+    pub work_limit: f64,
 }
 
 pub const CAT_EVENTS: usize = 0;
@@ -161,6 +166,7 @@ impl<M: FmuModel> Instance<M> {
             enabled,
             magic,
             fast: FastAccess::new(),
+            work_limit: 0.0,
         }
     }
 

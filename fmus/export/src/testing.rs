@@ -11,7 +11,7 @@
 //! the table, every variable readable and writable by name at its start value, and an exact
 //! rollback of the FMU state.
 
-use crate::variables::{check_table, Access, BaseType, Variable};
+use crate::variables::{check_table, Access, BaseType, Causality, Variable};
 use crate::xml::real;
 use crate::FmuModel;
 use fmi2::*;
@@ -451,6 +451,225 @@ impl<M: FmuModel> Drop for Harness<M> {
     fn drop(&mut self) {
         unsafe { (self.f.fmi2FreeInstance)(self.c) }
     }
+}
+
+/// How a probe case must end (see [`check_probe`]).
+#[derive(Clone, Copy, Debug)]
+pub enum Outcome {
+    /// A call returns fmi2Error with a log message that contains this text.
+    Error(&'static str),
+    /// Every call returns fmi2OK and every Real output stays finite.
+    Finite,
+}
+
+impl<M: FmuModel> Harness<M> {
+    /// The Real outputs that are not finite numbers, by name (read one by one: a getter's status
+    /// is checked).
+    pub fn non_finite_outputs(&self) -> Vec<&'static str> {
+        let outputs = M::variables()
+            .iter()
+            .filter(|v| v.causality == Causality::Output && v.base_type() == BaseType::Real);
+        outputs
+            .filter(|v| !self.real(v.name).is_finite())
+            .map(|v| v.name)
+            .collect()
+    }
+
+    /// Sets `integers`, then `reals`, in Initialization Mode, leaves it at t = 0 and takes
+    /// `steps` steps of `h`, reading every Real output after each: the first status that is not
+    /// fmi2OK (of a setter, the exit, a step or a read), with the last log message and the
+    /// number of steps taken (fmi2OK: all taken).
+    pub fn run_probe(
+        &mut self,
+        integers: &[(&str, i32)],
+        reals: &[(&str, f64)],
+        h: f64,
+        steps: usize,
+    ) -> (fmi2Status, String, usize) {
+        let s = self.setup(0.0, None);
+        self.check("fmi2SetupExperiment", s);
+        let s = self.enter_initialization();
+        self.check("fmi2EnterInitializationMode", s);
+        for &(name, value) in integers {
+            let s = self.try_set(name, value);
+            if s != fmi2OK {
+                return (s, self.log().last(), 0);
+            }
+        }
+        for &(name, value) in reals {
+            let s = self.try_set(name, value);
+            if s != fmi2OK {
+                return (s, self.log().last(), 0);
+            }
+        }
+        let s = self.exit_initialization();
+        if s != fmi2OK {
+            return (s, self.log().last(), 0);
+        }
+        let outputs: Vec<fmi2ValueReference> = M::variables()
+            .iter()
+            .enumerate()
+            .filter(|(_, v)| v.causality == Causality::Output && v.base_type() == BaseType::Real)
+            .map(|(vr, _)| vr as fmi2ValueReference)
+            .collect();
+        let mut values = vec![0.0; outputs.len()];
+        for k in 0..steps {
+            let s = self.try_step(k as f64 * h, h);
+            if s != fmi2OK {
+                return (s, self.log().last(), k);
+            }
+            // The outputs, as a master reads them after each step.
+            let (n, vrs, out) = (outputs.len(), outputs.as_ptr(), values.as_mut_ptr());
+            let s = unsafe { (self.f.fmi2GetReal)(self.c, vrs, n, out) };
+            if s != fmi2OK {
+                return (s, self.log().last(), k + 1);
+            }
+        }
+        (fmi2OK, self.log().last(), steps)
+    }
+}
+
+/// A case of the issue-19 reliability probe: `integers` and `reals` set in Initialization Mode,
+/// then up to `steps` steps of `h` from t = 0 (see [`Harness::run_probe`]); the outcome must be
+/// `expect`. A case that hangs on a model without the work bound ends here with the error of
+/// the bound.
+pub fn check_probe<M: FmuModel>(
+    functions: Fmi2Functions,
+    integers: &[(&str, i32)],
+    reals: &[(&str, f64)],
+    h: f64,
+    steps: usize,
+    expect: Outcome,
+) {
+    let mut fmu = Harness::<M>::instantiate(functions, "probe");
+    let (status, last, taken) = fmu.run_probe(integers, reals, h, steps);
+    let case = format!("{} {integers:?} {reals:?}, h = {h}", M::MODEL_IDENTIFIER);
+    match expect {
+        Outcome::Error(text) => {
+            assert_eq!(
+                status,
+                fmi2Error,
+                "{case}: {} after {taken} steps, outputs not finite: {:?} (last log: {last})",
+                status_name(status),
+                fmu.non_finite_outputs()
+            );
+            assert!(last.contains(text), "{case}: {last:?} lacks {text:?}");
+        }
+        Outcome::Finite => {
+            assert_eq!(status, fmi2OK, "{case}: {}: {last}", status_name(status));
+            assert_eq!(fmu.non_finite_outputs(), Vec::<&str>::new(), "{case}");
+        }
+    }
+}
+
+/// How a corrupt serialized state must end (see [`check_corrupt_state`]).
+#[derive(Clone, Copy, Debug)]
+pub enum Corrupt {
+    /// `fmi2DeSerializeFMUstate` refuses it with a message that contains this text.
+    Refused(&'static str),
+    /// It is within the declared ranges (as `fmi2SetReal` would accept it): it restores, and
+    /// the next step of the default experiment returns fmi2Error with a message that contains
+    /// this text (the bound on the work of one step).
+    StepRefused(&'static str),
+}
+
+/// A corrupt serialized FMU state, as a file or a network could deliver it: `M` initialized at
+/// t = 0 (with `integers` set first) takes three steps of its default experiment; its state is
+/// serialized, and the `occurrence`-th (0-based; `None`: every) 8-byte little-endian copy of
+/// `find` in the bytes is replaced by `replace`. The outcome must be `expect`.
+pub fn check_corrupt_state<M: FmuModel>(
+    functions: Fmi2Functions,
+    integers: &[(&str, i32)],
+    find: f64,
+    occurrence: Option<usize>,
+    replace: f64,
+    expect: Corrupt,
+) {
+    let id = M::MODEL_IDENTIFIER;
+    let mut fmu = Harness::<M>::instantiate(functions, "corrupt");
+    let h = M::DEFAULT_EXPERIMENT.step_size;
+    let (status, last, _) = fmu.run_probe(integers, &[], h, 3);
+    assert_eq!(status, fmi2OK, "{id}: {last}");
+    let state = fmu.get_state();
+    let mut bytes = fmu.serialize(state);
+    let at: Vec<usize> = (0..bytes.len().saturating_sub(7))
+        .filter(|&i| bytes[i..i + 8] == find.to_le_bytes())
+        .collect();
+    let chosen: Vec<usize> = match occurrence {
+        Some(k) => at.get(k).copied().into_iter().collect(),
+        None => at.clone(),
+    };
+    assert!(
+        !chosen.is_empty(),
+        "{id}: occurrence {occurrence:?} of {find:?} in the state: found at {at:?}"
+    );
+    for i in chosen {
+        bytes[i..i + 8].copy_from_slice(&replace.to_le_bytes());
+    }
+    let (status, restored) = fmu.deserialize(&bytes);
+    let last = fmu.log().last();
+    let case = format!("{id}: a state with {find:?} -> {replace:?}");
+    match expect {
+        Corrupt::Refused(text) => {
+            assert_eq!(status, fmi2Error, "{case} was accepted");
+            assert!(restored.0.is_null(), "{case}: a state was created");
+            assert!(last.contains(text), "{case}: {last:?} lacks {text:?}");
+            fmu.step(3.0 * h, h);
+        }
+        Corrupt::StepRefused(text) => {
+            assert_eq!(status, fmi2OK, "{case} was refused: {last}");
+            assert_eq!(
+                fmu.set_state(restored),
+                fmi2OK,
+                "{case}: {}",
+                fmu.log().last()
+            );
+            let s = fmu.try_step(3.0 * h, h);
+            let last = fmu.log().last();
+            assert_eq!(s, fmi2Error, "{case}: the step returned {}", status_name(s));
+            assert!(last.contains(text), "{case}: {last:?} lacks {text:?}");
+            fmu.free_state(restored);
+        }
+    }
+    fmu.free_state(state);
+}
+
+/// For a test file of an FMU crate with the cases of the reliability probe: declares the FMI
+/// symbols the crate exports and, over them, `probe(integers, reals, h, steps, expect)`
+/// ([`check_probe`]) and `corrupt(integers, find, replace, expect)` ([`check_corrupt_state`] of
+/// every copy of `find`). Use once per test file: `fmi2_export::probe_cases!(my_fmu::MyFmu);`.
+#[macro_export]
+macro_rules! probe_cases {
+    ($model:ty) => {
+        $crate::fmi2::declare_fmi2_functions!();
+
+        /// `integers` and `reals` set in Initialization Mode, then `steps` steps of `h` from 0.
+        #[allow(dead_code)]
+        fn probe(
+            integers: &[(&str, i32)],
+            reals: &[(&str, f64)],
+            h: f64,
+            steps: usize,
+            expect: $crate::testing::Outcome,
+        ) {
+            let f = linked_fmi2_functions();
+            $crate::testing::check_probe::<$model>(f, integers, reals, h, steps, expect);
+        }
+
+        /// The serialized state after three default steps with every copy of `find` replaced.
+        #[allow(dead_code)]
+        fn corrupt(
+            integers: &[(&str, i32)],
+            find: f64,
+            replace: f64,
+            expect: $crate::testing::Corrupt,
+        ) {
+            let f = linked_fmi2_functions();
+            $crate::testing::check_corrupt_state::<$model>(
+                f, integers, find, None, replace, expect,
+            );
+        }
+    };
 }
 
 /// One variable as `modelDescription.xml` declares it, in a form both the table and an

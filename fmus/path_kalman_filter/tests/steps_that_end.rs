@@ -1,0 +1,215 @@
+//! The issue-19 reliability probe's cases (`../shared/reliability/`, main 616074e) for PathKalmanFilter:
+//! each ends with the error named or finite outputs (a case that hung, with the error of the
+//! bound on the work of one step). See `fmi2_export::testing::check_probe`.
+
+use fmi2_export::testing::{Corrupt, Outcome::*};
+
+fmi2_export::probe_cases!(path_kalman_filter_fmu::PathKalmanFilterFmu);
+
+/// bigstep_all.txt: one fmi2DoStep of 1e9 s.
+#[test]
+fn one_step_of_1e9_s_ends() {
+    probe(
+        &[],
+        &[],
+        1000000000.0,
+        1,
+        Error("internal steps of euler_step_prime = "),
+    );
+}
+
+/// tinystep_all.txt: a 1 s step with a tiny positive sub-step or sample parameter.
+#[test]
+fn tiny_internal_steps_end() {
+    probe(
+        &[],
+        &[("euler_step_prime", 1e-300)],
+        1.0,
+        1,
+        Error("internal steps of euler_step_prime = "),
+    );
+}
+
+/// param_sweep_all.txt: extreme in-range parameters that gave fmi2OK with NaN or inf (50 steps of the default experiment).
+#[test]
+fn extreme_parameters_give_an_error_not_nan() {
+    probe(
+        &[],
+        &[("initial_heading", 1e+300)],
+        0.2348812095032397,
+        50,
+        Error("output \"innovation_rms_heading\" = inf is not a finite number"),
+    );
+    probe(
+        &[],
+        &[("initial_heading", -1e+300)],
+        0.2348812095032397,
+        50,
+        Error("output \"innovation_rms_heading\" = inf is not a finite number"),
+    );
+    probe(
+        &[],
+        &[("initial_yaw_rate", 1e+300)],
+        0.2348812095032397,
+        50,
+        Error("output \"innovation_rms_yaw_rate\" = inf is not a finite number"),
+    );
+    probe(
+        &[],
+        &[("initial_yaw_rate", -1e+300)],
+        0.2348812095032397,
+        50,
+        Error("output \"innovation_rms_yaw_rate\" = inf is not a finite number"),
+    );
+    probe(
+        &[],
+        &[("initial_drift_angle", 1e+300)],
+        0.2348812095032397,
+        50,
+        Error("output \"innovation_rms_yaw_rate\" = inf is not a finite number"),
+    );
+    probe(
+        &[],
+        &[("initial_drift_angle", -1e+300)],
+        0.2348812095032397,
+        50,
+        Error("output \"innovation_rms_yaw_rate\" = inf is not a finite number"),
+    );
+    probe(
+        &[],
+        &[("initial_cross_track", 1e+300)],
+        0.2348812095032397,
+        50,
+        Error("output \"innovation_rms_cross_track\" = inf is not a finite number"),
+    );
+    probe(
+        &[],
+        &[("initial_cross_track", -1e+300)],
+        0.2348812095032397,
+        50,
+        Error("output \"innovation_rms_cross_track\" = inf is not a finite number"),
+    );
+    probe(
+        &[],
+        &[("initial_rudder", 1e+300)],
+        0.2348812095032397,
+        50,
+        Error("output \"innovation_rms_yaw_rate\" = inf is not a finite number"),
+    );
+    probe(
+        &[],
+        &[("initial_rudder", -1e+300)],
+        0.2348812095032397,
+        50,
+        Error("output \"innovation_rms_yaw_rate\" = inf is not a finite number"),
+    );
+    probe(
+        &[],
+        &[("initial_yaw_moment_prime", 1e+300)],
+        0.2348812095032397,
+        50,
+        Error("output \"innovation_rms_yaw_rate\" = inf is not a finite number"),
+    );
+    probe(
+        &[],
+        &[("initial_yaw_moment_prime", -1e+300)],
+        0.2348812095032397,
+        50,
+        Error("output \"innovation_rms_yaw_rate\" = inf is not a finite number"),
+    );
+    probe(
+        &[],
+        &[("initial_sway_force_prime", 1e+300)],
+        0.2348812095032397,
+        50,
+        Error("output \"innovation_rms_yaw_rate\" = inf is not a finite number"),
+    );
+    probe(
+        &[],
+        &[("initial_sway_force_prime", -1e+300)],
+        0.2348812095032397,
+        50,
+        Error("output \"innovation_rms_yaw_rate\" = inf is not a finite number"),
+    );
+    probe(
+        &[],
+        &[("heading_measured", 1e+300)],
+        0.2348812095032397,
+        50,
+        Error("output \"innovation_rms_heading\" = inf is not a finite number"),
+    );
+    probe(
+        &[],
+        &[("heading_measured", -1e+300)],
+        0.2348812095032397,
+        50,
+        Error("output \"innovation_rms_heading\" = inf is not a finite number"),
+    );
+    probe(
+        &[],
+        &[("yaw_rate_measured", 1e+300)],
+        0.2348812095032397,
+        50,
+        Error("output \"innovation_rms_yaw_rate\" = inf is not a finite number"),
+    );
+    probe(
+        &[],
+        &[("yaw_rate_measured", -1e+300)],
+        0.2348812095032397,
+        50,
+        Error("output \"innovation_rms_yaw_rate\" = inf is not a finite number"),
+    );
+    probe(
+        &[],
+        &[("cross_track_measured", 1e+300)],
+        0.2348812095032397,
+        50,
+        Error("output \"innovation_rms_cross_track\" = inf is not a finite number"),
+    );
+    probe(
+        &[],
+        &[("cross_track_measured", -1e+300)],
+        0.2348812095032397,
+        50,
+        Error("output \"innovation_rms_cross_track\" = inf is not a finite number"),
+    );
+    probe(
+        &[],
+        &[("rudder_command", 1e+300)],
+        0.2348812095032397,
+        50,
+        Error("output \"innovation_rms_yaw_rate\" = inf is not a finite number"),
+    );
+    probe(
+        &[],
+        &[("rudder_command", -1e+300)],
+        0.2348812095032397,
+        50,
+        Error("output \"innovation_rms_yaw_rate\" = inf is not a finite number"),
+    );
+}
+
+/// param_sweep_all.txt: extreme in-range parameters that hung (50 steps of the default experiment).
+#[test]
+fn extreme_parameters_that_hung_end() {
+    probe(
+        &[],
+        &[("euler_step_prime", 1e-300)],
+        0.2348812095032397,
+        50,
+        Error("internal steps of euler_step_prime = "),
+    );
+}
+
+/// fuzz_state_all.txt: a state whose sub-step or sample interval (every copy of 0.005) is
+/// 1.5e-40 (the mutated states that hung) is refused, or restores within the declared range and
+/// its next step is refused by the bound.
+#[test]
+fn a_corrupt_state_is_refused_or_bounded() {
+    corrupt(
+        &[],
+        0.005,
+        1.5e-40,
+        Corrupt::StepRefused("internal steps of euler_step_prime = "),
+    );
+}
