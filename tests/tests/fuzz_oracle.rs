@@ -160,3 +160,74 @@ fn a_spinning_do_step_is_a_hang_of_that_call() {
         lines[0]
     );
 }
+
+/// A stand-in for shipsim that fails the way `mode` says on every check, run and inspect (and
+/// writes a small OSP file for `export-osp`, which the fuzzer uses to make its OSP bases).
+const FAKE_SHIPSIM: &str = r#"#!/bin/sh
+if [ "$1" = export-osp ]; then
+    mkdir -p "$(dirname "$4")"
+    echo '<OspSystemStructure><Simulators><Simulator name="a" source="x/Clean.fmu" stepSize="0.1"/></Simulators></OspSystemStructure>' > "$4"
+    exit 0
+fi
+case "$FUZZ_FAKE_MODE" in
+    exit101) echo "error: boom" >&2; exit 101 ;;
+    segv) kill -SEGV $$ ;;
+    silent) exit 1 ;;
+    panic) echo "thread 'main' panicked at master/src/main.rs:1:1:" >&2; exit 1 ;;
+    *) echo "error: a clean refusal, naming the file" >&2; exit 1 ;;
+esac
+"#;
+
+#[test]
+fn malformed_file_cases_judge_shipsims_exit() {
+    use std::os::unix::fs::PermissionsExt;
+    let tmp = tempfile::tempdir().unwrap();
+    let fmus = tmp.path().join("fmus");
+    std::fs::create_dir(&fmus).unwrap();
+    build(&fmus, "Clean", 0);
+    let fake = tmp.path().join("shipsim");
+    std::fs::write(&fake, FAKE_SHIPSIM).unwrap();
+    std::fs::set_permissions(&fake, std::fs::Permissions::from_mode(0o755)).unwrap();
+    for (mode, kind, text) in [
+        ("exit101", "exit101", "error: boom"),
+        ("segv", "crash", "killed by SIGSEGV"),
+        ("silent", "nomessage", "exited with status 1"),
+        ("panic", "panic", "panicked at master/src/main.rs"),
+        ("refuse", "", ""),
+    ] {
+        let out = tmp.path().join(mode);
+        let o = Command::new(env!("CARGO_BIN_EXE_fuzz"))
+            .args(["suite", "--only", "toml,osp,md", "--jobs", "2", "--fmu-dir"])
+            .arg(&fmus)
+            .arg("--shipsim")
+            .arg(&fake)
+            .arg("--out")
+            .arg(&out)
+            .env("FUZZ_FAKE_MODE", mode)
+            .output()
+            .unwrap();
+        let text_out = String::from_utf8_lossy(&o.stdout);
+        let lines: Vec<String> = std::fs::read_to_string(out.join("suite-failures.txt"))
+            .unwrap()
+            .lines()
+            .filter(|l| !l.starts_with("    replay:"))
+            .map(String::from)
+            .collect();
+        if kind.is_empty() {
+            // An error exit with a message is what a malformed file must give.
+            assert_eq!(o.status.code(), Some(0), "{mode}: {text_out}\n{lines:#?}");
+            assert!(lines.is_empty(), "{mode}: {lines:#?}");
+            continue;
+        }
+        assert_eq!(o.status.code(), Some(1), "{mode}: {text_out}");
+        // Every case of every family fails, at its first command, as the fake does.
+        assert_eq!(lines.len(), 180, "{mode}: {text_out}");
+        for family in ["toml", "osp", "md"] {
+            let n = lines
+                .iter()
+                .filter(|l| l.starts_with(&format!("{kind} case={family} ")) && l.contains(text))
+                .count();
+            assert_eq!(n, 60, "{mode} {family}: {lines:#?}");
+        }
+    }
+}
