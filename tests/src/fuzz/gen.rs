@@ -151,33 +151,36 @@ fn get_call(rng: &mut Rng, model: &Model) -> Call {
     }
 }
 
+/// One value per value reference, drawn for its variable when the list names one.
+fn values<T>(
+    rng: &mut Rng,
+    model: &Model,
+    ty: VarType,
+    v: &Vrs,
+    draw: fn(&mut Rng, Option<&Var>) -> T,
+) -> Vec<T> {
+    (0..v.len())
+        .map(|i| {
+            let var = match v {
+                Vrs::List(l) => var_of(model, ty, l[i]),
+                _ => None,
+            };
+            draw(rng, var)
+        })
+        .collect()
+}
+
 fn set_call(rng: &mut Rng, model: &Model, phase: Phase) -> Call {
     let ok = settable(phase);
     match rng.weighted(&[7, 2, 2, 1]) {
         0 => {
             let v = vrs(rng, model, VarType::Real, &ok);
-            let x = (0..v.len())
-                .map(|i| {
-                    let var = match &v {
-                        Vrs::List(l) => var_of(model, VarType::Real, l[i]),
-                        _ => None,
-                    };
-                    real(rng, var)
-                })
-                .collect();
+            let x = values(rng, model, VarType::Real, &v, real);
             Call::SetReal(v, x)
         }
         1 => {
             let v = vrs(rng, model, VarType::Integer, &ok);
-            let x = (0..v.len())
-                .map(|i| {
-                    let var = match &v {
-                        Vrs::List(l) => var_of(model, VarType::Integer, l[i]),
-                        _ => None,
-                    };
-                    integer(rng, var)
-                })
-                .collect();
+            let x = values(rng, model, VarType::Integer, &v, integer);
             Call::SetInteger(v, x)
         }
         2 => {
