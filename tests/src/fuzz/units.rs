@@ -55,14 +55,13 @@ pub fn run(kind: Kind, fmu: &Loaded, seed: u64, unit: u64) {
         Kind::State => mutated_state(&mut ctx, &mut rng),
         Kind::Param => {
             let cases = param_cases(&fmu.model);
-            let (var, value) = match cases.get(unit as usize) {
+            let case = match cases.get(unit as usize) {
                 Some(c) => c.clone(),
-                None => match random_param(&mut rng, &fmu.model) {
-                    Some(c) => c,
-                    None => return,
-                },
+                None => random_params(&mut rng, &fmu.model),
             };
-            parameter(&mut ctx, &var, value);
+            if !case.is_empty() {
+                parameters(&mut ctx, &case);
+            }
         }
     }
     ctx.close();
@@ -144,19 +143,21 @@ fn last_successful_time(ctx: &mut Ctx) -> Option<f64> {
     (st == fmi2OK && t.is_finite()).then_some(t)
 }
 
-/// One parameter value, then initialization and one step of 1 s.
-fn parameter(ctx: &mut Ctx, var: &Var, value: f64) {
+/// Parameter values, then initialization and one step of 1 s.
+fn parameters(ctx: &mut Ctx, case: &[(Var, f64)]) {
     if ctx.run(&gen::instantiate(&mut Rng::new(0), true)) != fmi2OK {
         return;
     }
-    let vrs = super::calls::Vrs::List(vec![var.vr]);
-    let set = match var.ty {
-        VarType::Real => Call::SetReal(vrs, vec![value]),
-        VarType::Boolean => Call::SetBoolean(vrs, vec![value as i32]),
-        _ => Call::SetInteger(vrs, vec![value as i32]),
-    };
-    if !ok(ctx.run(&set)) {
-        return;
+    for (var, value) in case {
+        let vrs = super::calls::Vrs::List(vec![var.vr]);
+        let set = match var.ty {
+            VarType::Real => Call::SetReal(vrs, vec![*value]),
+            VarType::Boolean => Call::SetBoolean(vrs, vec![*value as i32]),
+            _ => Call::SetInteger(vrs, vec![*value as i32]),
+        };
+        if !ok(ctx.run(&set)) {
+            return;
+        }
     }
     for call in [
         Call::Setup {
@@ -222,32 +223,53 @@ pub fn extremes(var: &Var) -> Vec<f64> {
     out
 }
 
-/// Every (parameter, extreme value) of a model, in table order.
-pub fn param_cases(model: &Model) -> Vec<(Var, f64)> {
-    model
+/// The fixed parameter cases of a model, in table order: every (parameter, extreme value); then
+/// every mode-like Integer parameter (declared maximum at most 1000) at its maximum with every
+/// Real parameter at 1e-300 (SteeringGear's `max_substep` only sub-steps with `servo_order` = 2).
+pub fn param_cases(model: &Model) -> Vec<Vec<(Var, f64)>> {
+    let mut cases: Vec<Vec<(Var, f64)>> = model
         .parameters()
-        .flat_map(|v| extremes(v).into_iter().map(move |x| (v.clone(), x)))
-        .collect()
-}
-
-/// A random in-range value of a random parameter (the long run, past the fixed cases).
-fn random_param(rng: &mut Rng, model: &Model) -> Option<(Var, f64)> {
-    let params: Vec<&Var> = model.parameters().collect();
-    if params.is_empty() {
-        return None;
-    }
-    let v = (*rng.pick(&params)).clone();
-    let x = match v.ty {
-        VarType::Real => {
-            let e = extremes(&v);
-            if rng.chance(0.5) && !e.is_empty() {
-                *rng.pick(&e)
-            } else {
-                gen::in_range(rng, v.min, v.max)
+        .flat_map(|v| extremes(v).into_iter().map(move |x| vec![(v.clone(), x)]))
+        .collect();
+    let modes = model.parameters().filter(|v| {
+        v.ty != VarType::Real
+            && v.ty != VarType::Boolean
+            && v.max <= 1000.0
+            && Some(v.max) != v.start
+    });
+    for m in modes {
+        for r in model.parameters().filter(|v| v.ty == VarType::Real) {
+            if r.min <= 1e-300 && r.max >= 1e-300 {
+                cases.push(vec![(m.clone(), m.max), (r.clone(), 1e-300)]);
             }
         }
-        VarType::Boolean => rng.below(2) as f64,
-        _ => f64::from(gen::integer(rng, Some(&v))),
-    };
-    Some((v, x))
+    }
+    cases
+}
+
+/// One to three random parameters at random in-range values (the long run, past the fixed
+/// cases): half the time an extreme value, else any in range.
+fn random_params(rng: &mut Rng, model: &Model) -> Vec<(Var, f64)> {
+    let params: Vec<&Var> = model.parameters().collect();
+    if params.is_empty() {
+        return Vec::new();
+    }
+    (0..1 + rng.below(3))
+        .map(|_| {
+            let v = (*rng.pick(&params)).clone();
+            let x = match v.ty {
+                VarType::Real => {
+                    let e = extremes(&v);
+                    if rng.chance(0.5) && !e.is_empty() {
+                        *rng.pick(&e)
+                    } else {
+                        gen::in_range(rng, v.min, v.max)
+                    }
+                }
+                VarType::Boolean => rng.below(2) as f64,
+                _ => f64::from(gen::integer(rng, Some(&v))),
+            };
+            (v, x)
+        })
+        .collect()
 }

@@ -7,7 +7,9 @@ use std::sync::mpsc::{channel, Receiver, RecvTimeoutError};
 use std::time::{Duration, Instant};
 
 /// How long one call may take: `cpu` of the child's CPU time (so that a loaded machine does
-/// not make a slow call a hang), and `wall` for a call that blocks without computing.
+/// not make a slow call a hang), and `wall` for a call that blocks without computing (long
+/// enough that a computing call on a machine loaded many times over reaches the CPU limit
+/// first).
 #[derive(Clone, Copy, Debug)]
 pub struct Limits {
     pub cpu: Duration,
@@ -18,7 +20,7 @@ impl Default for Limits {
     fn default() -> Self {
         Limits {
             cpu: Duration::from_secs(1),
-            wall: Duration::from_secs(10),
+            wall: Duration::from_secs(60),
         }
     }
 }
