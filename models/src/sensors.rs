@@ -48,6 +48,19 @@ pub const CHANNEL_NAMES: [(&str, &str); CHANNELS] = [
     ("sway_velocity", "m/s"),
 ];
 
+/// The FMU parameter of each channel's sampling interval (`<name>_interval`), in order.
+pub const CHANNEL_INTERVALS: [&str; CHANNELS] = [
+    "heading_interval",
+    "yaw_rate_interval",
+    "roll_interval",
+    "roll_rate_interval",
+    "north_interval",
+    "east_interval",
+    "cross_track_interval",
+    "speed_interval",
+    "sway_velocity_interval",
+];
+
 /// Channel indices.
 pub mod ch {
     pub const HEADING: usize = 0;
@@ -219,6 +232,21 @@ impl Sensors {
             if (self.instant(i, k) - self.time).abs() <= 1e-9 * self.params.channels[i].interval {
                 self.state[i].held = self.measure(i, input[i]);
             }
+        }
+    }
+
+    /// The sampling work of [`advance_to`](Self::advance_to)`(t)`: `each(name, interval,
+    /// passes)` per channel, `name` its interval parameter (for the bound on the work of one
+    /// FMU step; +inf passes for an interval that is not a positive number).
+    pub fn internal_steps(&self, t: f64, each: &mut dyn FnMut(&'static str, f64, f64)) {
+        for (i, name) in CHANNEL_INTERVALS.iter().enumerate() {
+            let interval = self.params.channels[i].interval;
+            let passes = if interval > 0.0 {
+                ((t - self.instant(i, self.state[i].k)) / interval).max(0.0)
+            } else {
+                f64::INFINITY
+            };
+            each(name, interval, passes);
         }
     }
 

@@ -2,7 +2,7 @@
 //! `models::hull::container_ship` (and its linearisation as a variant) as an FMI 2.0
 //! co-simulation FMU. No physics here: the variable table maps the model onto FMI variables.
 
-use fmi2_export::FmuModel;
+use fmi2_export::{passes, FmuModel};
 use models::error::{check_finite, check_positive, ParamError};
 use models::hull::container_ship::{
     ContainerShip, ContainerShipInputs, ContainerShipOutputs, ContainerShipParams,
@@ -256,6 +256,14 @@ impl FmuModel for ContainerShipFmu {
         }
         self.keep_outputs();
         Ok(())
+    }
+
+    fn internal_steps(&self, _t: f64, h: f64, each: &mut dyn FnMut(&'static str, f64, f64)) {
+        let max_substep = match &self.hull {
+            Hull::Nonlinear(s) => s.params.max_substep,
+            Hull::Linear(s) => s.max_substep,
+        };
+        each("max_substep", max_substep, passes(h, max_substep));
     }
 }
 

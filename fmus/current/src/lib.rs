@@ -190,6 +190,10 @@ impl FmuModel for CurrentFmu {
         self.model.advance_to(t + h);
         Ok(())
     }
+
+    fn internal_steps(&self, t: f64, h: f64, each: &mut dyn FnMut(&'static str, f64, f64)) {
+        self.model.internal_steps(t + h, each);
+    }
 }
 
 #[cfg(test)]

@@ -1,7 +1,7 @@
 //! `DgpsKalman` FMU: the 4-state DGPS position/velocity Kalman filter of [Artyszuk2003, sec. 2]
 //! (`models::observers::dgps_kalman`). No physics here.
 
-use fmi2_export::FmuModel;
+use fmi2_export::{passes, FmuModel};
 use models::observers::dgps_kalman::{DgpsKalman, DgpsKalmanParams};
 use serde::{Deserialize, Serialize};
 
@@ -113,5 +113,10 @@ impl FmuModel for DgpsKalmanFmu {
     fn do_step(&mut self, _t: f64, h: f64) -> Result<(), String> {
         self.filter.step(self.measured[0], self.measured[1], h);
         Ok(())
+    }
+
+    fn internal_steps(&self, _t: f64, h: f64, each: &mut dyn FnMut(&'static str, f64, f64)) {
+        let dt = self.filter.params().dt;
+        each("time_step", dt, passes(h, dt));
     }
 }

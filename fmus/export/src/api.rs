@@ -6,10 +6,12 @@ use crate::instance::{
     CAT_EVENTS,
 };
 use crate::variables::{Access, Causality, Variability, Variable};
-use crate::{FmuModel, LOG_CATEGORIES};
+use crate::{FmuModel, LOG_CATEGORIES, MAX_INTERNAL_STEPS};
 use fmi2::*;
+use std::cell::{Cell, RefCell};
 use std::ffi::{c_char, c_void, CStr, CString};
-use std::panic::{catch_unwind, AssertUnwindSafe};
+use std::panic::{catch_unwind, AssertUnwindSafe, PanicHookInfo};
+use std::sync::Once;
 
 /// Layout version of serialized FMU states (bumped when [`Snapshot`] changes shape).
 const SERIAL_VERSION: u32 = 1;
@@ -22,6 +24,52 @@ fn panic_message(p: &(dyn std::any::Any + Send)) -> String {
     } else {
         "unknown panic".to_string()
     }
+}
+
+/// Where the panic being reported happened (` at file:line:column`; empty if the hook did not
+/// see it).
+fn panic_location() -> String {
+    match PANIC_LOCATION.with(|l| l.borrow_mut().take()) {
+        Some(at) => format!(" at {at}"),
+        None => String::new(),
+    }
+}
+
+thread_local! {
+    /// Whether this thread is inside an FMI call of this library (see [`guarded`]).
+    static IN_FMI_CALL: Cell<bool> = const { Cell::new(false) };
+    /// Where the last panic inside an FMI call happened (kept by the panic hook for the log).
+    static PANIC_LOCATION: RefCell<Option<String>> = const { RefCell::new(None) };
+}
+
+/// Installs, once per FMU library, a panic hook that stays silent for a panic inside an FMI
+/// call of this library (the call catches it and reports it through the instance's logger as an
+/// fmi2Error message) and defers to the hook it replaced for every other panic. An importer's
+/// stderr is not the FMU's to write to (FMI 2.0, sec. 2.1.5: messages go through the logger).
+/// A cdylib FMU has its own copy of the standard library, so the hook is this FMU's alone.
+fn install_panic_hook() {
+    static INSTALLED: Once = Once::new();
+    INSTALLED.call_once(|| {
+        let previous = std::panic::take_hook();
+        std::panic::set_hook(Box::new(move |info: &PanicHookInfo| {
+            if IN_FMI_CALL.with(Cell::get) {
+                let at = info.location().map(|l| l.to_string());
+                PANIC_LOCATION.with(|l| *l.borrow_mut() = at);
+            } else {
+                previous(info)
+            }
+        }));
+    });
+}
+
+/// `catch_unwind` of `f` with the thread marked as inside an FMI call of this library, so that
+/// the panic hook of [`install_panic_hook`] keeps a panic off the importer's stderr.
+#[inline(always)]
+fn guarded<R>(f: impl FnOnce() -> R) -> std::thread::Result<R> {
+    let outer = IN_FMI_CALL.with(|flag| flag.replace(true));
+    let result = catch_unwind(AssertUnwindSafe(f));
+    IN_FMI_CALL.with(|flag| flag.set(outer));
+    result
 }
 
 /// Runs `f` on the instance behind `c` if `function` is legal in its state; a panic becomes
@@ -45,7 +93,7 @@ unsafe fn with_instance<M: FmuModel>(
     if let Err(status) = (*inst).check_state(function, legal) {
         return status;
     }
-    match catch_unwind(AssertUnwindSafe(|| f(&mut *inst))) {
+    match guarded(|| f(&mut *inst)) {
         Ok(status) => status,
         Err(p) => panicked(&mut *inst, function, p.as_ref()),
     }
@@ -64,9 +112,10 @@ fn panicked<M: FmuModel>(
         fmi2Error,
         CAT_ERROR,
         &format!(
-            "{function}: internal error (panic: {}); the instance is in the Error state \
+            "{function}: internal error (panic: {}){}; the instance is in the Error state \
              (fmi2Reset, fmi2SetFMUstate or fmi2FreeInstance)",
-            panic_message(p)
+            panic_message(p),
+            panic_location()
         ),
     );
     fmi2Error
@@ -111,7 +160,8 @@ pub unsafe fn instantiate<M: FmuModel>(
     _visible: fmi2Boolean,
     logging_on: fmi2Boolean,
 ) -> fmi2Component {
-    let result = catch_unwind(AssertUnwindSafe(|| {
+    install_panic_hook();
+    let result = guarded(|| {
         if functions.is_null() {
             return std::ptr::null_mut();
         }
@@ -173,7 +223,7 @@ pub unsafe fn instantiate<M: FmuModel>(
             format_args!("instantiated {} {expected}", M::MODEL_IDENTIFIER),
         );
         Box::into_raw(Box::new(inst)) as fmi2Component
-    }));
+    });
     result.unwrap_or(std::ptr::null_mut())
 }
 
@@ -183,9 +233,9 @@ pub unsafe fn free_instance<M: FmuModel>(c: fmi2Component) {
     if c.is_null() {
         return;
     }
-    let _ = catch_unwind(AssertUnwindSafe(|| {
+    let _ = guarded(|| {
         drop(Box::from_raw(c as *mut Instance<M>));
-    }));
+    });
 }
 
 /// # Safety
@@ -282,6 +332,11 @@ pub unsafe fn exit_initialization_mode<M: FmuModel>(c: fmi2Component) -> fmi2Sta
         |inst| match inst.model.initialize(inst.core.start_time) {
             Ok(()) => {
                 inst.dirty = false;
+                if let Some(vr) = inst.fast.non_finite_output(&inst.model) {
+                    inst.core.state = LifeState::Error;
+                    let at = format_args!("at t = {}", inst.core.start_time);
+                    return non_finite_output(inst, "fmi2ExitInitializationMode", at, vr);
+                }
                 inst.core.state = LifeState::StepComplete;
                 inst.log_fmt(
                     fmi2OK,
@@ -882,6 +937,9 @@ pub unsafe fn set_fmu_state<M: FmuModel>(c: fmi2Component, s: fmi2FMUstate) -> f
         mask::FMU_STATE,
         |inst| match state_ref::<M>(inst, "fmi2SetFMUstate", s) {
             Ok(b) => {
+                if let Err(msg) = check_snapshot(&b.snapshot) {
+                    return refused_state(inst, "fmi2SetFMUstate", &msg);
+                }
                 inst.model = b.snapshot.model.clone();
                 inst.core = b.snapshot.core.clone();
                 inst.dirty = false;
@@ -914,6 +972,103 @@ pub unsafe fn free_fmu_state<M: FmuModel>(c: fmi2Component, s: *mut fmi2FMUstate
             Err(st) => st,
         }
     })
+}
+
+/// What a restored FMU state must satisfy, as the setters and the step enforce it on the way
+/// in (the bytes of a serialized state, or a state a caller wrote over, prove nothing): the times
+/// finite; every parameter and input finite and within its declared range (as `fmi2SetReal` and
+/// `fmi2SetInteger` enforce); every internal loop of the model a positive length
+/// ([`FmuModel::internal_steps`]); and the model's own checks ([`FmuModel::check_restored`]).
+/// The message names the value.
+fn check_snapshot<M: FmuModel>(snap: &Snapshot<M>) -> Result<(), String> {
+    let core = &snap.core;
+    for (name, t) in [
+        ("time", core.time),
+        ("startTime", core.start_time),
+        ("stopTime", core.stop_time.unwrap_or(0.0)),
+    ] {
+        if !t.is_finite() {
+            return Err(format!("{name} = {t} is not finite"));
+        }
+    }
+    let m = &snap.model;
+    let settable =
+        |v: &&Variable<M>| matches!(v.causality, Causality::Parameter | Causality::Input);
+    for v in M::variables().iter().filter(settable) {
+        let out_of_range = match v.access {
+            Access::Real { get, min, max, .. } => {
+                let x = get(m);
+                let inside =
+                    x.is_finite() && min.is_none_or(|lo| x >= lo) && max.is_none_or(|hi| x <= hi);
+                (!inside).then(|| (format!("{x:?}"), real_range(min, max)))
+            }
+            Access::Integer { get, min, max, .. } => {
+                let x = get(m);
+                let inside = min.is_none_or(|lo| x >= lo) && max.is_none_or(|hi| x <= hi);
+                let range = || {
+                    let (lo, hi) = (min.unwrap_or(i32::MIN), max.unwrap_or(i32::MAX));
+                    format!("[{lo}, {hi}]")
+                };
+                (!inside).then(|| (x.to_string(), range()))
+            }
+            Access::Boolean { .. } => None,
+        };
+        if let Some((x, range)) = out_of_range {
+            return Err(format!(
+                "{:?} = {x} is not a finite number in {range}",
+                v.name
+            ));
+        }
+    }
+    // The loops of a step of length 0 from the state's time: only a grid lagging behind it, a
+    // length that is not positive or a NaN take any passes.
+    work(m, core.time, 0.0)?;
+    // A loop's length where the model keeps a copy of the parameter that sets it (a noise grid's
+    // step, a sample interval) obeys the parameter's declared minimum, as `fmi2SetReal` does.
+    let mut below = None;
+    m.internal_steps(core.time, 0.0, &mut |name, length, _| {
+        if let Some(lo) = declared_min_seconds::<M>(name) {
+            if !(length >= lo) && below.is_none() {
+                below = Some(format!(
+                    "internal step {name} = {length:?} s is below its declared minimum {lo:?} s"
+                ));
+            }
+        }
+    });
+    below.map_or(Ok(()), Err)?;
+    m.check_restored(core.time)
+}
+
+/// The declared minimum of the Real parameter `name` if its unit is the second (the lengths of
+/// [`FmuModel::internal_steps`] are in seconds; a parameter in other units is not compared).
+fn declared_min_seconds<M: FmuModel>(name: &str) -> Option<f64> {
+    let v = M::variables().iter().find(|v| v.name == name)?;
+    match v.access {
+        Access::Real {
+            unit: Some("s"),
+            min,
+            ..
+        } if v.causality == Causality::Parameter => min,
+        _ => None,
+    }
+}
+
+fn real_range(min: Option<f64>, max: Option<f64>) -> String {
+    let (lo, hi) = (
+        min.unwrap_or(f64::NEG_INFINITY),
+        max.unwrap_or(f64::INFINITY),
+    );
+    format!("[{lo}, {hi}]")
+}
+
+/// A restored state refused by [`check_snapshot`]; the instance is left as it was.
+#[cold]
+#[inline(never)]
+fn refused_state<M: FmuModel>(inst: &Instance<M>, function: &str, msg: &str) -> fmi2Status {
+    inst.error(&format!(
+        "{function}: instance {:?}: the FMU state is refused: {msg}",
+        inst.name.to_string_lossy()
+    ))
 }
 
 fn serialize_snapshot<M: FmuModel>(magic: u64, snap: &Snapshot<M>) -> Result<Vec<u8>, String> {
@@ -1008,6 +1163,9 @@ pub unsafe fn deserialize_fmu_state<M: FmuModel>(
             Ok(v) => v,
             Err(e) => return inst.error(&format!("fmi2DeSerializeFMUstate: corrupt state: {e}")),
         };
+        if let Err(msg) = check_snapshot(&snapshot) {
+            return refused_state(inst, "fmi2DeSerializeFMUstate", &msg);
+        }
         if (*s).is_null() {
             *s = Box::into_raw(Box::new(StateBox {
                 magic: inst.magic,
@@ -1117,15 +1275,129 @@ pub unsafe fn do_step<M: FmuModel>(
                 return past_stop(inst, end, stop);
             }
         }
+        if let Err(status) = check_work(inst, t, h) {
+            return status;
+        }
         match inst.model.do_step(t, h) {
             Ok(()) => {
-                inst.core.time = t + h;
                 inst.dirty = false;
+                if let Some(vr) = inst.fast.non_finite_output(&inst.model) {
+                    inst.core.state = LifeState::Error;
+                    let at = format_args!("at t = {t}, h = {h}");
+                    return non_finite_output(inst, "fmi2DoStep", at, vr);
+                }
+                inst.core.time = t + h;
                 fmi2OK
             }
             Err(msg) => step_failed(inst, t, h, &msg),
         }
     })
+}
+
+/// The work bound of one `fmi2DoStep`: the passes of the model's internal loops
+/// ([`FmuModel::internal_steps`]) over `[t, t + h]` are at most [`MAX_INTERNAL_STEPS`] in all,
+/// and each loop's length is a positive number. Refused before the model is touched: the
+/// instance stays in StepComplete (as for a refused step size), so a master may retry with a
+/// smaller step.
+#[inline(always)]
+fn check_work<M: FmuModel>(inst: &Instance<M>, t: f64, h: f64) -> Result<(), fmi2Status> {
+    match work(&inst.model, t, h) {
+        Ok(()) => Ok(()),
+        Err(msg) => Err(too_much_work(inst, t, h, &msg)),
+    }
+}
+
+/// [`check_work`] of a model: the message names the step size, the largest loop and its length.
+#[inline(always)]
+fn work<M: FmuModel>(m: &M, t: f64, h: f64) -> Result<(), String> {
+    let mut total = 0.0;
+    m.internal_steps(t, h, &mut |_, length, passes| {
+        // A length that is not positive, NaN passes or h / length overflowing make +inf or NaN.
+        total += if length > 0.0 {
+            passes.max(0.0)
+        } else {
+            f64::NAN
+        };
+    });
+    if total <= MAX_INTERNAL_STEPS {
+        Ok(())
+    } else {
+        Err(work_message(m, t, h))
+    }
+}
+
+#[cold]
+#[inline(never)]
+fn work_message<M: FmuModel>(m: &M, t: f64, h: f64) -> String {
+    let (mut total, mut worst) = (0.0, None::<(&str, f64, f64)>);
+    let mut not_positive = None;
+    m.internal_steps(t, h, &mut |name, length, passes| {
+        if !(length > 0.0) {
+            not_positive.get_or_insert((name, length));
+        }
+        let passes = if passes.is_nan() {
+            f64::INFINITY
+        } else {
+            passes.max(0.0)
+        };
+        total += passes;
+        if !worst.is_some_and(|(_, _, most)| most >= passes) {
+            worst = Some((name, length, passes));
+        }
+    });
+    if let Some((name, length)) = not_positive {
+        return format!("internal step {name} = {length:?} s is not a positive number");
+    }
+    let (name, length, passes) = worst.unwrap_or(("?", f64::NAN, f64::NAN));
+    if h == 0.0 {
+        return format!(
+            "the internal loops lag {total:.3e} steps behind the time {t} s ({passes:.3e} of \
+             {name} = {length:?} s)"
+        );
+    }
+    format!(
+        "communicationStepSize = {h} s would take {total:.3e} internal steps ({passes:.3e} of \
+         {name} = {length:?} s); at most {MAX_INTERNAL_STEPS:e} per fmi2DoStep: use a smaller \
+         communication step size or a larger {name}"
+    )
+}
+
+#[cold]
+#[inline(never)]
+fn too_much_work<M: FmuModel>(inst: &Instance<M>, t: f64, h: f64, msg: &str) -> fmi2Status {
+    fail(
+        inst,
+        format_args!(
+            "fmi2DoStep at t = {t}, h = {h}: instance {:?}: {msg}",
+            inst.name.to_string_lossy()
+        ),
+    )
+}
+
+/// An output that is not a finite number after `function` (`at`: the time, and the step):
+/// fmi2Error naming the variable and its value instead of fmi2OK with NaN.
+#[cold]
+#[inline(never)]
+fn non_finite_output<M: FmuModel>(
+    inst: &Instance<M>,
+    function: &str,
+    at: std::fmt::Arguments,
+    vr: fmi2ValueReference,
+) -> fmi2Status {
+    let v = &M::variables()[vr as usize];
+    let value = match v.access {
+        Access::Real { get, .. } => get(&inst.model),
+        _ => f64::NAN,
+    };
+    fail(
+        inst,
+        format_args!(
+            "{function} {at}: instance {:?}: output {:?} = {value} is not a finite number \
+             (parameters or inputs outside what the model can handle?)",
+            inst.name.to_string_lossy(),
+            v.name
+        ),
+    )
 }
 
 #[cold]
@@ -1267,5 +1539,5 @@ pub unsafe fn emit_text(
     write: unsafe extern "C" fn(*mut c_void, *const u8, usize),
     text: &str,
 ) {
-    let _ = catch_unwind(AssertUnwindSafe(|| write(out, text.as_ptr(), text.len())));
+    let _ = guarded(|| write(out, text.as_ptr(), text.len()));
 }

@@ -49,16 +49,48 @@ pub type RealGetter<M> = fn(&M) -> f64;
 pub struct FastAccess<M> {
     pub get_real: Box<[Option<RealGetter<M>>]>,
     pub set_real: Box<[RealInput<M>]>,
+    /// The getters of the Real outputs, with their value references, for the finiteness check
+    /// after `fmi2ExitInitializationMode` and `fmi2DoStep`.
+    pub outputs: Box<[(u32, RealGetter<M>)]>,
 }
 
 impl<M: FmuDescription> FastAccess<M> {
     /// The accessors of `M::variables()`.
     pub fn new() -> Self {
         let vars = M::variables();
+        let output = |(vr, v): (usize, &Variable<M>)| match v.access {
+            Access::Real { get, .. } if v.causality == Causality::Output => Some((vr as u32, get)),
+            _ => None,
+        };
         FastAccess {
             get_real: vars.iter().map(real_getter).collect(),
             set_real: vars.iter().map(real_input).collect(),
+            outputs: vars.iter().enumerate().filter_map(output).collect(),
         }
+    }
+
+    /// The value reference of the first Real output of `m` that is not a finite number (`None`:
+    /// all are finite). The common path is one subtraction and one addition per output and one
+    /// test at the end: `x - x` is 0 for a finite `x` and NaN for NaN and the infinities.
+    #[inline]
+    pub fn non_finite_output(&self, m: &M) -> Option<u32> {
+        let mut sum = 0.0;
+        for (_, get) in self.outputs.iter() {
+            let x = get(m);
+            sum += x - x;
+        }
+        if sum == 0.0 {
+            None
+        } else {
+            self.first_non_finite(m)
+        }
+    }
+
+    #[cold]
+    #[inline(never)]
+    fn first_non_finite(&self, m: &M) -> Option<u32> {
+        let bad = self.outputs.iter().find(|(_, get)| !get(m).is_finite());
+        bad.map(|(vr, _)| *vr)
     }
 }
 

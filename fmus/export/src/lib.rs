@@ -113,7 +113,46 @@ pub trait FmuModel: FmuDescription + Clone + Default + Serialize + DeserializeOw
 
     /// Advances from `t` to `t + h` with the inputs held; computes the outputs at `t + h`.
     fn do_step(&mut self, t: f64, h: f64) -> Result<(), String>;
+
+    /// The internal loops of [`FmuModel::do_step`]`(t, h)`, for the export layer's bound on the
+    /// work of one `fmi2DoStep`: calls `each(name, length, passes)` once per loop whose number
+    /// of passes grows with the step (an integrator's sub-step, a sample interval, a noise grid),
+    /// with `length` the loop's step in seconds **as the model will use it** (the derived value
+    /// where the model keeps one, so that a restored FMU state is bounded too), `name` the
+    /// parameter that sets it, and `passes` how many times the loop will run over `[t, t + h]`
+    /// ([`passes`]`(h, length)` for a loop of `ceil(h / length)` sub-steps; more for a grid that
+    /// lags behind `t`). Before each step the layer refuses, with fmi2Error naming the step size
+    /// and the largest loop, a step of more than [`MAX_INTERNAL_STEPS`] passes in all; a restored
+    /// state is refused if a length is not a positive number or the loops lag behind its time by
+    /// more than that ([`FmuModel::check_restored`]). Default: no such loop.
+    fn internal_steps(&self, _t: f64, _h: f64, _each: &mut dyn FnMut(&'static str, f64, f64)) {}
+
+    /// Checks a restored FMU state (`fmi2SetFMUstate`, `fmi2DeSerializeFMUstate`) beyond what
+    /// the layer checks itself (every parameter and input finite and within its declared range,
+    /// the time finite, the internal loops of [`FmuModel::internal_steps`] of positive length
+    /// and not lagging behind `time`): derived values the model keeps, at the state's `time`.
+    /// The message names the value. Default: nothing more to check.
+    fn check_restored(&self, _time: f64) -> Result<(), String> {
+        Ok(())
+    }
 }
+
+/// The passes of a loop of sub-steps of at most `length` over `h`: `h / length`, +inf for a
+/// `length` that is not a positive number (see [`FmuModel::internal_steps`]).
+#[inline]
+pub fn passes(h: f64, length: f64) -> f64 {
+    if length > 0.0 {
+        h / length
+    } else {
+        f64::INFINITY
+    }
+}
+
+/// The most internal loop passes (sub-steps, samples, grid steps; [`FmuModel::internal_steps`])
+/// one `fmi2DoStep` may take. The costliest pass of the 24 FMUs (a ContainerShip RK4 sub-step,
+/// about 0.55 µs) makes this about half a second; the default experiments take at most a few
+/// hundred passes per step.
+pub const MAX_INTERNAL_STEPS: f64 = 1e6;
 
 /// Emits the FMI 2.0 C API for a model type: the 34 `fmi2*` functions of
 /// [`fmi2::fmi2_functions!`], each forwarding to its implementation in [`api`], plus the two

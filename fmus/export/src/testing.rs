@@ -11,7 +11,7 @@
 //! the table, every variable readable and writable by name at its start value, and an exact
 //! rollback of the FMU state.
 
-use crate::variables::{check_table, Access, BaseType, Variable};
+use crate::variables::{check_table, Access, BaseType, Causality, Variable};
 use crate::xml::real;
 use crate::FmuModel;
 use fmi2::*;
@@ -451,6 +451,151 @@ impl<M: FmuModel> Drop for Harness<M> {
     fn drop(&mut self) {
         unsafe { (self.f.fmi2FreeInstance)(self.c) }
     }
+}
+
+/// How a probe case must end (see [`check_probe`]).
+#[derive(Clone, Copy, Debug)]
+pub enum Outcome {
+    /// A call returns fmi2Error with a log message that contains this text.
+    Error(&'static str),
+    /// Every call returns fmi2OK and every Real output stays finite.
+    Finite,
+}
+
+impl<M: FmuModel> Harness<M> {
+    /// The Real outputs that are not finite numbers, by name (read one by one: a getter's status
+    /// is checked).
+    pub fn non_finite_outputs(&self) -> Vec<&'static str> {
+        let outputs = M::variables()
+            .iter()
+            .filter(|v| v.causality == Causality::Output && v.base_type() == BaseType::Real);
+        outputs
+            .filter(|v| !self.real(v.name).is_finite())
+            .map(|v| v.name)
+            .collect()
+    }
+
+    /// Sets `integers`, then `reals`, in Initialization Mode (each checked), leaves it at t = 0
+    /// and takes `steps` steps of `h`: the first status that is not fmi2OK, with the last log
+    /// message and the number of steps taken (fmi2OK: all taken).
+    pub fn run_probe(
+        &mut self,
+        integers: &[(&str, i32)],
+        reals: &[(&str, f64)],
+        h: f64,
+        steps: usize,
+    ) -> (fmi2Status, String, usize) {
+        let s = self.setup(0.0, None);
+        self.check("fmi2SetupExperiment", s);
+        let s = self.enter_initialization();
+        self.check("fmi2EnterInitializationMode", s);
+        for &(name, value) in integers {
+            self.set(name, value);
+        }
+        for &(name, value) in reals {
+            self.set(name, value);
+        }
+        let s = self.exit_initialization();
+        if s != fmi2OK {
+            return (s, self.log().last(), 0);
+        }
+        for k in 0..steps {
+            let s = self.try_step(k as f64 * h, h);
+            if s != fmi2OK {
+                return (s, self.log().last(), k);
+            }
+        }
+        (fmi2OK, self.log().last(), steps)
+    }
+}
+
+/// A case of the issue-19 reliability probe: `integers` and `reals` set in Initialization Mode,
+/// then up to `steps` steps of `h` from t = 0 (see [`Harness::run_probe`]); the outcome must be
+/// `expect`. A case that hangs on a model without the work bound ends here with the error of
+/// the bound.
+pub fn check_probe<M: FmuModel>(
+    functions: Fmi2Functions,
+    integers: &[(&str, i32)],
+    reals: &[(&str, f64)],
+    h: f64,
+    steps: usize,
+    expect: Outcome,
+) {
+    let mut fmu = Harness::<M>::instantiate(functions, "probe");
+    let (status, last, taken) = fmu.run_probe(integers, reals, h, steps);
+    let case = format!("{} {integers:?} {reals:?}, h = {h}", M::MODEL_IDENTIFIER);
+    match expect {
+        Outcome::Error(text) => {
+            assert_eq!(
+                status,
+                fmi2Error,
+                "{case}: {} after {taken} steps, outputs not finite: {:?} (last log: {last})",
+                status_name(status),
+                fmu.non_finite_outputs()
+            );
+            assert!(last.contains(text), "{case}: {last:?} lacks {text:?}");
+        }
+        Outcome::Finite => {
+            assert_eq!(status, fmi2OK, "{case}: {}: {last}", status_name(status));
+            assert_eq!(fmu.non_finite_outputs(), Vec::<&str>::new(), "{case}");
+        }
+    }
+}
+
+/// A corrupt serialized FMU state, as a file or a network could deliver it: `M` initialized at
+/// t = 0 (with `integers` set first) takes three steps of its default experiment; its state is
+/// serialized, and the `occurrence`-th (0-based; `None`: every) 8-byte little-endian copy of
+/// `find` in the bytes is replaced by `replace`. `fmi2DeSerializeFMUstate` must refuse the
+/// bytes with fmi2Error and a message that contains `text`; the instance keeps stepping.
+pub fn check_corrupt_state<M: FmuModel>(
+    functions: Fmi2Functions,
+    integers: &[(&str, i32)],
+    find: f64,
+    occurrence: Option<usize>,
+    replace: f64,
+    text: &str,
+) {
+    let mut fmu = Harness::<M>::instantiate(functions, "corrupt");
+    let h = M::DEFAULT_EXPERIMENT.step_size;
+    let (status, last, _) = fmu.run_probe(integers, &[], h, 3);
+    assert_eq!(status, fmi2OK, "{}: {last}", M::MODEL_IDENTIFIER);
+    let state = fmu.get_state();
+    let mut bytes = fmu.serialize(state);
+    let at: Vec<usize> = (0..bytes.len().saturating_sub(7))
+        .filter(|&i| bytes[i..i + 8] == find.to_le_bytes())
+        .collect();
+    let chosen: Vec<usize> = match occurrence {
+        Some(k) => at.get(k).copied().into_iter().collect(),
+        None => at.clone(),
+    };
+    assert!(
+        !chosen.is_empty(),
+        "{}: occurrence {occurrence:?} of {find:?} in the state: found at {at:?}",
+        M::MODEL_IDENTIFIER
+    );
+    for i in chosen {
+        bytes[i..i + 8].copy_from_slice(&replace.to_le_bytes());
+    }
+    let (status, restored) = fmu.deserialize(&bytes);
+    let last = fmu.log().last();
+    assert_eq!(
+        status,
+        fmi2Error,
+        "{}: a state with {find:?} -> {replace:?} was accepted",
+        M::MODEL_IDENTIFIER
+    );
+    assert!(
+        restored.0.is_null(),
+        "{}: a state was created",
+        M::MODEL_IDENTIFIER
+    );
+    assert!(
+        last.contains(text),
+        "{}: {last:?} lacks {text:?}",
+        M::MODEL_IDENTIFIER
+    );
+    fmu.step(3.0 * h, h);
+    fmu.free_state(state);
 }
 
 /// One variable as `modelDescription.xml` declares it, in a form both the table and an

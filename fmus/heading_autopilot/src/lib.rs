@@ -157,4 +157,8 @@ impl FmuModel for HeadingAutopilotFmu {
         self.autopilot.step(self.heading, self.reference_input, h);
         Ok(())
     }
+
+    fn internal_steps(&self, _t: f64, h: f64, each: &mut dyn FnMut(&'static str, f64, f64)) {
+        self.autopilot.internal_steps(h, each);
+    }
 }

@@ -2,7 +2,7 @@
 //! `models::hull::mariner` as an FMI 2.0 co-simulation FMU. No physics here: the variable table
 //! maps the model onto FMI variables.
 
-use fmi2_export::FmuModel;
+use fmi2_export::{passes, FmuModel};
 use models::error::ParamError;
 use models::hull::mariner::{Mariner, MarinerInputs, MarinerOutputs, MarinerParams, U0_DEFAULT};
 use models::hull::DEG;
@@ -138,6 +138,11 @@ impl FmuModel for MarinerFmu {
         self.ship.step(&self.inputs, h);
         self.keep_outputs();
         Ok(())
+    }
+
+    fn internal_steps(&self, _t: f64, h: f64, each: &mut dyn FnMut(&'static str, f64, f64)) {
+        let max_substep = self.ship.params.max_substep;
+        each("max_substep", max_substep, passes(h, max_substep));
     }
 }
 

@@ -3,7 +3,7 @@
 //! with Esso Osaka coefficients, as an FMI 2.0 co-simulation FMU. No physics here: the variable
 //! table maps the model onto FMI variables.
 
-use fmi2_export::FmuModel;
+use fmi2_export::{passes, FmuModel};
 use models::error::{check_positive, ParamError};
 use models::hull::nomoto::{NomotoInputs, NomotoModel, NomotoOutputs, NomotoShip};
 use models::hull::DEG;
@@ -205,6 +205,11 @@ impl FmuModel for NomotoShipFmu {
         self.ship.step(&self.inputs, h);
         self.keep_outputs();
         Ok(())
+    }
+
+    fn internal_steps(&self, _t: f64, h: f64, each: &mut dyn FnMut(&'static str, f64, f64)) {
+        let max_substep = self.ship.max_substep;
+        each("max_substep", max_substep, passes(h, max_substep));
     }
 }
 

@@ -2,7 +2,7 @@
 //! (`models::observers::parameter_ekf`), identifying −Y_v, m − Y_r, −N_v, m x_G − N_r.
 //! No physics here.
 
-use fmi2_export::FmuModel;
+use fmi2_export::{passes, FmuModel};
 use models::hull::nomoto::{esso_osaka_assumed_m_b, FOOT};
 use models::hull::KNOT;
 use models::observers::parameter_ekf::{ParameterEkf, ParameterEkfParams};
@@ -152,5 +152,13 @@ impl FmuModel for ParameterEkfFmu {
     fn do_step(&mut self, t: f64, h: f64) -> Result<(), String> {
         self.filter.step(t, h, self.measured, self.rudder);
         Ok(())
+    }
+
+    fn internal_steps(&self, _t: f64, h: f64, each: &mut dyn FnMut(&'static str, f64, f64)) {
+        // RK4 in t' = t U/L ([`ParameterEkf::propagate`]); at most one update per step.
+        let p = self.filter.params();
+        let scale = p.speed / p.length;
+        let n = passes(h * scale, p.max_substep * scale);
+        each("max_substep", p.max_substep, n);
     }
 }

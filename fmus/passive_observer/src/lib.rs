@@ -1,7 +1,7 @@
 //! `PassiveObserver` FMU: the nonlinear passive DP observer of [Fossen1999] with wave filtering and
 //! bias estimation (`models::observers::passive_observer`). No physics here.
 
-use fmi2_export::FmuModel;
+use fmi2_export::{passes, FmuModel};
 use models::observers::passive_observer::{Injection, PassiveObserver, PassiveObserverParams};
 use serde::{Deserialize, Serialize};
 
@@ -145,5 +145,10 @@ impl FmuModel for PassiveObserverFmu {
     fn do_step(&mut self, _t: f64, h: f64) -> Result<(), String> {
         self.observer.step(self.measured, self.thrust, h);
         Ok(())
+    }
+
+    fn internal_steps(&self, _t: f64, h: f64, each: &mut dyn FnMut(&'static str, f64, f64)) {
+        let max_substep = self.observer.params().max_substep;
+        each("max_substep", max_substep, passes(h, max_substep));
     }
 }

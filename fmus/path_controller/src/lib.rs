@@ -207,4 +207,8 @@ impl FmuModel for PathControllerFmu {
             .step(&self.inputs, h)
             .map_err(|e| e.to_string())
     }
+
+    fn internal_steps(&self, _t: f64, h: f64, each: &mut dyn FnMut(&'static str, f64, f64)) {
+        self.controller.internal_steps(h, each);
+    }
 }

@@ -1,7 +1,7 @@
 //! `PathKalmanFilter` FMU: the steady-state Kalman-Bucy filter of [Parsons1980, sec. 3] on the
 //! Tokyo Maru 7-state design model (`models::observers::path_kalman`). No physics here.
 
-use fmi2_export::FmuModel;
+use fmi2_export::{passes, FmuModel};
 use models::error::check_positive;
 use models::hull::tokyo_maru::{TokyoMaruCoefficients, L, U};
 use models::memo::{Bits, Memo};
@@ -243,5 +243,11 @@ impl FmuModel for PathKalmanFilterFmu {
             h,
         );
         Ok(())
+    }
+
+    fn internal_steps(&self, _t: f64, h: f64, each: &mut dyn FnMut(&'static str, f64, f64)) {
+        // Euler sub-steps of t' = t U/L ([`PathKalmanFilter::step`]).
+        let dt_prime = self.filter.dt_prime;
+        each("euler_step_prime", dt_prime / UL, passes(h * UL, dt_prime));
     }
 }

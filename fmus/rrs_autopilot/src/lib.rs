@@ -3,7 +3,7 @@
 //! controller, AGC, criterion adaptation, operator modes) as an FMI 2.0 co-simulation FMU. No
 //! physics here: the variable table maps the model onto FMI variables.
 
-use fmi2_export::FmuModel;
+use fmi2_export::{passes, FmuModel};
 use models::controllers::rrs::{
     AgcTarget, RollMode, RrsAutopilot, RrsAutopilotParams, RrsInputs, RrsOutputs,
 };
@@ -107,7 +107,9 @@ fmi2_export::fmu! {
         fixed real "k_dv0" (params.laws.k_dv0), "k_dv = K_dv0 U (0.01)";
         fixed real "k_dr0" (params.laws.k_dr0), "k_dr = K_dr0 U (-0.0027)";
         fixed real "k_vp0" (params.laws.k_vp0), "k_vp = K_vp0 U (0.21)";
-        fixed real "t_v0" ["m"] (params.laws.t_v0).min(0.0), "tau_v = T_v0 / U (78 m)";
+        // min 1 m: T_v0 = 0 gives a NaN rudder command, T_v0 <= 0.1 m NaN roll gains within
+        // 2 s (issue 19); 1 m is 1.3 % of Table 2.4's 78 m.
+        fixed real "t_v0" ["m"] (params.laws.t_v0).min(1.0), "tau_v = T_v0 / U (78 m)";
         fixed real "z_n0" (params.laws.z_n0), "z_n = z_n0 + z_n1 U (0.064)";
         fixed real "z_n1" (params.laws.z_n1), "z_n1 (0.0038 s/m) [s/m]";
         fixed real "k_vr0" (params.laws.k_vr0), "k_vr = K_vr0 (-0.46)";
@@ -173,6 +175,11 @@ impl FmuModel for RrsAutopilotFmu {
         self.autopilot.step(&self.inputs, h);
         self.keep_outputs();
         Ok(())
+    }
+
+    fn internal_steps(&self, _t: f64, h: f64, each: &mut dyn FnMut(&'static str, f64, f64)) {
+        let max_substep = self.autopilot.params.max_substep;
+        each("max_substep", max_substep, passes(h, max_substep));
     }
 }
 

@@ -1,7 +1,7 @@
 //! `RrsFilter` FMU: the roll, yaw and adaptive speed filters of [Klugt1987, sec. 6.3]
 //! (`models::observers::rrs_filter`). No physics here.
 
-use fmi2_export::FmuModel;
+use fmi2_export::{passes, FmuModel};
 use models::error::check_positive;
 use models::observers::rrs_filter::{
     RollFilter, RollFilterParams, RrsFilter, RrsFilterInputs, SpeedAdaptation, SpeedFilter,
@@ -194,5 +194,10 @@ impl FmuModel for RrsFilterFmu {
     fn do_step(&mut self, _t: f64, h: f64) -> Result<(), String> {
         self.filter.step(&self.inputs, h);
         Ok(())
+    }
+
+    fn internal_steps(&self, _t: f64, h: f64, each: &mut dyn FnMut(&'static str, f64, f64)) {
+        let dt = self.filter.sample_time;
+        each("sample_time", dt, passes(h, dt));
     }
 }

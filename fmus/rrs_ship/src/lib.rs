@@ -2,7 +2,7 @@
 //! model and the speed-dependent fifth-order control model, as an FMI 2.0 co-simulation FMU.
 //! No physics here: the variable table maps the model onto FMI variables.
 
-use fmi2_export::FmuModel;
+use fmi2_export::{passes, FmuModel};
 use models::error::check_positive;
 use models::hull::rrs_ship::{RrsShip, RrsShipInputs, RrsShipOutputs, NX, U_22KN};
 use models::hull::DEG;
@@ -155,6 +155,11 @@ impl FmuModel for RrsShipFmu {
         inputs.yaw_disturbance += self.wind_yaw;
         self.ship.step(&inputs, h);
         Ok(())
+    }
+
+    fn internal_steps(&self, _t: f64, h: f64, each: &mut dyn FnMut(&'static str, f64, f64)) {
+        let max_substep = self.ship.max_substep;
+        each("max_substep", max_substep, passes(h, max_substep));
     }
 }
 

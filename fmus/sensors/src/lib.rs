@@ -135,4 +135,8 @@ impl FmuModel for SensorsFmu {
         self.sensors.advance_to(t + h);
         Ok(())
     }
+
+    fn internal_steps(&self, t: f64, h: f64, each: &mut dyn FnMut(&'static str, f64, f64)) {
+        self.sensors.internal_steps(t + h, each);
+    }
 }

@@ -1,7 +1,7 @@
 //! `SteeringGear` FMU: the steering machine of `models::steering_gear` as an FMI 2.0
 //! co-simulation FMU. No physics here: the variable table maps the model onto FMI variables.
 
-use fmi2_export::FmuModel;
+use fmi2_export::{passes, FmuModel};
 use models::steering_gear::{ServoOrder, SteeringGear, SteeringGearParams};
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
@@ -93,5 +93,12 @@ impl FmuModel for SteeringGearFmu {
     fn do_step(&mut self, _t: f64, h: f64) -> Result<(), String> {
         self.gear.step(self.command, h);
         Ok(())
+    }
+
+    fn internal_steps(&self, _t: f64, h: f64, each: &mut dyn FnMut(&'static str, f64, f64)) {
+        let p = &self.gear.params;
+        if p.order == ServoOrder::Second {
+            each("max_substep", p.max_substep, passes(h, p.max_substep));
+        }
     }
 }

@@ -2,7 +2,7 @@
 //! (`models::hull::supply_vessel`, [Fossen1999, sec. 2]) as an FMI 2.0 co-simulation FMU. No
 //! physics here: the variable table maps the model onto FMI variables.
 
-use fmi2_export::FmuModel;
+use fmi2_export::{passes, FmuModel};
 use models::error::check_positive;
 use models::hull::supply_vessel::{
     SupplyVessel, SupplyVesselInputs, SupplyVesselOutputs, NORTHERN_CLIPPER_D, NORTHERN_CLIPPER_M,
@@ -162,6 +162,11 @@ impl FmuModel for SupplyVesselFmu {
         self.vessel.step(&self.inputs, h);
         self.keep_outputs();
         Ok(())
+    }
+
+    fn internal_steps(&self, _t: f64, h: f64, each: &mut dyn FnMut(&'static str, f64, f64)) {
+        let max_substep = self.vessel.max_substep;
+        each("max_substep", max_substep, passes(h, max_substep));
     }
 }
 

@@ -2,10 +2,10 @@
 //! water (`models::hull::tokyo_maru`) as an FMI 2.0 co-simulation FMU. No physics here: the
 //! variable table maps the model onto FMI variables.
 
-use fmi2_export::FmuModel;
+use fmi2_export::{passes, FmuModel};
 use models::error::ParamError;
 use models::hull::tokyo_maru::{
-    TokyoMaru, TokyoMaruInputs, TokyoMaruIntegration, TokyoMaruOutputs, T_R,
+    TokyoMaru, TokyoMaruInputs, TokyoMaruIntegration, TokyoMaruOutputs, L, T_R, U,
 };
 use models::hull::DEG;
 use serde::{Deserialize, Serialize};
@@ -205,6 +205,18 @@ impl FmuModel for TokyoMaruFmu {
         self.ship.step(&inputs, h);
         self.keep_outputs();
         Ok(())
+    }
+
+    fn internal_steps(&self, _t: f64, h: f64, each: &mut dyn FnMut(&'static str, f64, f64)) {
+        // Euler sub-steps of t' = t U/L ([`TokyoMaru::step`]); the exact ZOH has no loop.
+        if let TokyoMaruIntegration::Euler { max_substep_prime } = self.ship.integration {
+            let length = max_substep_prime * L / U;
+            each(
+                "euler_substep_prime",
+                length,
+                passes(h * U / L, max_substep_prime),
+            );
+        }
     }
 }
 

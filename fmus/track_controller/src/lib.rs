@@ -94,4 +94,8 @@ impl FmuModel for TrackControllerFmu {
             .step(self.cross_track, self.reference_input, h);
         Ok(())
     }
+
+    fn internal_steps(&self, _t: f64, h: f64, each: &mut dyn FnMut(&'static str, f64, f64)) {
+        self.controller.internal_steps(h, each);
+    }
 }

@@ -165,4 +165,8 @@ impl FmuModel for WavesFmu {
         self.waves.advance_to(t + h);
         Ok(())
     }
+
+    fn internal_steps(&self, t: f64, h: f64, each: &mut dyn FnMut(&'static str, f64, f64)) {
+        self.waves.internal_steps(t + h, each);
+    }
 }

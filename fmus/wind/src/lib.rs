@@ -137,6 +137,10 @@ impl FmuModel for WindFmu {
         self.keep_relative();
         Ok(())
     }
+
+    fn internal_steps(&self, t: f64, h: f64, each: &mut dyn FnMut(&'static str, f64, f64)) {
+        self.model.internal_steps(t + h, each);
+    }
 }
 
 #[cfg(test)]

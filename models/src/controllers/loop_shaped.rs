@@ -541,6 +541,19 @@ struct Sampler {
 /// [`crate::memo`]).
 type Spare<const N: usize> = Memo<Bits<2>, TustinController<N>>;
 
+/// The sampling work of a communication step of `h` seconds for the work bound of one FMU step:
+/// `each("sample_step", sample step in seconds, samples)` ([`Sampler::split`] takes
+/// ⌈h U/L / τ_max⌉ samples).
+fn sampling_work(c: &LoopShapingCommon, h: f64, each: &mut dyn FnMut(&'static str, f64, f64)) {
+    let scale = c.speed / c.length;
+    let samples = if c.sample_step > 0.0 {
+        h * scale / c.sample_step
+    } else {
+        f64::INFINITY
+    };
+    each("sample_step", c.sample_step / scale, samples);
+}
+
 impl Sampler {
     /// (n, τ) for a communication step of `h_prime`.
     fn split(h_prime: f64, tau_max: f64) -> (usize, f64) {
@@ -677,6 +690,11 @@ impl HeadingAutopilot {
         self.last_reference
     }
 
+    /// The sampling work of a step of `h` seconds (see `sampling_work`).
+    pub fn internal_steps(&self, h: f64, each: &mut dyn FnMut(&'static str, f64, f64)) {
+        sampling_work(&self.design.common, h, each);
+    }
+
     /// Advances `h` seconds with the measured heading and external reference held.
     pub fn step(&mut self, heading: f64, external_reference: f64, h: f64) {
         if !(h > 0.0) || !h.is_finite() {
@@ -789,6 +807,11 @@ impl TrackController {
     /// Cross-track reference used at the last sample [m].
     pub fn cross_track_reference(&self) -> f64 {
         self.last_reference
+    }
+
+    /// The sampling work of a step of `h` seconds (see `sampling_work`).
+    pub fn internal_steps(&self, h: f64, each: &mut dyn FnMut(&'static str, f64, f64)) {
+        sampling_work(&self.design.common, h, each);
     }
 
     /// Advances `h` seconds with the measured cross-track position y [m] and reference held.

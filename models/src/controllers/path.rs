@@ -502,6 +502,25 @@ impl PathController {
             .dot(&inputs.state_prime(self.params.length, self.params.speed))
     }
 
+    /// The gain-scheduling clock's work over a step of `h` seconds, for the work bound of one FMU
+    /// step: `each("update_interval", interval in seconds, passes)` with the scheduled
+    /// adaptation (one pass per update instant the step reaches; +inf where the clock cannot
+    /// advance: an interval that is not positive or lost in the rounding of the next instant).
+    pub fn internal_steps(&self, h: f64, each: &mut dyn FnMut(&'static str, f64, f64)) {
+        if self.params.adaptation != Adaptation::Scheduled {
+            return;
+        }
+        let scale = self.params.speed / self.params.length;
+        let interval = self.params.update_interval;
+        let reached = self.time_prime + h * scale - self.next_update;
+        let passes = if interval > 0.0 && self.next_update + interval != self.next_update {
+            (reached / interval).max(0.0) + 1.0
+        } else {
+            f64::INFINITY
+        };
+        each("update_interval", interval / scale, passes);
+    }
+
     /// Advances `h` seconds with the inputs held; runs the adaptation clock.
     pub fn step(&mut self, inputs: &PathInputs, h: f64) -> Result<(), ControlError> {
         if !(h > 0.0) || !h.is_finite() {

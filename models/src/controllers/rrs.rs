@@ -471,6 +471,8 @@ impl Default for RrsAutopilotParams {
 
 impl RrsAutopilotParams {
     pub fn validate(&self) -> Result<(), ControlError> {
+        // τ_v = T_v0/U divides the roll model: T_v0 = 0 made a NaN rudder command.
+        check_positive("t_v0", self.laws.t_v0)?;
         check_positive("r", self.r)?;
         check_positive("lambda", self.lambda)?;
         check_positive("angle_max", self.angle_max)?;

@@ -333,6 +333,17 @@ impl Current {
         }
     }
 
+    /// The noise grids' work of [`advance_to`](Self::advance_to)`(t)`: `each("internal_step",
+    /// grid step, passes)` per process (for the bound on the work of one FMU step).
+    pub fn internal_steps(&self, t: f64, each: &mut dyn FnMut(&'static str, f64, f64)) {
+        let t = quantise_time(t);
+        let grids = self.white.iter().map(|p| p.grid_passes(t));
+        let processes = self.shaping.iter().chain(&self.walk).chain(&self.bias);
+        for (dt, passes) in grids.chain(processes.map(|p| p.grid_passes(t))) {
+            each("internal_step", dt, passes);
+        }
+    }
+
     /// Nondimensional time t′ = (t − t0) U/L.
     pub fn nondimensional_time(&self) -> f64 {
         (self.time - self.t0) / self.params.time_scale()

@@ -56,6 +56,17 @@ impl Grid {
     fn time(&self, k: u64) -> f64 {
         self.t0 + k as f64 * self.dt
     }
+    /// (grid step, passes of `advance_to(t)`): the grid points from the current one up to `t`,
+    /// for the bound on the work of one step (+inf passes for a grid step that is not a
+    /// positive number).
+    fn passes_to(&self, t: f64) -> (f64, f64) {
+        let passes = if self.dt > 0.0 {
+            ((t - self.time(self.k)) / self.dt).max(0.0)
+        } else {
+            f64::INFINITY
+        };
+        (self.dt, passes)
+    }
     /// Fraction of the current interval at time `t`, clamped to [0, 1].
     fn frac(&self, t: f64) -> f64 {
         ((t - self.time(self.k)) / self.dt).clamp(0.0, 1.0)
@@ -162,6 +173,11 @@ impl SecondOrderProcess {
         ]
     }
 
+    /// (grid step, passes) of [`advance_to`](Self::advance_to)`(t)` (see `Grid::passes_to`).
+    pub fn grid_passes(&self, t: f64) -> (f64, f64) {
+        self.grid.passes_to(t)
+    }
+
     /// Advances the grid so that `t` lies in the current interval (never goes back).
     pub fn advance_to(&mut self, t: f64) {
         while self.grid.time(self.grid.k + 1) < t {
@@ -261,6 +277,11 @@ impl FirstOrderProcess {
         self.phi * self.now + self.step_std * self.rng.normal()
     }
 
+    /// (grid step, passes) of [`advance_to`](Self::advance_to)`(t)` (see `Grid::passes_to`).
+    pub fn grid_passes(&self, t: f64) -> (f64, f64) {
+        self.grid.passes_to(t)
+    }
+
     pub fn advance_to(&mut self, t: f64) {
         while self.grid.time(self.grid.k + 1) < t {
             self.now = self.next;
@@ -295,6 +316,11 @@ impl WhiteSequence {
             now,
             rng,
         }
+    }
+
+    /// (grid step, passes) of [`advance_to`](Self::advance_to)`(t)` (see `Grid::passes_to`).
+    pub fn grid_passes(&self, t: f64) -> (f64, f64) {
+        self.grid.passes_to(t)
     }
 
     /// Advances so that the held sample is the one of the last grid instant ≤ t. A grid

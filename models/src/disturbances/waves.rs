@@ -595,6 +595,20 @@ impl Waves {
         self.time
     }
 
+    /// The noise grids' work of [`advance_to`](Self::advance_to)`(t)`: `each("internal_step",
+    /// grid step, passes)` per process (for the bound on the work of one FMU step).
+    pub fn internal_steps(&self, t: f64, each: &mut dyn FnMut(&'static str, f64, f64)) {
+        let t = quantise_time(t);
+        if self.params.realisation == Realisation::ShapingFilter {
+            let (dt, passes) = self.shaping.grid_passes(t);
+            each("internal_step", dt, passes);
+        }
+        for p in &self.wf {
+            let (dt, passes) = p.grid_passes(t);
+            each("internal_step", dt, passes);
+        }
+    }
+
     /// Wave elevation at the ship ζ(t) [m].
     pub fn elevation(&self) -> f64 {
         self.elevation

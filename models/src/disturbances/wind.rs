@@ -172,6 +172,15 @@ impl Wind {
         self.turn.advance_to(t);
     }
 
+    /// The noise grids' work of [`advance_to`](Self::advance_to)`(t)`: `each("internal_step",
+    /// grid step, passes)` per process (for the bound on the work of one FMU step).
+    pub fn internal_steps(&self, t: f64, each: &mut dyn FnMut(&'static str, f64, f64)) {
+        let t = quantise_time(t);
+        for (dt, passes) in [self.gust.grid_passes(t), self.turn.grid_passes(t)] {
+            each("internal_step", dt, passes);
+        }
+    }
+
     /// True wind speed V̄ + v_g (≥ 0) [m/s].
     pub fn true_speed(&self) -> f64 {
         (self.params.mean_speed + self.gust.value(self.time)).max(0.0)
