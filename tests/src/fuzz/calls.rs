@@ -29,6 +29,9 @@ fn list<T: fmt::Display>(items: &[T]) -> String {
         .join(",")
 }
 
+/// The start of the text of the oracle's own reads (watched, not counted as calls).
+pub const CHECK: &str = "check: ";
+
 /// Value references of a get or set.
 #[derive(Clone, Debug)]
 pub enum Vrs {
@@ -416,10 +419,14 @@ impl<'a> Ctx<'a> {
             return None;
         }
         let mut values = vec![0.0; vrs.len()];
+        // The read is watched like any call (it can hang: a model may compute its outputs
+        // there), but not counted as one.
+        Record::Begin(format!("{CHECK}fmi2GetReal of every Real output")).send();
         // SAFETY: both arrays have vrs.len() elements; the component is live.
         let st = unsafe {
             (self.fmu.api.fmi2GetReal)(self.comp, vrs.as_ptr(), vrs.len(), values.as_mut_ptr())
         };
+        Record::End(st).send();
         if st != fmi2OK {
             return None;
         }

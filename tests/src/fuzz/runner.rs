@@ -2,6 +2,7 @@
 //! watches every call against the limits, turns deaths, overruns, non-finite outputs and panic
 //! messages into failures, and restarts a child after the unit that killed the previous one.
 
+use super::calls::CHECK;
 use super::ffi::Unpacked;
 use super::files::{self, Family};
 use super::proto::Record;
@@ -87,6 +88,10 @@ struct Progress {
     kind: &'static str,
     /// The child reported that it could not set up (its failure is recorded).
     setup: bool,
+    /// The call in progress is the oracle's read of the outputs.
+    check: bool,
+    /// The first line of stray output of this unit (shown with a crash: an abort says why).
+    stray: Option<String>,
     /// This unit printed a panic message: how many more of its lines go into the failure.
     panic: Option<u8>,
     unit: Option<u64>,
@@ -134,6 +139,8 @@ fn run_fmu(env: &Env, kind: Kind, target: usize, seed: u64, units: Range<u64>) -
             kind: kind.name(),
             setup: false,
             panic: None,
+            check: false,
+            stray: None,
             unit: None,
             calls: Vec::new(),
             in_call: None,
@@ -162,7 +169,9 @@ fn run_fmu(env: &Env, kind: Kind, target: usize, seed: u64, units: Range<u64>) -
                         format!("{last}: {why}"),
                         p.calls.clone(),
                     ));
-                    report.calls += 1;
+                    if !p.check {
+                        report.calls += 1;
+                    }
                     *report.units.entry(kind.name()).or_default() += 1;
                     ended = Some(unit + 1);
                     break;
@@ -182,10 +191,15 @@ fn run_fmu(env: &Env, kind: Kind, target: usize, seed: u64, units: Range<u64>) -
                     report.failures.push(fail(
                         FailKind::Crash,
                         unit,
-                        format!("{last}: the process {why}"),
+                        match &p.stray {
+                            Some(out) => {
+                                format!("{last}: the process {why}; its output: {out}")
+                            }
+                            None => format!("{last}: the process {why}"),
+                        },
                         p.calls.clone(),
                     ));
-                    if p.in_call.is_some() {
+                    if p.in_call.is_some() && !p.check {
                         report.calls += 1;
                     }
                     *report.units.entry(kind.name()).or_default() += 1;
@@ -217,6 +231,9 @@ fn on_line(
 ) -> Option<(FailKind, String)> {
     let Some(rec) = Record::parse(line) else {
         report.stray += 1;
+        if p.stray.is_none() {
+            p.stray = Some(line.chars().take(300).collect());
+        }
         // A panic message is several lines: one failure per unit, with its next two lines.
         if let Some(more) = &mut p.panic {
             if *more > 0 {
@@ -238,17 +255,25 @@ fn on_line(
         Record::Unit(u) => {
             p.unit = Some(u);
             p.panic = None;
+            p.stray = None;
             p.calls.clear();
         }
         Record::Begin(t) => {
             if t.starts_with("deSerializeFMUstate(last{") {
                 report.states += 1;
             }
+            p.check = t.starts_with(CHECK);
+            // The oracle's reads appear in a failure only when they are the failing call.
+            if p.calls.last().is_some_and(|c| c.starts_with(CHECK)) {
+                p.calls.pop();
+            }
             p.calls.push(t);
             p.in_call = Some(InCall::now(w));
         }
         Record::End(_) => {
-            report.calls += 1;
+            if !p.check {
+                report.calls += 1;
+            }
             p.in_call = None;
         }
         Record::NonFinite(d) => return Some((FailKind::NonFinite, d)),
