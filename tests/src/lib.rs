@@ -4,9 +4,11 @@
 //!   system is measured against);
 //! - [`reference`]: the Rust-model reference outputs the Python cross-checks compare FMPy and
 //!   libcosim against;
+//! - [`fuzz`]: the FMI fuzzer of issue 19 (`fuzz` binary, docs/fuzzing.md);
 //! - [`study`] and [`studies`]: coupled-system studies run through the shipsim master and
 //!   compared with the sources' published values (system tests and `cargo xtask report`).
 
+pub mod fuzz;
 pub mod model_loop;
 pub mod reference;
 pub mod studies;

@@ -9,11 +9,14 @@
 //! * `export-osp`: every system file of systems/ as target/osp/<name>/OspSystemStructure.xml
 //!   (+ scenario.json for its events) for libcosim / cosim-cli.
 //! * `export-ssp`: every system file of systems/ that SSP 1.0 can express as target/ssp/<name>.ssp.
+//! * `fuzz --minutes N [--seed S]`: seeded fuzzing of every FMU and of malformed files
+//!   (docs/fuzzing.md); its fixed-seed suite is a step of `test`.
 //! * `artifacts DIR` / `artifacts --compare A B`: captures the model descriptions, documentation,
 //!   system CSVs and report of a commit and compares two captures byte for byte (see artifacts.rs).
 
 mod artifacts;
 mod fmu;
+mod fuzz;
 
 use anyhow::{bail, Context, Result};
 use std::path::{Path, PathBuf};
@@ -31,6 +34,7 @@ fn main() {
         Some("export-ssp") => export_ssp(),
         Some("wheel") => wheel(),
         Some("artifacts") => artifacts::main(&args[1..]),
+        Some("fuzz") => fuzz::main(&args[1..]),
         _ => {
             eprintln!(
                 "usage: cargo xtask <task>\n\n\
@@ -43,6 +47,7 @@ fn main() {
                  export-osp   every system of systems/ as target/osp/<name>/OspSystemStructure.xml for libcosim\n  \
                  export-ssp   every system of systems/ that SSP 1.0 can express as target/ssp/<name>.ssp\n  \
                  bench        master overhead vs libcosim and FMPy, every system's speed and profile, campaigns (docs/bench.md)\n  \
+                 fuzz --minutes N [--seed S]  seeded FMI and file fuzzing for N minutes (target/fuzz)\n  \
                  artifacts DIR          FMU model descriptions, system CSVs and report into DIR\n  \
                  artifacts --compare A B  byte-compare two artifact folders (refactor check)"
             );
@@ -178,6 +183,7 @@ fn test(extra: &[String]) -> Result<()> {
         .args(["test", "--release", "--workspace", "--exclude", "xtask"])
         .args(extra)
         .env("SHIPSIM_FMU_DIR", &fmu_dir))?;
+    fuzz::suite(&root, &fmu_dir)?;
     let python = ensure_venv(&root)?;
     install_python_package(&root, &python)?;
     eprintln!("xtask: Python checks (FMPy, libcosim, the shipsim package) in tests/python");
