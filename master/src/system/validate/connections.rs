@@ -7,6 +7,7 @@ use super::Checker;
 use crate::error::Error;
 use crate::model_description::{Causality, ModelDescription, ScalarVariable, VarType};
 use crate::system::{ConnectionSpec, PlanConnection};
+use crate::units::{RadRule, Unit, RAD};
 use std::borrow::Cow;
 use std::collections::{HashMap, HashSet};
 
@@ -26,16 +27,10 @@ struct Ends<'c> {
     to: (usize, usize),
 }
 
-/// BaseUnit exponents (kg, m, s, A, K, mol, cd, rad) that differ in the last one only.
-fn only_rad_differs(a: [i32; 8], b: [i32; 8]) -> bool {
-    a[..7] == b[..7] && a[7] != b[7]
-}
-
-/// Converts a Real unit to SI: (exponents, factor, offset) if the unit is defined.
-fn unit_si(md: &ModelDescription, unit: &str) -> Option<([i32; 8], f64, f64)> {
-    md.unit(unit)
-        .and_then(|u| u.base_unit)
-        .map(|b| (b.exponents(), b.factor, b.offset))
+/// A Real unit of a model description as the unit module has it, if it is defined with a
+/// `BaseUnit`.
+fn defined_unit(md: &ModelDescription, unit: &str) -> Option<Unit> {
+    md.unit(unit).and_then(Unit::from_definition)
 }
 
 impl<'a> Checker<'a> {
@@ -211,18 +206,25 @@ impl<'a> Checker<'a> {
             return true;
         }
         let (name, line, spec) = (&c.name, c.spec.line, &c.spec);
-        match (unit_si(fmd, fu), unit_si(tmd, tu)) {
-            (Some((fe, ff, fo)), Some((te, tf, to))) => {
-                if fe != te {
-                    return self.unit_mismatch(c, fu, tu, only_rad_differs(fe, te));
-                } else if (ff != tf || fo != to) && spec.gain == 1.0 && spec.offset == 0.0 {
-                    let g = ff / tf;
-                    let o = (fo - to) / tf;
+        match (defined_unit(fmd, fu), defined_unit(tmd, tu)) {
+            (Some(f), Some(t)) => match f.conversion_to(&t, RadRule::Strict) {
+                None => {
+                    // exponents (kg, m, s, A, K, mol, cd, rad) that differ in rad only?
+                    let only_rad = f.exponents[..RAD] == t.exponents[..RAD];
+                    return self.unit_mismatch(c, fu, tu, only_rad);
+                }
+                Some(conversion)
+                    if (f.factor != t.factor || f.offset != t.offset)
+                        && spec.gain == 1.0
+                        && spec.offset == 0.0 =>
+                {
+                    let (g, o) = conversion.gain_offset();
                     self.warnings.push(format!(
                         "{}: connection {name} goes from {fu} to {tu} without conversion; set gain = {g} and offset = {o}",
                         self.loc(line)));
                 }
-            }
+                Some(_) => {}
+            },
             _ => self.warnings.push(format!(
                 "{}: connection {name} connects unit '{fu}' to unit '{tu}' (not comparable: no BaseUnit)", self.loc(line))),
         }
