@@ -745,6 +745,42 @@ impl<S: Readable> Instance<S> {
         self.core.check("fmi2GetBoolean", s, None)
     }
 
+    /// `fmi2GetString` into caller-owned strings, in batches of up to 32 value references
+    /// (the FMU owns its strings only until the next call, so each is copied into `out[i]`,
+    /// reusing its buffer: in process, no allocation once a buffer is as long as the text;
+    /// invalid UTF-8 is replaced by U+FFFD, a null pointer reads as ""). For recording String
+    /// variables from the step loop.
+    pub fn get_string_into(&mut self, vrs: &[VR], out: &mut [String]) -> Result<()> {
+        debug_assert_eq!(vrs.len(), out.len());
+        if vrs.is_empty() {
+            return Ok(());
+        }
+        if let Some(r) = self.remote() {
+            let (s, values) = r.get_string(vrs);
+            self.core.check("fmi2GetString", s, None)?;
+            for (o, v) in out.iter_mut().zip(values) {
+                *o = v;
+            }
+            return Ok(());
+        }
+        const BATCH: usize = 32;
+        for (vrs, out) in vrs.chunks(BATCH).zip(out.chunks_mut(BATCH)) {
+            let mut ptrs: [fmi2String; BATCH] = [std::ptr::null(); BATCH];
+            let s = self.local(Op::GetString, |api, c| unsafe {
+                (api.fmi2GetString)(c, vrs.as_ptr(), vrs.len(), ptrs.as_mut_ptr())
+            });
+            self.core.check("fmi2GetString", s, None)?;
+            for (o, p) in out.iter_mut().zip(&ptrs) {
+                o.clear();
+                if !p.is_null() {
+                    // SAFETY: a NUL-terminated string the FMU owns until its next call.
+                    o.push_str(&unsafe { std::ffi::CStr::from_ptr(*p) }.to_string_lossy());
+                }
+            }
+        }
+        Ok(())
+    }
+
     /// `fmi2GetString` (copies the strings, which the FMU owns only until the next call).
     pub fn get_string(&mut self, vrs: &[VR]) -> Result<Vec<String>> {
         let (s, values) = match self.remote() {

@@ -29,54 +29,76 @@ pub struct Panel {
 pub struct Table {
     pub names: Vec<String>,
     pub columns: Vec<Vec<f64>>,
+    /// Columns of text (recorded String variables), left out of `names` and `columns`.
+    pub text: Vec<String>,
+}
+
+/// A CSV field as a number (`true`/`false` as 1/0).
+fn number(field: &str) -> Option<f64> {
+    match field.trim() {
+        "true" | "True" => Some(1.0),
+        "false" | "False" => Some(0.0),
+        f => f.parse().ok(),
+    }
 }
 
 impl Table {
-    /// Reads a CSV written by the recorder (first column time, header `instance.variable`).
-    /// Booleans (`true`/`false`) read as 1/0.
+    /// Reads a CSV written by the recorder (first column time, header `instance.variable`;
+    /// fields quoted as RFC 4180 says, read by the `csv` crate). Booleans (`true`/`false`) read
+    /// as 1/0. A column whose first value is not a number is text (a recorded String
+    /// variable): it is listed in `text` and left out; a later value that is not a number in
+    /// a number column is an error naming the line and column.
     pub fn read(path: &Path) -> Result<Table> {
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| Error::io(format!("cannot read {}", path.display()), e))?;
-        let mut lines = text.lines();
-        let names: Vec<String> = lines
+        let bad = |line: u64, e: String| Error::Other(format!("{}:{line}: {e}", path.display()));
+        let mut reader = csv::ReaderBuilder::new()
+            .has_headers(false)
+            .from_path(path)
+            .map_err(|e| Error::Other(format!("cannot read {}: {e}", path.display())))?;
+        let mut records = reader.records();
+        let header = records
             .next()
             .ok_or_else(|| Error::Other(format!("{}: empty CSV file", path.display())))?
-            .split(',')
-            .map(|s| s.trim().trim_matches('"').to_string())
-            .collect();
-        let mut columns = vec![Vec::new(); names.len()];
-        for (row, line) in lines.enumerate() {
-            if line.trim().is_empty() {
+            .map_err(|e| bad(1, e.to_string()))?;
+        let all: Vec<String> = header.iter().map(|s| s.trim().to_string()).collect();
+        let mut numeric: Option<Vec<bool>> = None;
+        let mut columns = vec![Vec::new(); all.len()];
+        for record in records {
+            let record =
+                record.map_err(|e| bad(e.position().map_or(0, |p| p.line()), e.to_string()))?;
+            let line = record.position().map_or(0, |p| p.line());
+            if record.iter().all(|f| f.trim().is_empty()) {
                 continue;
             }
-            let cells: Vec<&str> = line.split(',').collect();
-            if cells.len() != names.len() {
-                return Err(Error::Other(format!(
-                    "{}:{}: {} values, header has {}",
-                    path.display(),
-                    row + 2,
-                    cells.len(),
-                    names.len()
-                )));
+            if record.len() != all.len() {
+                let e = format!("{} values, header has {}", record.len(), all.len());
+                return Err(bad(line, e));
             }
-            for (c, cell) in cells.iter().enumerate() {
-                let cell = cell.trim();
-                let v = match cell {
-                    "true" | "True" => 1.0,
-                    "false" | "False" => 0.0,
-                    _ => cell.parse::<f64>().map_err(|_| {
-                        Error::Other(format!(
-                            "{}:{}: column {:?}: {cell:?} is not a number",
-                            path.display(),
-                            row + 2,
-                            names[c]
-                        ))
-                    })?,
-                };
+            let numeric =
+                numeric.get_or_insert_with(|| record.iter().map(|f| number(f).is_some()).collect());
+            for (c, field) in record.iter().enumerate().filter(|(c, _)| numeric[*c]) {
+                let v = number(field).ok_or_else(|| {
+                    let e = format!("column {:?}: {:?} is not a number", all[c], field.trim());
+                    bad(line, e)
+                })?;
                 columns[c].push(v);
             }
         }
-        Ok(Table { names, columns })
+        let numeric = numeric.unwrap_or_else(|| vec![true; all.len()]);
+        let (mut names, mut text, mut kept) = (Vec::new(), Vec::new(), Vec::new());
+        for ((name, column), is_number) in all.into_iter().zip(columns).zip(numeric) {
+            match is_number {
+                true => {
+                    names.push(name);
+                    kept.push(column);
+                }
+                false => text.push(name),
+            }
+        }
+        Ok(Table {
+            names,
+            columns: kept,
+            text,
+        })
     }
 
     /// The column named `name`; the error lists the available columns.
@@ -85,11 +107,12 @@ impl Table {
             .iter()
             .position(|n| n == name)
             .map(|i| self.columns[i].as_slice())
-            .ok_or_else(|| {
-                Error::Other(format!(
+            .ok_or_else(|| match self.text.iter().any(|t| t == name) {
+                true => Error::Other(format!("column {name:?} is text (a String variable)")),
+                false => Error::Other(format!(
                     "no column {name:?}; columns: {}",
                     self.names.join(", ")
-                ))
+                )),
             })
     }
 

@@ -183,3 +183,34 @@ fn columns_by_name_and_glob_and_the_table() {
     assert!(!stats(&csv, &["--window", "5"]).status.success());
     assert!(!stats(&csv, &["--window", "6:5"]).status.success());
 }
+
+/// A CSV with a recorded String variable and RFC 4180 quoting (a name with a comma, a text
+/// field with a comma and doubled quotes): the numbers are read by column, the text column is
+/// left out, and asking for it says it is text. (Before, the reader split lines at every
+/// comma: "3 values, header has 4".)
+#[test]
+fn quoted_fields_and_text_columns_are_read() {
+    let d = tempfile::tempdir().unwrap();
+    let csv = d.path().join("text.csv");
+    std::fs::write(
+        &csv,
+        "time,m.mode,\"a,b.y\",m.x\n0,\"on, \"\"fast\"\"\",1,10\n0.5,off,3,20\n1,off,5,30\n",
+    )
+    .unwrap();
+    let j = json(&csv, &[]);
+    let names: Vec<&str> = j["columns"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| c["name"].as_str().unwrap())
+        .collect();
+    assert_eq!(names, ["a,b.y", "m.x"]);
+    // mean of 1, 3, 5 and of 10, 20, 30, written out by hand
+    assert_eq!(column(&j, "a,b.y")["mean"], 3.0);
+    assert_eq!(column(&j, "m.x")["mean"], 20.0);
+    refused(
+        &csv,
+        &["--columns", "m.mode"],
+        &["column 'm.mode' is text (a String variable)"],
+    );
+}

@@ -59,7 +59,7 @@ def toml_value(v):
     if isinstance(v, bool):
         return "true" if v else "false"
     if isinstance(v, str):
-        return f'"{v}"'
+        return json.dumps(v)  # a TOML basic string: JSON's escapes are TOML's
     return repr(v)
 
 
@@ -157,6 +157,34 @@ def test_bouncing_ball_events_are_located_inside_the_step(built, tmp_path):
     apex = h[first:second].max()
     assert 0.49 - 9.81 / 2 * (1 / 32) ** 2 <= apex <= 0.49 + 1e-12, apex
     assert bounces[-1] >= 4
+
+
+def test_a_named_string_variable_is_recorded_quoted(built, tmp_path):
+    """A String variable named in the outputs is a CSV column (issue 18): Feedthrough's
+    string_parameter, set to text with a comma, a quote and non-ASCII, is in every row, quoted as
+    RFC 4180 says, and reads back exactly with Python's csv module; `m.*` still records numbers
+    only (so existing CSVs keep their columns). In memory (Python) it is refused by name."""
+    copy_fmus(built, ["Feedthrough"], tmp_path)
+    text = 'héllo, "world"'
+    toml = one_instance_toml("Feedthrough", 0.25, {"string_parameter": text}) + textwrap.dedent("""
+        [output]
+        variables = ["m.string_parameter", "m.*"]
+    """)
+    (tmp_path / "s.toml").write_text(toml)
+    shipsim("run", tmp_path / "s.toml", "-o", tmp_path / "s.csv")
+    raw = (tmp_path / "s.csv").read_text(encoding="utf-8").splitlines()
+    assert raw[1].split(",", 1)[1].startswith('"héllo, ""world""",'), raw[1]
+    with open(tmp_path / "s.csv", newline="", encoding="utf-8") as f:
+        rows = list(csv.reader(f))
+    header = rows[0]
+    assert header[:2] == ["time", "m.string_parameter"] and "m.integer_output" in header
+    assert header.count("m.string_parameter") == 1  # not again from m.*
+    assert len(rows) == 1 + 5  # t = 0, 0.0625, ..., 0.25
+    assert all(r[1] == text and len(r) == len(header) for r in rows[1:])
+    import shipsim as sp
+    system = sp.System.load(tmp_path / "s.toml")
+    with pytest.raises(sp.ShipsimError, match="'m.string_parameter' is a String variable"):
+        system.run(0.25, variables=["m.string_parameter"])
 
 
 def test_resource_file_is_read_at_instantiation(built, tmp_path):

@@ -20,7 +20,7 @@
 //! Manoeuvring KPIs feed the streaming trackers of `models::manoeuvre` (IMO MSC.137(76)).
 
 use crate::error::{Error, Result};
-use crate::run::{ColumnInfo, Recorder, Row};
+use crate::run::{ColumnInfo, Recorder, Row, Sample};
 
 /// A statistic over a time window.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -331,7 +331,7 @@ impl Recorder for KpiRecorder<'_> {
     #[inline]
     fn record(&mut self, time: f64, row: &Row<'_>) -> Result<()> {
         for j in 0..row.len() {
-            if row.get(j).as_f64().is_nan() {
+            if matches!(row.get(j), Sample::Real(x) if x.is_nan()) {
                 let name = self.columns[j].name.clone();
                 let e = Error::Other(format!("'{name}' is NaN at t = {time} s"));
                 self.nan = Some((name, time));

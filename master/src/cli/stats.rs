@@ -54,7 +54,7 @@ pub fn run(args: &StatsArgs) -> Result<()> {
     let time = table
         .column("time")
         .map_err(|_| Error::Other(format!("{file}: no column 'time'")))?;
-    let selected = select(&table.names, args.columns.as_deref(), &file)?;
+    let selected = select(&table, args.columns.as_deref(), &file)?;
     let inside: Vec<usize> = (0..time.len())
         .filter(|&k| time[k] >= window.0 && time[k] <= window.1)
         .collect();
@@ -96,7 +96,10 @@ pub fn run(args: &StatsArgs) -> Result<()> {
 }
 
 /// The indices of the selected columns, in the order of the pattern list (each column once).
-fn select(names: &[String], patterns: Option<&str>, file: &str) -> Result<Vec<usize>> {
+/// Text columns (recorded String variables) are not selected: a pattern that matches only
+/// text is an error that says so.
+fn select(table: &Table, patterns: Option<&str>, file: &str) -> Result<Vec<usize>> {
+    let names = &table.names;
     let Some(patterns) = patterns else {
         return Ok((0..names.len()).filter(|&c| names[c] != "time").collect());
     };
@@ -105,6 +108,13 @@ fn select(names: &[String], patterns: Option<&str>, file: &str) -> Result<Vec<us
         let matched: Vec<usize> = (0..names.len())
             .filter(|&c| glob(p.as_bytes(), names[c].as_bytes()))
             .collect();
+        if let Some(t) = table.text.iter().find(|t| glob(p.as_bytes(), t.as_bytes())) {
+            if matched.is_empty() {
+                return Err(Error::Other(format!(
+                    "{file}: column '{t}' is text (a String variable); stats are of numbers"
+                )));
+            }
+        }
         if matched.is_empty() {
             let candidates = names.iter().map(String::as_str);
             return Err(Error::Other(format!(

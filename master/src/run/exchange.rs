@@ -33,6 +33,9 @@ pub struct Values {
     pub integer: Vec<i32>,
     /// fmi2Boolean: 0 or 1.
     pub boolean: Vec<i32>,
+    /// Recorded String variables (never connected: String values are only recorded), read
+    /// into these buffers in place ([`Instance::get_string_into`]).
+    pub string: Vec<String>,
 }
 
 /// An FMI variable type as the exchange moves it: where its values live, how a connection
@@ -310,8 +313,10 @@ pub struct Ports {
     real: Port<Real>,
     integer: Port<Integer>,
     boolean: Port<Boolean>,
-    /// The Integer or the Boolean port has inputs or observed variables (one test per call
-    /// for the many instances that exchange only Real values).
+    /// Recorded String variables, stored at `Values::string[at..]`.
+    string: Observed,
+    /// The Integer or the Boolean port has inputs or observed variables, or String variables
+    /// are recorded (one test per call for the many instances that exchange only Real values).
     discrete: bool,
 }
 
@@ -338,15 +343,18 @@ impl Ports {
         if self.discrete {
             self.integer.get_outputs(inst, values)?;
             self.boolean.get_outputs(inst, values)?;
+            let Observed { vrs, at } = &self.string;
+            inst.get_string_into(vrs, &mut values.string[*at..*at + vrs.len()])?;
         }
         Ok(())
     }
 
-    /// The observed variables of exchange type `t` (Real, Integer or Boolean).
+    /// The observed variables of exchange type `t` (Real, Integer, Boolean or String).
     fn observed_mut(&mut self, t: VarType) -> &mut Observed {
         match t {
             VarType::Real => &mut self.real.observed,
             VarType::Boolean => &mut self.boolean.observed,
+            VarType::String => &mut self.string,
             _ => &mut self.integer.observed,
         }
     }
@@ -358,6 +366,7 @@ pub enum Column {
     Real(usize),
     Integer(usize),
     Boolean(usize),
+    String(usize),
 }
 
 /// The resolved exchange of a plan: per-instance ports, the shared values, and the place of
@@ -370,12 +379,17 @@ pub struct Exchange {
 }
 
 /// The exchange types, in the order of the batched calls and of [`Values`].
-const KINDS: [VarType; 3] = [VarType::Real, VarType::Integer, VarType::Boolean];
+const KINDS: [VarType; 4] = [
+    VarType::Real,
+    VarType::Integer,
+    VarType::Boolean,
+    VarType::String,
+];
 
 /// The exchange's type of a plan variable type (Enumeration is already Integer in a plan).
 fn kind_of(t: VarType) -> VarType {
     match t {
-        VarType::Real | VarType::Boolean => t,
+        VarType::Real | VarType::Boolean | VarType::String => t,
         _ => VarType::Integer,
     }
 }
@@ -418,6 +432,7 @@ impl Exchange {
                 match kind_of(o.var_type) {
                     VarType::Real => Column::Real(g),
                     VarType::Boolean => Column::Boolean(g),
+                    VarType::String => Column::String(g),
                     _ => Column::Integer(g),
                 }
             })
@@ -447,7 +462,7 @@ impl Exchange {
             }
         }
         for p in ports.iter_mut() {
-            p.discrete = !(p.integer.is_empty() && p.boolean.is_empty());
+            p.discrete = !(p.integer.is_empty() && p.boolean.is_empty() && p.string.vrs.is_empty());
         }
         Exchange {
             ports,
@@ -459,7 +474,7 @@ impl Exchange {
 
 /// Lays the observed variables out instance after instance; returns the zeroed shared values.
 fn place_outputs(ports: &mut [Ports]) -> Values {
-    let mut len = [0usize; 3];
+    let mut len = [0usize; 4];
     for p in ports.iter_mut() {
         for (n, t) in len.iter_mut().zip(KINDS) {
             let observed = p.observed_mut(t);
@@ -471,5 +486,6 @@ fn place_outputs(ports: &mut [Ports]) -> Values {
         real: vec![0.0; len[0]],
         integer: vec![0; len[1]],
         boolean: vec![0; len[2]],
+        string: vec![String::new(); len[3]],
     }
 }

@@ -22,21 +22,23 @@ pub struct ColumnInfo {
     pub var_type: VarType,
 }
 
-/// One recorded value.
+/// One recorded value (a String borrowed from the exchange).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Sample {
+pub enum Sample<'a> {
     Real(f64),
     Integer(i32),
     Boolean(bool),
+    String(&'a str),
 }
 
-impl Sample {
-    /// The value as a number (a Boolean is 0 or 1).
+impl Sample<'_> {
+    /// The value as a number (a Boolean is 0 or 1; a String is not a number: NaN).
     pub fn as_f64(self) -> f64 {
         match self {
             Sample::Real(x) => x,
             Sample::Integer(i) => i as f64,
             Sample::Boolean(b) => b as i32 as f64,
+            Sample::String(_) => f64::NAN,
         }
     }
 }
@@ -63,15 +65,16 @@ impl<'a> Row<'a> {
 
     /// Column `j`.
     #[inline]
-    pub fn get(&self, j: usize) -> Sample {
+    pub fn get(&self, j: usize) -> Sample<'a> {
         match self.columns[j] {
             Column::Real(i) => Sample::Real(self.values.real[i]),
             Column::Integer(i) => Sample::Integer(self.values.integer[i]),
             Column::Boolean(i) => Sample::Boolean(self.values.boolean[i] != 0),
+            Column::String(i) => Sample::String(&self.values.string[i]),
         }
     }
 
-    pub fn iter(&self) -> impl Iterator<Item = Sample> + '_ {
+    pub fn iter(&self) -> impl Iterator<Item = Sample<'a>> + '_ {
         (0..self.len()).map(|j| self.get(j))
     }
 }
@@ -94,7 +97,8 @@ pub trait Recorder {
 /// quote or a line break is enclosed in quotes, its quotes doubled), so a name never shifts
 /// the columns. Numbers are written in Rust's shortest round-trip digits, so values survive
 /// the file exactly ([`write_real`]: plain decimal, with an exponent for very small and very
-/// large magnitudes); Booleans are written 0 or 1.
+/// large magnitudes); Booleans are written 0 or 1; Strings as they are, or quoted as RFC 4180
+/// says when they hold a comma, a quote or a line break ([`write_text`]).
 ///
 /// The output is flushed at least once a second of wall time ([`FlushClock`]), so a process
 /// killed by a crashing FMU loses at most about the last second of rows.
@@ -187,6 +191,25 @@ pub fn write_real(out: &mut impl Write, x: f64) -> std::io::Result<()> {
     }
 }
 
+/// Writes a text field of a CSV row as RFC 4180 says (sec. 2, rules 6 and 7): as it is, or, when
+/// it holds a comma, a double quote or a line break, enclosed in double quotes with each of its
+/// quotes doubled. No allocation.
+pub fn write_text(out: &mut impl Write, t: &str) -> std::io::Result<()> {
+    if !t.contains([',', '"', '\n', '\r']) {
+        return out.write_all(t.as_bytes());
+    }
+    out.write_all(b"\"")?;
+    let mut parts = t.split('"');
+    if let Some(first) = parts.next() {
+        out.write_all(first.as_bytes())?;
+    }
+    for part in parts {
+        out.write_all(b"\"\"")?;
+        out.write_all(part.as_bytes())?;
+    }
+    out.write_all(b"\"")
+}
+
 fn write_error(e: std::io::Error) -> Error {
     Error::io("writing the output file", e)
 }
@@ -218,6 +241,10 @@ impl Recorder for CsvRecorder {
                     .and_then(|()| write_real(&mut self.out, x)),
                 Sample::Integer(i) => write!(self.out, ",{i}"),
                 Sample::Boolean(b) => write!(self.out, ",{}", b as i32),
+                Sample::String(t) => self
+                    .out
+                    .write_all(b",")
+                    .and_then(|()| write_text(&mut self.out, t)),
             }
             .map_err(write_error)?;
         }
@@ -267,6 +294,13 @@ impl Recorder for MemoryRecorder {
             ))
         };
         let rows = usize::try_from(expected_rows).map_err(|_| too_long())?;
+        if let Some(c) = columns.iter().find(|c| c.var_type == VarType::String) {
+            return Err(Error::Other(format!(
+                "'{}' is a String variable: String variables are recorded into CSV files \
+                 (shipsim run -o FILE), not in memory (Python, campaigns)",
+                c.name
+            )));
+        }
         self.columns = columns.to_vec();
         self.time = Vec::new();
         self.data = columns.iter().map(|_| Vec::new()).collect();
@@ -288,7 +322,24 @@ impl Recorder for MemoryRecorder {
 
 #[cfg(test)]
 mod tests {
-    use super::write_real;
+    use super::{write_real, write_text};
+
+    /// RFC 4180 text fields, the expected bytes written out by hand.
+    #[test]
+    fn text_fields_are_quoted_only_when_needed() {
+        let field = |t: &str| {
+            let mut b = Vec::new();
+            write_text(&mut b, t).unwrap();
+            String::from_utf8(b).unwrap()
+        };
+        assert_eq!(field("plain text"), "plain text");
+        assert_eq!(field(""), "");
+        assert_eq!(field("a,b"), "\"a,b\"");
+        assert_eq!(field("say \"hi\""), "\"say \"\"hi\"\"\"");
+        assert_eq!(field("\"\""), "\"\"\"\"\"\"");
+        assert_eq!(field("two\nlines"), "\"two\nlines\"");
+        assert_eq!(field("cr\r"), "\"cr\r\"");
+    }
 
     fn text(x: f64) -> String {
         let mut b = Vec::new();

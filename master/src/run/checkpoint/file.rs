@@ -220,6 +220,8 @@ impl Checkpoint {
             real: r.list(8, "Real values", |r| r.f64("a Real value"))?,
             integer: r.list(4, "Integer values", |r| r.i32("an Integer value"))?,
             boolean: r.list(4, "Boolean values", |r| r.i32("a Boolean value"))?,
+            // String values are recorded only, never exchanged: read again after the resume
+            string: Vec::new(),
         };
         let states = r.list(12, "instance states", |r| {
             let name = r.str("an instance name")?;

@@ -1,5 +1,6 @@
 //! Recorded outputs: `inst.var`, `inst.*` (every output of an instance), or by default every
-//! output of every instance; String variables are not recorded.
+//! output of every instance. A String variable is recorded when it is named (`inst.var`), not by
+//! `inst.*` or the default, whose columns stay numbers.
 
 use super::Checker;
 use crate::error::did_you_mean;
@@ -53,17 +54,7 @@ impl Checker<'_> {
             return;
         };
         match self.resolve(&r, None, "output") {
-            Ok((i, vi)) => {
-                if self.mds[i].model_variables.variables[vi].var_type() == Some(VarType::String) {
-                    let e = self.err(
-                        None,
-                        format!("output '{s}': String variables cannot be recorded"),
-                    );
-                    self.errors.push(e);
-                } else {
-                    self.push_output(i, vi, outputs)
-                }
-            }
+            Ok((i, vi)) => self.push_output(i, vi, outputs, true),
             Err(e) => self.errors.push(e),
         }
     }
@@ -72,15 +63,17 @@ impl Checker<'_> {
     fn all_outputs(&self, i: usize, outputs: &mut Vec<PlanOutput>) {
         for (vi, v) in self.mds[i].model_variables.variables.iter().enumerate() {
             if v.causality == Causality::Output {
-                self.push_output(i, vi, outputs);
+                self.push_output(i, vi, outputs, false);
             }
         }
     }
 
-    fn push_output(&self, i: usize, vi: usize, outputs: &mut Vec<PlanOutput>) {
+    /// Variable `vi` of instance `i` as a recorded output; a String only when `strings` (it is
+    /// named, not matched by `instance.*`).
+    fn push_output(&self, i: usize, vi: usize, outputs: &mut Vec<PlanOutput>, strings: bool) {
         let sv = &self.mds[i].model_variables.variables[vi];
         let t = sv.var_type().unwrap();
-        if t != VarType::String {
+        if t != VarType::String || strings {
             outputs.push(PlanOutput {
                 instance: i,
                 vr: sv.value_reference,
