@@ -456,9 +456,13 @@ fn ctrl_c_stops_a_hung_isolated_fmu() {
     assert_no_temp_dirs(d.path());
 }
 
-/// The probe's case (issue 19, defect 5): `--set autopilot.t_v0=0` makes RrsAutopilot output
-/// a NaN rudder command. The error names the autopilot, not the steering gear that refused the
-/// value, and the six other instances, left in Initialization Mode, get no fmi2Terminate.
+/// The probe's case (issue 19, defect 5): `--set autopilot.t_v0=0` made RrsAutopilot output
+/// a NaN rudder command, blamed on the steering gear that refused it. The error now names the
+/// autopilot: since t_v0's declared minimum is 1 m (0 broke the model), the value is refused
+/// before the run, naming the variable and its range (an in-range NaN is reported by the
+/// autopilot's own fmi2GetReal, and a NaN that an FMU passes with fmi2OK is blamed on it by
+/// the exchange: `a_refused_nan_is_blamed_on_its_producer`). No instance gets an fmi2Terminate
+/// in Initialization Mode.
 #[test]
 fn rrs_nan_rudder_command_is_blamed_on_the_autopilot() {
     let d = tempfile::tempdir().unwrap();
@@ -479,7 +483,9 @@ fn rrs_nan_rudder_command_is_blamed_on_the_autopilot() {
         ],
     );
     let blamed = err.contains("error: 'autopilot.rudder_command' is NaN")
-        || err.contains("error: instance 'autopilot'");
+        || err.contains(
+            "instance 'autopilot', variable 't_v0': value 0 is outside the declared range [1, inf]",
+        );
     assert!(blamed, "{err}");
     assert!(!err.contains("fmi2Terminate is not allowed"), "{err}");
 }
