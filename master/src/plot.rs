@@ -516,10 +516,18 @@ mod tests {
         .unwrap();
         let bytes = std::fs::read(&png).unwrap();
         assert_eq!(&bytes[1..4], b"PNG");
+        // a column that starts with text is text (a String variable), left out of the numbers
         std::fs::write(&csv, "time,x\n0,abc\n").unwrap();
+        let t = Table::read(&csv).unwrap();
+        assert_eq!(
+            (t.names, t.text),
+            (vec!["time".to_string()], vec!["x".to_string()])
+        );
+        // text later in a number column is an error naming the line and column
+        std::fs::write(&csv, "time,x\n0,1\n0.1,abc\n").unwrap();
         let e = Table::read(&csv).unwrap_err().to_string();
         assert!(
-            e.contains("r.csv:2: column \"x\": \"abc\" is not a number"),
+            e.contains("r.csv:3: column \"x\": \"abc\" is not a number"),
             "{e}"
         );
     }
