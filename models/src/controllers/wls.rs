@@ -306,7 +306,8 @@ impl WlsEstimator {
         // MAX_WINDOW_SAMPLES before anything is allocated (a tiny step or ship speed asked
         // for 2.9e9 samples, 23 GB, and aborted the process: issue 19).
         let samples = (self.schedule.window_length / dt).ceil() + 2.0;
-        if !(samples <= MAX_WINDOW_SAMPLES as f64) || self.z.len() >= MAX_WINDOW_SAMPLES {
+        let too_many = samples.is_nan() || samples > MAX_WINDOW_SAMPLES as f64;
+        if too_many || self.z.len() >= MAX_WINDOW_SAMPLES {
             return Err(ControlError(format!(
                 "a data window of window_length = {} ship lengths at one sample per step of \
                  {dt} ship lengths needs {samples:e} samples, more than the limit of \
