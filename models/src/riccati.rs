@@ -16,7 +16,12 @@
 //! Matrices are `nalgebra::DMatrix<f64>`; these are design-time computations (at initialization
 //! or on a slow adaptation clock), never in a model's per-step path.
 
-use nalgebra::DMatrix;
+use nalgebra::{DMatrix, Schur};
+
+/// Iteration limit of the nalgebra QR-type iterations (SVD, Schur). They converge in a few
+/// iterations per eigenvalue on the matrices of ship models (order ≤ ~30); the limit only turns
+/// a non-converging iteration on extreme entries into an error.
+const MAX_QR_ITERATIONS: usize = 10_000;
 use std::fmt;
 
 /// Why a Riccati or Lyapunov equation could not be solved.
@@ -141,6 +146,9 @@ pub fn care(a: &M, b: &M, q: &M, r: &M) -> Result<M, RiccatiError> {
     h.view_mut((n, 0), (n, n)).copy_from(&(-q));
     h.view_mut((n, n), (n, n)).copy_from(&(-a.transpose()));
     let w = sign_function(&h)?;
+    if w.iter().any(|v| !v.is_finite()) {
+        return Err(RiccatiError::NoConvergence("non-finite sign function"));
+    }
     let eye = M::identity(n, n);
     let w11 = w.view((0, 0), (n, n)).clone_owned();
     let w12 = w.view((0, n), (n, n)).clone_owned();
@@ -153,8 +161,13 @@ pub fn care(a: &M, b: &M, q: &M, r: &M) -> Result<M, RiccatiError> {
     let mut rhs = M::zeros(2 * n, n);
     rhs.view_mut((0, 0), (n, n)).copy_from(&(-(w11 + &eye)));
     rhs.view_mut((n, 0), (n, n)).copy_from(&(-w21));
+    // nalgebra's `svd` is `try_svd` with this epsilon and no iteration limit: the limit only
+    // bounds the work on extreme inputs (issue 19), converged results are the same.
     let p = lhs
-        .svd(true, true)
+        .try_svd(true, true, f64::EPSILON * 5.0, MAX_QR_ITERATIONS)
+        .ok_or(RiccatiError::NoConvergence(
+            "SVD of the sign-function solve",
+        ))?
         .solve(&rhs, 1e-14)
         .map_err(|_| RiccatiError::NoConvergence("sign-function solve"))?;
     let mut p = symmetrize(&p);
@@ -171,7 +184,15 @@ pub fn care(a: &M, b: &M, q: &M, r: &M) -> Result<M, RiccatiError> {
         return Err(RiccatiError::NoConvergence("non-finite solution"));
     }
     let closed = a - &g * &p;
-    if closed.complex_eigenvalues().iter().any(|l| l.re >= 0.0) {
+    if closed.iter().any(|v| !v.is_finite()) {
+        return Err(RiccatiError::NoConvergence("non-finite closed loop"));
+    }
+    // `complex_eigenvalues` runs the Schur iteration without a limit: it spins forever on
+    // extreme entries (a weight of 1e300, issue 19). The same decomposition, bounded.
+    let schur = Schur::try_new(closed, f64::EPSILON, MAX_QR_ITERATIONS).ok_or(
+        RiccatiError::NoConvergence("Schur decomposition of the closed loop"),
+    )?;
+    if schur.complex_eigenvalues().iter().any(|l| l.re >= 0.0) {
         return Err(RiccatiError::NoConvergence(
             "no stabilising solution: (A, B) not stabilisable or (A, Q) with unobservable modes on the imaginary axis",
         ));

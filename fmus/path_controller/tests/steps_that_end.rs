@@ -17,3 +17,20 @@ fn one_step_of_1e9_s_ends() {
 fn tiny_internal_steps_end() {
     probe(&[], &[("update_interval", 1e-300)], 1.0, 1, Finite);
 }
+
+/// fuzz run, `replay param PathController 2036 229`: r_cross_track = 1e300 spun forever in the
+/// Schur decomposition of the gain design's closed loop.
+#[test]
+fn an_extreme_weight_ends_in_an_error() {
+    probe(
+        &[],
+        &[
+            ("r_yaw_rate", 142.19367881695118),
+            ("r_cross_track", 1e300),
+            ("schedule_tolerance", 1e6),
+        ],
+        1.0,
+        1,
+        Error("no convergence"),
+    );
+}

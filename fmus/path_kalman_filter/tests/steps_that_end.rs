@@ -213,3 +213,19 @@ fn a_corrupt_state_is_refused_or_bounded() {
         Corrupt::StepRefused("internal steps of euler_step_prime = "),
     );
 }
+
+/// fuzz run, `replay calls PathKalmanFilter 2028 17`: r_cross_track = 1.7e173 spun forever in
+/// fmi2ExitInitializationMode (the Schur decomposition of the Kalman design's closed loop).
+#[test]
+fn an_extreme_weight_ends_in_an_error() {
+    probe(
+        &[],
+        &[
+            ("euler_step_prime", 3.6265768353767425),
+            ("r_cross_track", 1.743975019132907e173),
+        ],
+        1.0,
+        1,
+        Error("no convergence"),
+    );
+}

@@ -17,3 +17,16 @@ fn one_step_of_1e9_s_ends() {
 fn extreme_parameters_that_panicked_give_an_error() {
     probe(&[], &[("ship_speed", 1000000.0)], 0.2349, 50, Finite);
 }
+
+/// fuzz run, `replay param PathWlsEstimator 2029 111`: a window of 2.5 ship lengths at a tiny
+/// ship speed asked for 2.9e9 samples (23 GB) and aborted the process; refused before allocating.
+#[test]
+fn a_window_of_too_many_samples_is_refused() {
+    probe(
+        &[],
+        &[("window_start", 0.0), ("ship_speed", 1e-6)],
+        1.0,
+        1,
+        Error("more than the limit of 1e6"),
+    );
+}

@@ -27,6 +27,11 @@ use crate::error::{check_finite, check_positive};
 use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
 
+/// Most samples one data window may hold (one per communication step): far above what a window
+/// of the systems needs (2.5 ship lengths at Δt′ = 0.005 in `systems/path_control_wls.toml`: 502),
+/// it bounds a window's buffers to 40 MB (issue 19).
+pub const MAX_WINDOW_SAMPLES: usize = 1_000_000;
+
 /// A data window: measured states z′_k (k = 0 … n−1, z′_0 at the window start) and rudder δ′_k.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Window {
@@ -297,10 +302,25 @@ impl WlsEstimator {
             self.loading = false;
             return Ok(false);
         };
+        // One sample per step: a window of LW needs LW/Δt′ of them. Refused above
+        // MAX_WINDOW_SAMPLES before anything is allocated (a tiny step or ship speed asked
+        // for 2.9e9 samples, 23 GB, and aborted the process: issue 19).
+        let samples = (self.schedule.window_length / dt).ceil() + 2.0;
+        let too_many = samples.is_nan() || samples > MAX_WINDOW_SAMPLES as f64;
+        if too_many || self.z.len() >= MAX_WINDOW_SAMPLES {
+            return Err(ControlError(format!(
+                "a data window of window_length = {} ship lengths at one sample per step of \
+                 {dt} ship lengths needs {samples:e} samples, more than the limit of \
+                 {MAX_WINDOW_SAMPLES:e}: shorten window_length or take longer steps \
+                 (h * ship_speed / ship_length)",
+                self.schedule.window_length
+            )));
+        }
         if self.z.capacity() == 0 {
-            let n = (self.schedule.window_length / dt).ceil() as usize + 2;
-            self.z.reserve_exact(n);
-            self.rudder.reserve_exact(n);
+            let n = samples as usize;
+            let cannot = |e| ControlError(format!("cannot allocate a window of {n} samples: {e}"));
+            self.z.try_reserve_exact(n).map_err(cannot)?;
+            self.rudder.try_reserve_exact(n).map_err(cannot)?;
         }
         if first || self.z.is_empty() {
             self.z.clear();
