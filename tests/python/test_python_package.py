@@ -183,14 +183,15 @@ def test_errors_are_documented_types_with_the_cli_message(tmp_path):
         s.set("waves.sed", 3)
     with pytest.raises(shipsim.VariableError, match="no instance 'wave'"):
         s.run(stop_time=1, variables=["wave.*"])
-    # an FMU failure (an FMI call returns fmi2Error)
-    s.set("autopilot.t_v0", 0)
+    # an FMU failure (an FMI call returns fmi2Error): a sub-step that would take 5e298
+    # internal steps in one fmi2DoStep is refused by the steering gear
+    s.set("gear.servo_order", 2).set("gear.max_substep", 1e-300)
     with pytest.raises(shipsim.SimulationError) as e:
         s.run(stop_time=10)
-    assert e.value.status == "fmi2Error"
-    assert e.value.function.startswith("fmi2")
+    assert e.value.status == "fmi2Error" and e.value.instance == "gear"
+    assert e.value.function == "fmi2DoStep"
     assert f"error: {e.value}" in cli_error("run", str(RRS), "--stop-time", "10", "--no-output",
-                                            "--set", "autopilot.t_v0=0")
+                                            "--set", "gear.servo_order=2", "--set", "gear.max_substep=1e-300")
     # an FMU archive that is not one
     bad = tmp_path / "bad.fmu"
     bad.write_bytes(b"not a zip")
