@@ -378,6 +378,7 @@ fn bench(extra: &[String]) -> Result<()> {
         "RrsAutopilot",
     ];
     let no_call_log = fmu::build_fmu_variant(&root, "shipsim_no_call_log", &rrs)?;
+    let no_output_check = fmu::build_fmu_variant(&root, "shipsim_no_output_check", &rrs)?;
     let python = ensure_venv(&root)?;
     install_python_package(&root, &python)?;
     let script = |name: &str, args: &[String]| -> Result<String> {
@@ -402,7 +403,10 @@ fn bench(extra: &[String]) -> Result<()> {
     let variants = || {
         script(
             "bench_variants.py",
-            &[format!("shipsim_no_call_log={}", no_call_log.display())],
+            &[
+                format!("shipsim_no_call_log={}", no_call_log.display()),
+                format!("shipsim_no_output_check={}", no_output_check.display()),
+            ],
         )
     };
     if only == Some("variants") {

@@ -498,6 +498,11 @@ fn update_outputs<M: FmuModel>(inst: &mut Instance<M>) {
     }
 }
 
+/// The finiteness check of the values `fmi2GetReal` hands out compiled in: always, except in
+/// the variant that `cargo xtask bench` builds with `--cfg shipsim_no_output_check` to measure
+/// what the check costs (the "output check" row of docs/bench.md; issue 19: at most 1 %).
+const OUTPUT_CHECK: bool = !cfg!(shipsim_no_output_check);
+
 /// A value a getter hands out: `x - x` for a Real (0 when finite, NaN for NaN and the
 /// infinities), 0 for the other types, summed over the values of a call.
 trait Handed: Copy {
@@ -556,7 +561,9 @@ unsafe fn get_values<M: FmuModel, T: Handed>(
                     Err(s) => return s,
                 },
             };
-            sum += x.not_finite();
+            if OUTPUT_CHECK {
+                sum += x.not_finite();
+            }
             *out.add(i) = x;
         }
         if sum == 0.0 {
@@ -949,7 +956,8 @@ pub unsafe fn set_string<M: FmuModel>(
     })
 }
 
-/// Checks that an FMU-state pointer was made by this model type.
+/// The state `s` points to, if this instance handed it out and it was not freed (looked up in
+/// [`Instance::states`] before the pointer is read); otherwise fmi2Error naming the call.
 unsafe fn state_ref<'a, M: FmuModel>(
     inst: &Instance<M>,
     function: &str,
@@ -958,14 +966,26 @@ unsafe fn state_ref<'a, M: FmuModel>(
     if s.is_null() {
         return Err(inst.error(&format!("{function}: FMU state is NULL")));
     }
-    let b = &mut *(s as *mut StateBox<M>);
-    if b.magic != inst.magic {
+    if !inst.states.contains(&(s as usize)) {
         return Err(inst.error(&format!(
-            "{function}: the FMU state was not created by {} (or was freed)",
+            "{function}: FMU state {s:p} was not created by this instance of {} or was \
+             already freed",
             M::MODEL_IDENTIFIER
         )));
     }
-    Ok(b)
+    // SAFETY: a live `StateBox<M>` of this instance (registered when created, removed when
+    // freed).
+    Ok(&mut *(s as *mut StateBox<M>))
+}
+
+/// A new FMU state holding `snapshot`, registered with the instance.
+fn new_state<M: FmuModel>(inst: &mut Instance<M>, snapshot: Snapshot<M>) -> fmi2FMUstate {
+    let s = Box::into_raw(Box::new(StateBox {
+        magic: inst.magic,
+        snapshot,
+    })) as fmi2FMUstate;
+    inst.states.push(s as usize);
+    s
 }
 
 /// `fmi2GetFMUstate`: a new snapshot, or overwrites the one `*s` points to.
@@ -983,10 +1003,7 @@ pub unsafe fn get_fmu_state<M: FmuModel>(c: fmi2Component, s: *mut fmi2FMUstate)
             core: inst.core.clone(),
         };
         if (*s).is_null() {
-            *s = Box::into_raw(Box::new(StateBox {
-                magic: inst.magic,
-                snapshot,
-            })) as fmi2FMUstate;
+            *s = new_state(inst, snapshot);
         } else {
             match state_ref::<M>(inst, "fmi2GetFMUstate", *s) {
                 Ok(b) => b.snapshot = snapshot,
@@ -1036,7 +1053,7 @@ pub unsafe fn free_fmu_state<M: FmuModel>(c: fmi2Component, s: *mut fmi2FMUstate
         }
         match state_ref::<M>(inst, "fmi2FreeFMUstate", *s) {
             Ok(b) => {
-                b.magic = 0;
+                inst.states.retain(|&a| a != *s as usize);
                 drop(Box::from_raw(b as *mut StateBox<M>));
                 *s = std::ptr::null_mut();
                 fmi2OK
@@ -1254,10 +1271,7 @@ pub unsafe fn deserialize_fmu_state<M: FmuModel>(
             return refused_state(inst, "fmi2DeSerializeFMUstate", &msg);
         }
         if (*s).is_null() {
-            *s = Box::into_raw(Box::new(StateBox {
-                magic: inst.magic,
-                snapshot,
-            })) as fmi2FMUstate;
+            *s = new_state(inst, snapshot);
         } else {
             match state_ref::<M>(inst, "fmi2DeSerializeFMUstate", *s) {
                 Ok(b) => b.snapshot = snapshot,

@@ -98,6 +98,13 @@ pub struct Instance<M> {
     /// step) after anything that may change a loop (a parameter set through the table, a
     /// restored state, initialization, reset).
     pub work_limit: f64,
+    /// The FMU states this instance handed out (`fmi2GetFMUstate`, `fmi2DeSerializeFMUstate`)
+    /// and not yet freed, by address. Every state call looks its pointer up here before
+    /// touching it, so a freed, foreign or made-up pointer is an fmi2Error and never a read of
+    /// freed memory (a second `fmi2FreeFMUstate` of one state was a double free that aborted
+    /// the host: the fuzzer's `replay calls TokyoMaru 2044 28`). `fmi2FreeInstance` frees the
+    /// states left here (FMI 2.0, sec. 2.1.6: it "frees all the allocated memory").
+    pub states: Vec<usize>,
 }
 
 pub const CAT_EVENTS: usize = 0;
@@ -138,6 +145,17 @@ pub fn fnv1a(bytes: &[u8]) -> u64 {
     h
 }
 
+impl<M> Drop for Instance<M> {
+    /// Frees the FMU states the importer did not free.
+    fn drop(&mut self) {
+        for addr in self.states.drain(..) {
+            // SAFETY: every address in `states` came from `Box::into_raw` of a `StateBox<M>`
+            // and is removed from `states` when freed.
+            drop(unsafe { Box::from_raw(addr as *mut StateBox<M>) });
+        }
+    }
+}
+
 impl<M: FmuModel> Instance<M> {
     /// An instance of `model` (the start values, `M::default()`).
     pub fn new(
@@ -167,6 +185,7 @@ impl<M: FmuModel> Instance<M> {
             magic,
             fast: FastAccess::new(),
             work_limit: 0.0,
+            states: Vec::new(),
         }
     }
 

@@ -791,7 +791,7 @@ fn fmu_state_restores_bit_for_bit_and_serializes() {
         .0
         .log()
         .last()
-        .contains("was not created by Integrator"));
+        .contains("was not created by this instance of Integrator"));
     assert_eq!(
         unsafe { api::free_fmu_state::<Other>(other_model, &mut foreign) },
         fmi2OK
@@ -808,8 +808,51 @@ fn fmu_state_restores_bit_for_bit_and_serializes() {
     trajectory(&fmu, 30, 5);
     assert_eq!(fmu.set_state(s), fmi2OK);
     assert_eq!(fmu.get(VR_Y), y_now);
+    // a state of another instance of the same model is refused: states belong to the
+    // instance that made them (serialized bytes carry a state across instances)
+    assert_eq!(other.set_state(s), fmi2Error);
+    assert!(host
+        .0
+        .log()
+        .last()
+        .contains("was not created by this instance of Integrator or was already freed"));
     fmu.free_state(s);
     other.free_state(restored);
+    // a freed state is refused by every state call without being read: a second free was a
+    // double free that aborted the host (fuzzer: `replay calls TokyoMaru 2044 28`)
+    let mut freed = s;
+    assert_eq!(
+        unsafe { api::free_fmu_state::<Integrator>(fmu.0, &mut freed) },
+        fmi2Error
+    );
+    assert!(host.0.log().last().contains("or was already freed"));
+    assert_eq!(fmu.set_state(s), fmi2Error);
+    let mut size = 0usize;
+    assert_eq!(
+        unsafe { api::serialized_fmu_state_size::<Integrator>(fmu.0, s, &mut size) },
+        fmi2Error
+    );
+    let mut buf = [0 as c_char; 16];
+    assert_eq!(
+        unsafe { api::serialize_fmu_state::<Integrator>(fmu.0, s, buf.as_mut_ptr(), 16) },
+        fmi2Error
+    );
+    let mut reuse = s;
+    assert_eq!(
+        unsafe { api::get_fmu_state::<Integrator>(fmu.0, &mut reuse) },
+        fmi2Error
+    );
+    // a pointer that was never a state is refused too
+    let mut made_up = 0x1000 as fmi2FMUstate;
+    assert_eq!(
+        unsafe { api::free_fmu_state::<Integrator>(fmu.0, &mut made_up) },
+        fmi2Error
+    );
+    // states the importer leaves are freed with the instance (FMI 2.0, sec. 2.1.6)
+    let left = host.instantiate("left");
+    left.init();
+    let _kept = [left.get_state(), left.get_state()];
+    drop(left);
     // freeing NULL is fine
     let mut nothing: fmi2FMUstate = null_mut();
     assert_eq!(
