@@ -48,20 +48,20 @@ COUNT_TIME = 240.0
 
 
 def instructions(shipsim, system, stop_time):
-    """cachegrind's instruction count (I refs) of `shipsim run system` to `stop_time`, and its
-    macro steps; None without valgrind."""
+    """cachegrind's instruction count (I refs) of `shipsim run system` to `stop_time` (without
+    the profiler, whose clock reads would count too), and its macro steps (from a run with
+    `--profile=json`, not under valgrind); None without valgrind."""
     if shutil.which("valgrind") is None:
         return None
-    cmd = ["valgrind", "--tool=cachegrind", "--cache-sim=no", "--cachegrind-out-file=/dev/null",
-           shipsim, "run", str(system), "--no-output", "--profile=json", "-q",
-           "--stop-time", repr(stop_time)]
+    run = [shipsim, "run", str(system), "--no-output", "-q", "--stop-time", repr(stop_time)]
+    cmd = ["valgrind", "--tool=cachegrind", "--cache-sim=no", "--cachegrind-out-file=/dev/null"] + run
     r = subprocess.run(cmd, capture_output=True, text=True, cwd=ROOT)
     if r.returncode != 0:
         raise SystemExit(f"{' '.join(cmd)} failed:\n{r.stderr}")
     refs = re.search(r"I\s+refs:\s+([\d,]+)", r.stderr)
     if refs is None:
         raise SystemExit(f"{' '.join(cmd)}: no 'I refs' line in valgrind's output:\n{r.stderr}")
-    steps = json.loads(r.stdout.strip().splitlines()[-1])["macro_steps"]
+    steps = run_system(shipsim, [], system, stop_time=stop_time)["macro_steps"]
     return int(refs.group(1).replace(",", "")), steps
 
 

@@ -16,6 +16,11 @@ pub const MAX_SYSTEM_FILE: u64 = 64 << 20;
 /// variables is about 30 MB).
 pub const MAX_MODEL_DESCRIPTION: u64 = 256 << 20;
 
+/// The largest checkpoint file read: 1 GiB (the most one instance's serialized state may
+/// take, `MAX_STATE_BYTES` in `instance.rs`; the checkpoints of the repository's systems are a
+/// few kB).
+pub const MAX_CHECKPOINT: u64 = 1 << 30;
+
 /// Limits on unpacking one FMU archive. An archive beyond one is refused before more is
 /// written than the limit, with an error naming the entry, the limit and how to raise it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -86,14 +91,30 @@ pub fn read_limited_from(file: std::fs::File, max: u64) -> std::result::Result<S
     if file.metadata().is_ok_and(|m| m.is_dir()) {
         return Err(ReadError::Directory);
     }
+    let bytes = read_bytes_from(file, max)?;
+    String::from_utf8(bytes).map_err(|e| ReadError::NotUtf8(e.utf8_error().valid_up_to()))
+}
+
+/// The bytes of a file of at most `max` bytes (a binary file: a checkpoint), refused like
+/// [`read_limited`] when larger.
+pub fn read_bytes_limited(path: &Path, max: u64) -> std::result::Result<Vec<u8>, ReadError> {
+    let file = std::fs::File::open(path).map_err(ReadError::Io)?;
+    if file.metadata().is_ok_and(|m| m.is_dir()) {
+        return Err(ReadError::Directory);
+    }
+    read_bytes_from(file, max)
+}
+
+/// At most `max` bytes of `r`; more is [`ReadError::TooLarge`] after reading `max + 1`.
+pub fn read_bytes_from(r: impl Read, max: u64) -> std::result::Result<Vec<u8>, ReadError> {
     let mut bytes = Vec::new();
-    file.take(max.saturating_add(1))
+    r.take(max.saturating_add(1))
         .read_to_end(&mut bytes)
         .map_err(ReadError::Io)?;
     if bytes.len() as u64 > max {
         return Err(ReadError::TooLarge(max));
     }
-    String::from_utf8(bytes).map_err(|e| ReadError::NotUtf8(e.utf8_error().valid_up_to()))
+    Ok(bytes)
 }
 
 /// [`read_limited`] for the files of a system (system, scenario and campaign files): an error

@@ -47,3 +47,65 @@ fn directory_as_system_file() {
     assert_eq!(code, Some(1), "{err}");
     assert!(err.contains(".: cannot read the system file"), "{err}");
 }
+
+/// A checkpoint to resume from is read with a bound (1 GiB): `/dev/zero` as one is refused at
+/// once, naming the file. Before, it was read whole (`std::fs::read`) until the allocation
+/// failed under the 4 GB limit and the process aborted.
+#[test]
+fn endless_checkpoint_is_refused() {
+    let s = Sandbox::new();
+    testfmu_with(s.path(), "t.fmu", vec![]);
+    std::fs::write(
+        s.path().join("s.toml"),
+        system("t.fmu", "a", "1.0", "0.1", ""),
+    )
+    .unwrap();
+    std::os::unix::fs::symlink("/dev/zero", s.path().join("cp.bin")).unwrap();
+    let (code, err) = s.run(&["run", "s.toml", "--resume", "cp.bin", "-o", "out.csv"]);
+    assert_eq!(code, Some(1), "{err}");
+    assert!(
+        err.contains("checkpoint file cp.bin: cannot read it: it is larger than 1 GiB"),
+        "{err}"
+    );
+    assert!(s.leftovers().is_empty(), "{:?}", s.leftovers());
+}
+
+/// An OSP model description (variable groups) is read with the system-file bound, and the
+/// FMU's modelDescription.xml for its model name with the model-description bound.
+#[test]
+fn endless_osp_model_description_is_refused() {
+    let s = Sandbox::new();
+    testfmu_with(s.path(), "testfmu.fmu", vec![]);
+    // A sparse 5 GiB regular file (a link to /dev/zero is not a file, and is not looked for):
+    // read whole before, which failed under the 4 GB limit.
+    std::fs::File::create(s.path().join("testfmu_OspModelDescription.xml"))
+        .unwrap()
+        .set_len(5 << 30)
+        .unwrap();
+    let osp = r#"<?xml version="1.0" encoding="utf-8"?>
+<OspSystemStructure xmlns="http://opensimulationplatform.com/MSMI/OSPSystemStructure" version="0.1">
+    <StartTime>0.0</StartTime>
+    <EndTime>0.1</EndTime>
+    <BaseStepSize>0.01</BaseStepSize>
+    <Simulators>
+        <Simulator name="a" source="testfmu.fmu"/>
+        <Simulator name="b" source="testfmu.fmu"/>
+    </Simulators>
+    <Connections>
+        <VariableGroupConnection>
+            <VariableGroup simulator="a" name="g"/>
+            <VariableGroup simulator="b" name="g"/>
+        </VariableGroupConnection>
+    </Connections>
+</OspSystemStructure>
+"#;
+    std::fs::write(s.path().join("OspSystemStructure.xml"), osp).unwrap();
+    let (code, err) = s.run(&["check", "OspSystemStructure.xml"]);
+    assert_eq!(code, Some(1), "{err}");
+    assert!(
+        err.contains(
+            "testfmu_OspModelDescription.xml: cannot read the OSP model description: it is larger than 64 MiB"
+        ),
+        "{err}"
+    );
+}

@@ -47,9 +47,12 @@ pub struct Campaign {
 
 /// SHA-256 of a file's bytes, hex.
 pub fn file_hash(path: &Path) -> Result<String> {
-    let bytes =
-        std::fs::read(path).map_err(|e| Error::io(format!("cannot read {}", path.display()), e))?;
-    Ok(design::hex(&Sha256::digest(&bytes)))
+    let io = |e| Error::io(format!("cannot read {}", path.display()), e);
+    let mut file = std::fs::File::open(path).map_err(io)?;
+    // Streamed: an FMU of any size hashes in constant memory.
+    let mut hasher = Sha256::new();
+    std::io::copy(&mut file, &mut hasher).map_err(io)?;
+    Ok(design::hex(&hasher.finalize()))
 }
 
 impl Campaign {

@@ -58,8 +58,11 @@ impl Provenance {
 
     pub fn read(dir: &Path) -> Result<Provenance> {
         let path = dir.join("campaign.json");
-        let text = std::fs::read_to_string(&path)
-            .map_err(|e| Error::io(format!("cannot read {}", path.display()), e))?;
+        let text = crate::limits::read_text(
+            &path,
+            crate::limits::MAX_SYSTEM_FILE,
+            "campaign provenance file",
+        )?;
         serde_json::from_str(&text).map_err(|e| {
             Error::system(
                 &path,

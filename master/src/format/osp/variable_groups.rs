@@ -8,9 +8,9 @@
 //! position only.
 
 use crate::error::{Error, Result};
+use crate::limits;
 use crate::model_description::ModelDescription;
 use quick_xml::events::{BytesStart, Event};
-use std::io::Read;
 use std::path::{Path, PathBuf};
 
 /// One variable group: its variables (`<Variable ref>`) and nested groups, in file order.
@@ -54,11 +54,13 @@ fn model_name(fmu: &Path) -> Result<String> {
         std::fs::File::open(fmu).map_err(|e| Error::fmu(fmu, format!("cannot open: {e}")))?;
     let mut zip = zip::ZipArchive::new(file)
         .map_err(|e| Error::fmu(fmu, format!("not a valid FMU (zip) archive: {e}")))?;
-    let mut xml = String::new();
-    zip.by_name("modelDescription.xml")
-        .map_err(|e| Error::fmu(fmu, format!("no modelDescription.xml: {e}")))?
-        .read_to_string(&mut xml)
+    let entry = zip
+        .by_name("modelDescription.xml")
+        .map_err(|e| Error::fmu(fmu, format!("no modelDescription.xml: {e}")))?;
+    let bytes = limits::read_bytes_from(entry, limits::MAX_MODEL_DESCRIPTION)
         .map_err(|e| Error::fmu(fmu, format!("cannot read modelDescription.xml: {e}")))?;
+    let xml = String::from_utf8(bytes)
+        .map_err(|e| Error::fmu(fmu, format!("modelDescription.xml is not UTF-8: {e}")))?;
     let md = ModelDescription::parse(&xml)
         .map_err(|e| Error::fmu(fmu, format!("modelDescription.xml does not parse: {e}")))?;
     Ok(md.model_name)
@@ -75,8 +77,7 @@ pub(crate) fn load(fmu: &Path, config_dir: &Path) -> Result<Option<Groups>> {
     let Some(file) = file else {
         return Ok(None);
     };
-    let text = std::fs::read_to_string(&file)
-        .map_err(|e| Error::system(&file, None, format!("cannot read: {e}")))?;
+    let text = limits::read_text(&file, limits::MAX_SYSTEM_FILE, "OSP model description")?;
     let top = parse(&text).map_err(|m| Error::system(&file, None, m))?;
     Ok(Some(Groups { file, top }))
 }

@@ -165,8 +165,11 @@ impl Checkpoint {
     /// Reads a checkpoint written by [`Checkpoint::write`]; a file that is not one, of another
     /// version, truncated or corrupt is an error naming the file.
     pub fn read(path: &Path) -> Result<Checkpoint> {
-        let bytes = std::fs::read(path)
-            .map_err(|e| Error::io(format!("reading checkpoint file {}", path.display()), e))?;
+        let bytes = crate::limits::read_bytes_limited(path, crate::limits::MAX_CHECKPOINT)
+            .map_err(|e| Error::Checkpoint {
+                file: path.to_path_buf(),
+                message: format!("cannot read it: {e}"),
+            })?;
         Checkpoint::decode(&bytes, path)
     }
 
