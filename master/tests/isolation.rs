@@ -181,6 +181,35 @@ fn isolated_crashes_are_errors_and_keep_every_completed_step() {
     }
 }
 
+/// `isolate = true` on an instance in the system file isolates it without the option: its
+/// segfault is the same error, with every completed step kept (in process it would end shipsim
+/// with SIGSEGV and an empty CSV). The other instance runs in process.
+#[test]
+fn isolate_true_in_the_system_file_isolates_that_instance() {
+    let d = tempfile::tempdir().unwrap();
+    evil_fmu(d.path(), "evil", &["EVIL_SEGV"]);
+    let sys = system(d.path());
+    let text = std::fs::read_to_string(&sys).unwrap();
+    let flagged = text.replace("name = \"evil\"\n", "name = \"evil\"\nisolate = true\n");
+    assert_ne!(flagged, text);
+    std::fs::write(&sys, flagged).unwrap();
+    let err = failing(d.path(), &["run", "sys.toml", "-q"]);
+    assert_names_call(&err, "was killed by signal 11 (SIGSEGV");
+    assert_three_steps_kept(d.path());
+    assert_no_temp_dirs(d.path());
+    // The flag is a boolean; anything else is refused at its line (11).
+    std::fs::write(
+        &sys,
+        text.replace("name = \"evil\"\n", "name = \"evil\"\nisolate = 1\n"),
+    )
+    .unwrap();
+    let err = failing(d.path(), &["check", "sys.toml"]);
+    assert!(
+        err.contains("sys.toml:11: invalid type: integer `1`, expected a boolean"),
+        "{err}"
+    );
+}
+
 #[test]
 fn isolated_hang_is_killed_after_the_call_timeout() {
     let (d, err) = isolated_failure(&["EVIL_HANG"], &["--call-timeout", "0.5"]);

@@ -326,6 +326,8 @@ impl Reader<'_> {
             step_multiple: m,
             values,
             line,
+            // OSP has no such attribute: `--isolate=NAMES` isolates instances of an OSP system.
+            isolate: false,
         }
     }
 
@@ -451,6 +453,20 @@ fn lost_in_export(sys: &System, scenario_path: &Path) -> Vec<String> {
     }
     if sys.output.file.is_some() || sys.output.variables.is_some() {
         warnings.push("output settings are not part of OspSystemStructure.xml".to_string());
+    }
+    let isolated: Vec<&str> = sys
+        .instances
+        .iter()
+        .filter(|i| i.isolate)
+        .map(|i| i.name.as_str())
+        .collect();
+    if !isolated.is_empty() {
+        warnings.push(format!(
+            "`isolate = true` ({}) is not part of OspSystemStructure.xml: run it with \
+             --isolate={}",
+            isolated.join(", "),
+            isolated.join(",")
+        ));
     }
     warnings
 }

@@ -16,6 +16,7 @@
 //! name = "gear"
 //! fmu = "SteeringGear.fmu"  # relative to this file
 //! step_multiple = 1         # this instance steps every n base steps
+//! isolate = false           # true: always run out of process (docs/isolation.md)
 //! parameters = { time_constant = 2.0, rate_max = "10 deg/s" }
 //!
 //! [[connections]]            # or a list, see below
@@ -119,6 +120,8 @@ struct RawInstance {
     fmu: String,
     #[serde(default)]
     step_multiple: Option<i64>,
+    #[serde(default)]
+    isolate: bool,
     #[serde(default)]
     parameters: BTreeMap<String, Spanned<toml::Value>>,
 }
@@ -308,6 +311,7 @@ impl Reader<'_> {
             step_multiple,
             values,
             line,
+            isolate: inst.isolate,
         }
     }
 

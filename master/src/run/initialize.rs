@@ -37,7 +37,7 @@ pub fn initialize<A: Algorithm>(
         .unwrap_or_else(|| stderr_sink(opts.verbose));
     let mut instantiated = Vec::with_capacity(plan.instances.len());
     for ((pi, fmu), ports) in plan.instances.iter().zip(fmus).zip(ports) {
-        let isolated = opts.isolation.applies(&pi.name, &fmu.model_description);
+        let isolated = pi.isolate || opts.isolation.applies(&pi.name, &fmu.model_description);
         let backend = Backend {
             isolate: isolated.then_some(&opts.isolation),
             interrupt: opts.interrupt.clone(),

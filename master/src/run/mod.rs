@@ -196,12 +196,17 @@ pub fn load_fmus_with(
     let key_of = |inst: &crate::system::InstanceSpec| {
         inst.fmu.canonicalize().unwrap_or_else(|_| inst.fmu.clone())
     };
-    // The files with an instance that is not isolated by name.
+    // The files with an instance that is not isolated by name (`--isolate=NAMES`) or by the
+    // system file (`isolate = true`).
+    let by_name: &[String] = match &isolation.mode {
+        IsolateMode::Instances(names) => names,
+        _ => &[],
+    };
     let named_in_process: Vec<PathBuf> = match &isolation.mode {
-        IsolateMode::Instances(names) => system
+        IsolateMode::None | IsolateMode::Instances(_) => system
             .instances
             .iter()
-            .filter(|i| !names.contains(&i.name))
+            .filter(|i| !i.isolate && !by_name.contains(&i.name))
             .map(key_of)
             .collect(),
         _ => Vec::new(),
@@ -224,8 +229,9 @@ pub fn load_fmus_with(
             None => {
                 system.require_fmu(inst)?;
                 let unloaded = match &isolation.mode {
-                    IsolateMode::None => false,
-                    IsolateMode::Instances(_) => !named_in_process.contains(&key),
+                    IsolateMode::None | IsolateMode::Instances(_) => {
+                        !named_in_process.contains(&key)
+                    }
                     _ => true,
                 };
                 let opened = match unloaded {

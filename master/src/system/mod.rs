@@ -78,6 +78,9 @@ pub struct InstanceSpec {
     pub step_multiple: u32,
     pub values: Vec<ValueSpec>,
     pub line: Option<usize>,
+    /// Run this instance out of process whatever the run's isolation option (TOML
+    /// `isolate = true`; [`crate::isolate`]): an FMU known to crash or hang.
+    pub isolate: bool,
 }
 
 /// `instance.variable`.

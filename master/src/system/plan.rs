@@ -21,6 +21,8 @@ pub struct PlanInstance {
     pub name: String,
     pub step_multiple: u32,
     pub start_values: Vec<StartValue>,
+    /// Out of process whatever the run's option ([`InstanceSpec::isolate`](super::InstanceSpec::isolate)).
+    pub isolate: bool,
 }
 
 /// A checked connection, by instance index and value reference.

@@ -367,6 +367,8 @@ impl Reader<'_> {
             step_multiple: 1,
             values: Vec::new(),
             line: Some(el.line),
+            // SSP has no such attribute: `--isolate=NAMES` isolates instances of an SSP system.
+            isolate: false,
         });
         self.step_hints.push(step_size_hint(el));
         for c in connectors(el) {

@@ -188,6 +188,20 @@ fn left_out(sys: &System, plan: &Plan) -> Vec<String> {
                 .to_string(),
         );
     }
+    let isolated: Vec<&str> = sys
+        .instances
+        .iter()
+        .filter(|i| i.isolate)
+        .map(|i| i.name.as_str())
+        .collect();
+    if !isolated.is_empty() {
+        warnings.push(format!(
+            "`isolate = true` ({}) is not part of SSP 1.0 and is left out: run the archive with \
+             --isolate={}",
+            isolated.join(", "),
+            isolated.join(",")
+        ));
+    }
     let mapped: Vec<&str> = plan
         .connections
         .iter()

@@ -362,6 +362,7 @@ impl<'a> Checker<'a> {
                 name: inst.name.clone(),
                 step_multiple: inst.step_multiple,
                 start_values: self.start_values(i, inst),
+                isolate: inst.isolate,
             })
             .collect()
     }
