@@ -11,6 +11,7 @@ use fmi2::*;
 use std::cell::{Cell, RefCell};
 use std::ffi::{c_char, c_void, CStr, CString};
 use std::panic::{catch_unwind, AssertUnwindSafe, PanicHookInfo};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Once;
 
 /// Layout version of serialized FMU states (bumped when [`Snapshot`] changes shape).
@@ -42,17 +43,54 @@ thread_local! {
     static PANIC_LOCATION: RefCell<Option<String>> = const { RefCell::new(None) };
 }
 
-/// Installs, once per FMU library, a panic hook that stays silent for a panic inside an FMI
-/// call of this library (the call catches it and reports it through the instance's logger as an
-/// fmi2Error message) and defers to the hook it replaced for every other panic. An importer's
-/// stderr is not the FMU's to write to (FMI 2.0, sec. 2.1.5: messages go through the logger).
-/// A cdylib FMU has its own copy of the standard library, so the hook is this FMU's alone.
+/// This code was loaded as a shared library of its own (an FMU binary, a `cdylib` with its own
+/// copy of the standard library), not linked into the program (a test of the export layer or
+/// of an FMU crate). Set once by [`install_panic_hook`].
+static SHARED_LIBRARY: AtomicBool = AtomicBool::new(false);
+
+/// Whether this function lies in another object than the program's entry point
+/// (`getauxval(AT_ENTRY)`, both located with `dladdr`).
+#[cfg(target_os = "linux")]
+fn loaded_as_shared_library() -> bool {
+    // SAFETY: `dladdr` fills the given struct for any address; `getauxval` reads the process's
+    // auxiliary vector.
+    unsafe {
+        let entry = libc::getauxval(libc::AT_ENTRY) as *const c_void;
+        let mut ours: libc::Dl_info = std::mem::zeroed();
+        let mut program: libc::Dl_info = std::mem::zeroed();
+        if entry.is_null()
+            || libc::dladdr(loaded_as_shared_library as *const c_void, &mut ours) == 0
+            || libc::dladdr(entry, &mut program) == 0
+        {
+            return false;
+        }
+        ours.dli_fbase != program.dli_fbase
+    }
+}
+
+#[cfg(not(target_os = "linux"))]
+fn loaded_as_shared_library() -> bool {
+    false
+}
+
+/// Installs, once per FMU library, a panic hook that stays silent for a panic of the FMU (the
+/// FMI call catches it and reports it through the instance's logger as an fmi2Error message)
+/// and defers to the hook it replaced for every other panic. An importer's stderr is not the
+/// FMU's to write to (FMI 2.0, sec. 2.1.5: messages go through the logger).
+///
+/// In an FMU binary, every panic this hook sees is the FMU's: the library has its own copy of
+/// the standard library (so the hook is its alone), and all its code runs inside FMI calls,
+/// each under `catch_unwind`. There the hook is silent for every panic, in every call, the
+/// getters and setters included, without a per-call flag. Linked into a program (tests), the
+/// hook also sees the program's panics, and an FMI call marks its thread ([`guarded`]).
 fn install_panic_hook() {
     static INSTALLED: Once = Once::new();
     INSTALLED.call_once(|| {
+        let shared = loaded_as_shared_library();
+        SHARED_LIBRARY.store(shared, Ordering::Relaxed);
         let previous = std::panic::take_hook();
         std::panic::set_hook(Box::new(move |info: &PanicHookInfo| {
-            if IN_FMI_CALL.with(Cell::get) {
+            if shared || IN_FMI_CALL.with(Cell::get) {
                 let at = info.location().map(|l| l.to_string());
                 PANIC_LOCATION.with(|l| *l.borrow_mut() = at);
             } else {
@@ -62,13 +100,17 @@ fn install_panic_hook() {
     });
 }
 
-/// `catch_unwind` of `f` with the thread marked as inside an FMI call of this library, so that
-/// the panic hook of [`install_panic_hook`] keeps a panic off the importer's stderr.
+/// `catch_unwind` of `f`, with the thread marked as inside an FMI call of this library when the
+/// library is linked into a program (see [`install_panic_hook`]; in an FMU binary no mark is
+/// needed, and none is made: a thread-local access there is a `__tls_get_addr` call).
 #[inline(always)]
 fn guarded<R>(f: impl FnOnce() -> R) -> std::thread::Result<R> {
-    let outer = IN_FMI_CALL.with(|flag| flag.replace(true));
+    let mark = !SHARED_LIBRARY.load(Ordering::Relaxed);
+    let outer = mark && IN_FMI_CALL.with(|flag| flag.replace(true));
     let result = catch_unwind(AssertUnwindSafe(f));
-    IN_FMI_CALL.with(|flag| flag.set(outer));
+    if mark {
+        IN_FMI_CALL.with(|flag| flag.set(outer));
+    }
     result
 }
 
@@ -85,16 +127,17 @@ unsafe fn with_instance<M: FmuModel>(
     legal: u32,
     f: impl FnOnce(&mut Instance<M>) -> fmi2Status,
 ) -> fmi2Status {
-    with_instance_flagged::<M, true>(c, function, legal, f)
+    with_instance_marked::<M, true>(c, function, legal, f)
 }
 
-/// [`with_instance`] with the panic hook's thread-local flag set (`FLAG`) or not. The getters
-/// and setters (`fmi2Get*`, `fmi2Set*`, a master's most frequent calls) run without it: in a
-/// shared library each thread-local access is a `__tls_get_addr` call, and the two per call
-/// cost about 1 % of the RRS system (callgrind). A panic there is still caught and logged, and
-/// also goes to the host's panic hook.
+/// [`with_instance`] with the thread marked for the panic hook (`MARK`, see [`guarded`]) or
+/// not. The getters and setters (`fmi2Get*`, `fmi2Set*`, a master's most frequent calls) run
+/// unmarked, a plain `catch_unwind`: in an FMU binary the hook is silent for every panic
+/// anyway, and running them through [`guarded`] cost 2.9 % more instructions on the RRS system
+/// (cachegrind). A panic in them is caught and logged in every build; linked into a test
+/// program it also reaches the program's hook.
 #[inline(always)]
-unsafe fn with_instance_flagged<M: FmuModel, const FLAG: bool>(
+unsafe fn with_instance_marked<M: FmuModel, const MARK: bool>(
     c: fmi2Component,
     function: &str,
     legal: u32,
@@ -108,7 +151,7 @@ unsafe fn with_instance_flagged<M: FmuModel, const FLAG: bool>(
     if let Err(status) = (*inst).check_state(function, legal) {
         return status;
     }
-    let result = if FLAG {
+    let result = if MARK {
         guarded(|| f(&mut *inst))
     } else {
         catch_unwind(AssertUnwindSafe(|| f(&mut *inst)))
@@ -543,7 +586,7 @@ unsafe fn get_values<M: FmuModel, T: Handed>(
     fast: impl Fn(&Instance<M>, fmi2ValueReference) -> Option<T>,
     read: impl Fn(&Variable<M>, &M) -> T,
 ) -> fmi2Status {
-    with_instance_flagged::<M, false>(c, function, mask::GET, |inst| {
+    with_instance_marked::<M, false>(c, function, mask::GET, |inst| {
         if n == 0 {
             return fmi2OK;
         }
@@ -720,7 +763,7 @@ unsafe fn set_values<M: FmuModel, T: Copy>(
     fast: impl Fn(&mut Instance<M>, fmi2ValueReference, T) -> bool,
     apply: impl Fn(&Variable<M>, &mut M, T) -> Result<Option<T>, String>,
 ) -> fmi2Status {
-    with_instance_flagged::<M, false>(c, function, legal, |inst| {
+    with_instance_marked::<M, false>(c, function, legal, |inst| {
         if n == 0 {
             return fmi2OK;
         }

@@ -33,8 +33,10 @@
 //!   setters validate values: finite times, parameters and inputs in their declared ranges,
 //!   internal loops of positive length, at least their parameter's minimum, not lagging;
 //! * a panic inside an FMI call goes to the instance's logger with its location, not to the
-//!   host's stderr (a panic hook installed once per FMU library, silent inside the library's
-//!   FMI calls but for the getters and setters, deferring to the previous hook otherwise);
+//!   host's stderr (a panic hook installed once per FMU library: in an FMU binary, which has
+//!   its own standard library, silent for every panic, all of them the FMU's; linked into a
+//!   test program, silent inside the library's FMI calls but for the getters and setters, and
+//!   deferring to the program's hook otherwise; `fmus/panic_probe` tests the binary case);
 //! * `fmi2SetReal` and `fmi2GetReal` take the Real accessors from a per-instance table indexed
 //!   by value reference (`fast.rs`): a Real input within its range is written after one bounds
 //!   test and two comparisons; every other value goes through the variable table, which gives
