@@ -288,3 +288,56 @@ fn variable_groups_need_the_osp_model_description() {
     let p = write_system(&sub, "OspSystemStructure.xml", &text);
     assert_eq!(load_plan(&p).unwrap().0.connections.len(), 2);
 }
+
+/// Export names each connected variable by value reference *and type*: the test FMU's Boolean
+/// `enabled_out` (1) and input `enabled` (0) share their value references with the Real `y`
+/// and `u`, and its Integer `n_out` (3) with the Real `t_last`. Before, the lookup ignored the
+/// type and wrote `a.y -> b.u` for `a.enabled_out -> b.enabled`.
+#[test]
+fn export_names_connected_variables_by_value_reference_and_type() {
+    let d = tempfile::tempdir().unwrap();
+    test_fmu(d.path());
+    let p = write_system(
+        d.path(),
+        "sys.toml",
+        r#"
+connections = ["a.enabled_out -> b.enabled", "a.n_out -> b.n_in", "a.y -> b.u"]
+[simulation]
+stop_time = 0.1
+step_size = 0.01
+[[instances]]
+name = "a"
+fmu = "testfmu.fmu"
+[[instances]]
+name = "b"
+fmu = "testfmu.fmu"
+"#,
+    );
+    let sys = System::load(&p).unwrap();
+    let out = d.path().join("OspSystemStructure.xml");
+    shipsim::format::osp::write(&sys, &out).unwrap();
+    let xml = std::fs::read_to_string(&out).unwrap();
+    for (from, to) in [("enabled_out", "enabled"), ("n_out", "n_in"), ("y", "u")] {
+        let connection = format!(
+            "<Variable simulator=\"a\" name=\"{from}\" causality=\"output\"/>\n            \
+             <Variable simulator=\"b\" name=\"{to}\" causality=\"input\"/>"
+        );
+        assert!(xml.contains(&connection), "{connection} not in\n{xml}");
+    }
+    // The file reads back into the same three connections.
+    let back = System::load(&out).unwrap();
+    let mut names: Vec<String> = back
+        .connections
+        .iter()
+        .map(|c| format!("{} -> {}", c.from, c.to))
+        .collect();
+    names.sort();
+    assert_eq!(
+        names,
+        [
+            "a.enabled_out -> b.enabled",
+            "a.n_out -> b.n_in",
+            "a.y -> b.u"
+        ]
+    );
+}

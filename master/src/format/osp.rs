@@ -9,7 +9,7 @@
 
 use super::{collected, line_of};
 use crate::error::{Error, Result};
-use crate::model_description::{Causality, ModelDescription, VarType};
+use crate::model_description::{Causality, ModelDescription, ScalarVariable, VarType};
 use crate::system::{
     Algorithm, InstanceSpec, OutputSpec, Plan, PlanConnection, System, TypedValue, Value, ValueSpec,
 };
@@ -526,18 +526,30 @@ fn is_enumeration(md: &ModelDescription, variable: &str) -> bool {
 }
 
 /// The variable with this value reference (an input, or not) is an Enumeration.
-fn is_enumeration_vr(md: &ModelDescription, vr: u32, input: bool) -> bool {
-    md.model_variables.variables.iter().any(|v| {
+fn is_enumeration_vr(md: &ModelDescription, vr: u32, t: VarType, input: bool) -> bool {
+    connected_variable(md, vr, t, input).is_some_and(|v| v.var_type() == Some(VarType::Enumeration))
+}
+
+/// The variable a connection end of type `t` names by value reference `vr`: an input (`input`)
+/// or not. Value references are unique only within one family of get/set functions (FMI 2.0,
+/// sec. 2.2.7: Real, Integer and Enumeration, Boolean, String), so the type is part of the key.
+fn connected_variable(
+    md: &ModelDescription,
+    vr: u32,
+    t: VarType,
+    input: bool,
+) -> Option<&ScalarVariable> {
+    md.model_variables.variables.iter().find(|v| {
         v.value_reference == vr
             && (v.causality == Causality::Input) == input
-            && v.var_type() == Some(VarType::Enumeration)
+            && v.var_type().is_some_and(|vt| vt.connectable_with(t))
     })
 }
 
 /// A connection with an Enumeration at either end.
 fn touches_enumeration(c: &PlanConnection, mds: &[&ModelDescription]) -> bool {
-    is_enumeration_vr(mds[c.from_instance], c.from_vr, false)
-        || is_enumeration_vr(mds[c.to_instance], c.to_vr, true)
+    is_enumeration_vr(mds[c.from_instance], c.from_vr, c.var_type, false)
+        || is_enumeration_vr(mds[c.to_instance], c.to_vr, c.var_type, true)
 }
 
 /// libcosim ignores FMI 2.0 Enumeration variables: its FMU import leaves them out of the model
@@ -675,21 +687,17 @@ fn write_connections(
         return;
     }
     x.push_str("    <Connections>\n");
-    let var_name = |inst: usize, vr: u32, input: bool| -> String {
-        mds[inst]
-            .model_variables
-            .variables
-            .iter()
-            .find(|v| v.value_reference == vr && (v.causality == Causality::Input) == input)
+    let var_name = |inst: usize, vr: u32, t: VarType, input: bool| -> String {
+        connected_variable(mds[inst], vr, t, input)
             .map(|v| v.name.clone())
             .unwrap_or_default()
     };
     let from = |c: &PlanConnection| {
-        let name = esc(&var_name(c.from_instance, c.from_vr, false));
+        let name = esc(&var_name(c.from_instance, c.from_vr, c.var_type, false));
         (esc(&sys.instances[c.from_instance].name), name)
     };
     let to = |c: &PlanConnection| {
-        let name = esc(&var_name(c.to_instance, c.to_vr, true));
+        let name = esc(&var_name(c.to_instance, c.to_vr, c.var_type, true));
         (esc(&sys.instances[c.to_instance].name), name)
     };
     for (k, c) in connections.iter().enumerate() {
