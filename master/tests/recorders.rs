@@ -141,3 +141,35 @@ fmu = "testfmu.fmu"
     assert!(msg.contains("cannot keep 1000000000000001 rows"), "{msg}");
     assert!(msg.contains("rows of 8 columns in memory"), "{msg}");
 }
+
+/// A variable named and also matched by `inst.*`, or named twice, is one column, at its first
+/// place. Before, it was recorded once per match (the header had `a.y` twice).
+#[test]
+fn a_variable_matched_twice_is_recorded_once() {
+    let d = tempfile::tempdir().unwrap();
+    test_fmu(d.path());
+    let text = SYSTEM.replace("ALGO", "jacobi").replace(
+        r#"variables = ["a.y", "a.enabled_out", "b.y", "b.n_out", "b.enabled_out"]"#,
+        r#"variables = ["a.y", "b.y", "a.*", "b.y", "a.y"]"#,
+    );
+    let p = write_system(d.path(), "r.toml", &text);
+    let (plan, fmus) = prepare(&System::load(&p).unwrap()).unwrap();
+    let mut mem = MemoryRecorder::new();
+    run_with(&plan, &fmus, Some(&mut mem), &RunOptions::default()).unwrap();
+    let names: Vec<&str> = mem.columns.iter().map(|c| c.name.as_str()).collect();
+    // a.* is y, t_last, grid_error, y2, steps, n_out, enabled_out (the test FMU's outputs, in
+    // its model description's order); a.y and b.y keep their first places.
+    assert_eq!(
+        names,
+        [
+            "a.y",
+            "b.y",
+            "a.t_last",
+            "a.grid_error",
+            "a.y2",
+            "a.steps",
+            "a.n_out",
+            "a.enabled_out"
+        ]
+    );
+}

@@ -6,9 +6,11 @@ use super::Checker;
 use crate::error::did_you_mean;
 use crate::model_description::{Causality, VarType};
 use crate::system::{PlanOutput, VarRef};
+use std::collections::HashSet;
 
 impl Checker<'_> {
-    /// The recorded columns, in the order the system lists them.
+    /// The recorded columns, in the order the system lists them, each variable once: a variable
+    /// both named and matched by `inst.*` (or named twice) keeps its first column.
     pub(super) fn outputs(&mut self) -> Vec<PlanOutput> {
         let mut outputs = Vec::new();
         let sys = self.sys;
@@ -24,6 +26,8 @@ impl Checker<'_> {
                 }
             }
         }
+        let mut seen = HashSet::with_capacity(outputs.len());
+        outputs.retain(|o| seen.insert((o.instance, o.vr, o.var_type)));
         outputs
     }
 
