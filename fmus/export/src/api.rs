@@ -1438,7 +1438,10 @@ pub unsafe fn do_step<M: FmuModel>(
 
 /// The work bound of one `fmi2DoStep`: each of the model's internal loops
 /// ([`FmuModel::internal_steps`]) takes at most [`MAX_INTERNAL_STEPS`] passes over
-/// `[t, t + h]`, and its length is a positive number. Refused before the model is touched: the
+/// `[t, t + h]`, and its length is a positive number that the time can still resolve at
+/// `t + h` (one internal step must advance the time: at t = 1e300 a 0.1 s step is lost in
+/// rounding, and a loop that advances by it never ends, as the fuzzer found in Sensors with
+/// `fmi2DoStep(t = 1e300, h = 0.05)`). Refused before the model is touched: the
 /// instance stays in StepComplete (as for a refused step size), so a master may retry with a
 /// smaller step.
 ///
@@ -1463,9 +1466,10 @@ fn check_work<M: FmuModel>(inst: &mut Instance<M>, t: f64, h: f64) -> Result<(),
 #[inline(always)]
 fn work<M: FmuModel>(m: &M, t: f64, h: f64) -> Result<(), String> {
     let mut within = true;
+    let end = t + h;
     m.internal_steps(t, h, &mut |_, length, passes| {
         // NaN passes fail the comparison, like a length that is not a positive number.
-        within &= length > 0.0 && passes <= MAX_INTERNAL_STEPS;
+        within &= length > 0.0 && passes <= MAX_INTERNAL_STEPS && end + length > end;
     });
     if within {
         Ok(())
@@ -1479,9 +1483,13 @@ fn work<M: FmuModel>(m: &M, t: f64, h: f64) -> Result<(), String> {
 fn work_message<M: FmuModel>(m: &M, t: f64, h: f64) -> String {
     let mut worst = None::<(&str, f64, f64)>;
     let mut not_positive = None;
+    let mut unresolved = None;
+    let end = t + h;
     m.internal_steps(t, h, &mut |name, length, passes| {
         if !positive(length) {
             not_positive.get_or_insert((name, length));
+        } else if !(end + length > end) {
+            unresolved.get_or_insert((name, length));
         }
         let passes = if passes.is_nan() {
             f64::INFINITY
@@ -1494,6 +1502,13 @@ fn work_message<M: FmuModel>(m: &M, t: f64, h: f64) -> String {
     });
     if let Some((name, length)) = not_positive {
         return format!("internal step {name} = {length:?} s is not a positive number");
+    }
+    if let Some((name, length)) = unresolved {
+        return format!(
+            "internal step {name} = {length:?} s is lost in rounding at t + h = {end:e} s \
+             (the doubles there are {:e} s apart): the time is too large for this step",
+            end.next_up() - end
+        );
     }
     let (name, length, passes) = worst.unwrap_or(("?", f64::NAN, f64::NAN));
     if h == 0.0 {
@@ -1515,10 +1530,27 @@ fn too_much_work<M: FmuModel>(inst: &Instance<M>, t: f64, h: f64, msg: &str) -> 
     fail(
         inst,
         format_args!(
-            "fmi2DoStep at t = {t}, h = {h}: instance {:?}: {msg}",
+            "fmi2DoStep at t = {}, h = {}: instance {:?}: {msg}",
+            Num(t),
+            Num(h),
             inst.name.to_string_lossy()
         ),
     )
+}
+
+/// A number for a message: plain (`0.3`, `1000000000`) unless very large or small, then in
+/// exponent form (`1e300`, not 301 digits).
+struct Num(f64);
+
+impl std::fmt::Display for Num {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let a = self.0.abs();
+        if a != 0.0 && !(1e-5..1e16).contains(&a) {
+            write!(f, "{:e}", self.0)
+        } else {
+            write!(f, "{}", self.0)
+        }
+    }
 }
 
 /// An output that is not a finite number after `function` (`at`: the time, and the step):

@@ -36,3 +36,28 @@ fn a_corrupt_state_is_refused_or_bounded() {
         Corrupt::Refused("is not a finite number in [1e-6, inf]"),
     );
 }
+
+/// Fuzz run (seed 2027): at t = 1e300 a 0.1 s sample interval is lost in rounding
+/// (t0 + k*interval no longer grows with k), and `fmi2DoStep(t = 1e300, h = 0.05)` spun in the
+/// sampling loop. The work bound now refuses an internal step that cannot advance the time.
+/// Replay: `fuzz replay calls Sensors 2086 24`.
+#[test]
+fn a_step_at_a_time_too_large_for_the_sample_interval_is_refused() {
+    use fmi2_export::fmi2::{fmi2Error, fmi2OK};
+    use fmi2_export::testing::{functions, Harness};
+    let mut fmu = Harness::<sensors_fmu::SensorsFmu>::instantiate(
+        functions::<sensors_fmu::SensorsFmu>(),
+        "late",
+    );
+    assert_eq!(fmu.setup(1e300, None), fmi2OK);
+    assert_eq!(fmu.enter_initialization(), fmi2OK);
+    assert_eq!(fmu.exit_initialization(), fmi2OK);
+    assert_eq!(fmu.try_step(1e300, 0.05), fmi2Error);
+    let line = fmu.log().last();
+    assert!(
+        line.contains("fmi2DoStep at t = 1e300")
+            && line.contains("s is lost in rounding at t + h = 1e300 s")
+            && line.contains("the time is too large for this step"),
+        "{line}"
+    );
+}
