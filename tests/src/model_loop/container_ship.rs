@@ -12,13 +12,13 @@
 //! A summed input is Σ (gain·x + offset) over its connections ([`link`] each); with two terms the
 //! order of the addition does not change a bit (IEEE 754 addition is commutative).
 
+pub use super::disturbances::Moments;
+use super::disturbances::{WavesInstance, WindInstance};
 use super::{link, n_steps, LoopSummary};
 use models::controllers::loop_shaped::presets::HeadingPreset;
 use models::controllers::loop_shaped::{HeadingAutopilot, HeadingDesign, HeadingReference};
-use models::disturbances::waves::{
-    encounter_angle, wf_sigma_for_std, SeaState, SpectrumKind, WaveParams, Waves,
-};
-use models::disturbances::wind::{Wind, WindParams};
+use models::disturbances::waves::{SeaState, SpectrumKind, WaveParams};
+use models::disturbances::wind::WindParams;
 use models::hull::container_ship::{
     ContainerShip, ContainerShipInputs, ContainerShipOutputs, ContainerShipParams,
 };
@@ -76,13 +76,6 @@ impl Default for SeawayParams {
             wind_coefficients: (1.7e4, 3.75e4),
         }
     }
-}
-
-/// A disturbance's published outputs: the moments.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct Moments {
-    pub roll_moment: f64,
-    pub yaw_moment: f64,
 }
 
 /// The values published at a communication point: every output a connection reads or
@@ -181,116 +174,34 @@ impl Ship {
     }
 }
 
-/// `waves` (`fmus/waves`): the file's sea, the FMU's other defaults (σ_i of its default WF
-/// standard deviations), encounter angle from the ship's heading.
-struct WavesInstance {
-    params: WaveParams,
-    wave_direction: f64,
-    speed: f64,
-    heading: f64,
-    waves: Waves,
+/// `waves`: the file's Bretschneider sea, gains and seed, the FMU's other defaults.
+fn waves_instance(p: &SeawayParams) -> Result<WavesInstance, String> {
+    let params = WaveParams {
+        sea: SeaState {
+            spectrum: SpectrumKind::Bretschneider,
+            hs: p.significant_wave_height,
+            period: p.wave_period,
+            ..WaveParams::default().sea
+        },
+        roll_gain: p.wave_gains.0,
+        yaw_gain: p.wave_gains.1,
+        seed: p.waves_seed,
+        ..WaveParams::default()
+    };
+    WavesInstance::new(params, p.wave_direction, 0.0, START_TIME)
 }
 
-impl WavesInstance {
-    fn new(p: &SeawayParams) -> Result<WavesInstance, String> {
-        let mut params = WaveParams {
-            sea: SeaState {
-                spectrum: SpectrumKind::Bretschneider,
-                hs: p.significant_wave_height,
-                period: p.wave_period,
-                ..WaveParams::default().sea
-            },
-            roll_gain: p.wave_gains.0,
-            yaw_gain: p.wave_gains.1,
-            seed: p.waves_seed,
-            ..WaveParams::default()
-        };
-        let wf_std = [5.0, 5.0, 0.5f64.to_radians()];
-        for (sigma, std) in params.wf_sigma.iter_mut().zip(wf_std) {
-            *sigma = wf_sigma_for_std(std, params.wf_zeta, params.wf_omega0);
-        }
-        Ok(WavesInstance {
-            waves: Waves::new(params.clone(), START_TIME)?,
-            params,
-            wave_direction: p.wave_direction,
-            speed: 0.0,
-            heading: 0.0,
-        })
-    }
-
-    fn apply_inputs(&mut self) {
-        let gamma = encounter_angle(self.wave_direction, self.heading);
-        self.waves.set_inputs(self.speed, gamma);
-    }
-
-    fn initialize(&mut self) -> Result<(), String> {
-        self.waves = Waves::new(self.params.clone(), START_TIME)?;
-        self.apply_inputs();
-        Ok(())
-    }
-
-    fn do_step(&mut self, t: f64, h: f64) {
-        self.apply_inputs();
-        self.waves.advance_to(t + h);
-    }
-
-    fn outputs(&self) -> Moments {
-        Moments {
-            roll_moment: self.waves.roll_moment(),
-            yaw_moment: self.waves.yaw_moment(),
-        }
-    }
-}
-
-/// `wind` (`fmus/wind`): the file's mean wind and coefficients, the default gusts.
-struct WindInstance {
-    params: WindParams,
-    speed: f64,
-    heading: f64,
-    model: Wind,
-}
-
-impl WindInstance {
-    fn new(p: &SeawayParams) -> Result<WindInstance, String> {
-        let params = WindParams {
-            seed: p.wind_seed,
-            mean_speed: p.mean_wind_speed,
-            direction: p.wind_direction,
-            roll_coefficient: p.wind_coefficients.0,
-            yaw_coefficient: p.wind_coefficients.1,
-            ..WindParams::default()
-        };
-        Ok(WindInstance {
-            model: Wind::new(params.clone(), START_TIME)?,
-            params,
-            speed: 0.0,
-            heading: 0.0,
-        })
-    }
-
-    fn initialize(&mut self) -> Result<(), String> {
-        self.model = Wind::new(self.params.clone(), START_TIME)?;
-        self.model.set_inputs(self.speed, self.heading);
-        Ok(())
-    }
-
-    fn calculate_outputs(&mut self) {
-        self.model.set_inputs(self.speed, self.heading);
-    }
-
-    fn do_step(&mut self, t: f64, h: f64) {
-        self.model.set_inputs(self.speed, self.heading);
-        self.model.advance_to(t + h);
-    }
-
-    /// The FMU's outputs from the relative wind (`WindFmu::relative`).
-    fn outputs(&self) -> Moments {
-        let wind = self.model.relative();
-        Moments {
-            roll_moment: self.model.roll_moment_at(wind),
-            yaw_moment: self.model.yaw_moment_at(wind),
-        }
-    }
+/// `wind`: the file's mean wind and coefficients, the default gusts.
+fn wind_instance(p: &SeawayParams) -> Result<WindInstance, String> {
+    let params = WindParams {
+        seed: p.wind_seed,
+        mean_speed: p.mean_wind_speed,
+        direction: p.wind_direction,
+        roll_coefficient: p.wind_coefficients.0,
+        yaw_coefficient: p.wind_coefficients.1,
+        ..WindParams::default()
+    };
+    WindInstance::new(params, 0.0, START_TIME)
 }
 
 /// `ap` (`fmus/heading_autopilot`): preset 2, the external reference.
@@ -351,8 +262,8 @@ impl SeawayLoop {
             k: 0,
             values: SeawayValues::default(),
             ship: Ship::new(params)?,
-            waves: WavesInstance::new(params)?,
-            wind: WindInstance::new(params)?,
+            waves: waves_instance(params)?,
+            wind: wind_instance(params)?,
             autopilot: AutopilotInstance::new(params)?,
         };
         s.initialize()?;
@@ -377,8 +288,8 @@ impl SeawayLoop {
 
     fn initialize_models(&mut self) -> Result<(), String> {
         self.ship.initialize()?;
-        self.waves.initialize()?;
-        self.wind.initialize()?;
+        self.waves.initialize(START_TIME)?;
+        self.wind.initialize(START_TIME)?;
         self.autopilot.initialize()
     }
 

@@ -25,6 +25,7 @@
 #![allow(unknown_lints, clippy::manual_is_multiple_of)]
 
 pub mod container_ship;
+mod disturbances;
 pub mod rrs;
 
 use shipsim::run::recorder::write_real;

@@ -12,12 +12,12 @@
 //! `set_inputs`, `advance_to`, `roll_moment`, `yaw_moment`, and the FMU's σ_i from
 //! `wf_sigma_for_std`), so a faster wave model changes the FMU system and this loop alike.
 
+pub use super::disturbances::Moments;
+use super::disturbances::{WavesInstance, WindInstance};
 use super::{link, n_steps, LoopSummary};
 use models::controllers::rrs::{RollMode, RrsAutopilot, RrsAutopilotParams, RrsInputs, RrsOutputs};
-use models::disturbances::waves::{
-    encounter_angle, wf_sigma_for_std, SeaState, SpectrumKind, WaveParams, Waves,
-};
-use models::disturbances::wind::{Wind, WindParams};
+use models::disturbances::waves::{SeaState, SpectrumKind, WaveParams};
+use models::disturbances::wind::WindParams;
 use models::error::check_positive;
 use models::hull::rrs_ship::{RrsShip, RrsShipInputs};
 use models::observers::rrs_filter::{
@@ -99,13 +99,6 @@ pub struct GearValues {
     pub rudder_angle: f64,
     pub rudder_rate: f64,
     pub rate_saturated_time: f64,
-}
-
-/// `waves.*` and `wind.*` outputs: the rudder-equivalent moments.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct Moments {
-    pub roll_moment: f64,
-    pub yaw_moment: f64,
 }
 
 /// `sensors.*` outputs.
@@ -272,119 +265,34 @@ impl Gear {
     }
 }
 
-/// `waves` (`fmus/waves`): a Bretschneider-ITTC sea, encounter angle from the ship's heading.
-struct WavesInstance {
-    /// The model parameters with the FMU's derived σ_i (`WavesFmu::model_params`).
-    params: WaveParams,
-    wave_direction: f64,
-    speed: f64,
-    heading: f64,
-    waves: Waves,
-}
-
-impl WavesInstance {
-    fn new(p: &RrsParams) -> Result<WavesInstance, String> {
-        let mut params = WaveParams {
-            sea: SeaState {
-                spectrum: SpectrumKind::Bretschneider,
-                hs: p.significant_wave_height,
-                period: p.wave_period,
-                ..WaveParams::default().sea
-            },
-            roll_gain: p.wave_roll_gain,
-            yaw_gain: 0.002,
-            seed: p.waves_seed,
-            ..WaveParams::default()
-        };
-        // the FMU's default standard deviations of the WF motion (surge, sway, yaw)
-        let wf_std = [5.0, 5.0, 0.5f64.to_radians()];
-        for (sigma, std) in params.wf_sigma.iter_mut().zip(wf_std) {
-            *sigma = wf_sigma_for_std(std, params.wf_zeta, params.wf_omega0);
-        }
-        Ok(WavesInstance {
-            waves: Waves::new(params.clone(), START_TIME)?,
-            params,
-            wave_direction: p.wave_direction,
-            speed: SPEED,
-            heading: 0.0,
-        })
-    }
-
-    fn apply_inputs(&mut self) {
-        let gamma = encounter_angle(self.wave_direction, self.heading);
-        self.waves.set_inputs(self.speed, gamma);
-    }
-
-    fn initialize(&mut self) -> Result<(), String> {
-        self.waves = Waves::new(self.params.clone(), START_TIME)?;
-        self.apply_inputs();
-        Ok(())
-    }
-
-    fn calculate_outputs(&mut self) {
-        self.apply_inputs();
-    }
-
-    fn do_step(&mut self, t: f64, h: f64) {
-        self.apply_inputs();
-        self.waves.advance_to(t + h);
-    }
-
-    fn outputs(&self) -> Moments {
-        Moments {
-            roll_moment: self.waves.roll_moment(),
-            yaw_moment: self.waves.yaw_moment(),
-        }
-    }
+/// `waves` (`fmus/waves`): a Bretschneider-ITTC sea from the file, the FMU's other defaults.
+fn waves_instance(p: &RrsParams) -> Result<WavesInstance, String> {
+    let params = WaveParams {
+        sea: SeaState {
+            spectrum: SpectrumKind::Bretschneider,
+            hs: p.significant_wave_height,
+            period: p.wave_period,
+            ..WaveParams::default().sea
+        },
+        roll_gain: p.wave_roll_gain,
+        yaw_gain: 0.002,
+        seed: p.waves_seed,
+        ..WaveParams::default()
+    };
+    WavesInstance::new(params, p.wave_direction, SPEED, START_TIME)
 }
 
 /// `wind` (`fmus/wind`): 10 m/s beam wind with the default gusts.
-struct WindInstance {
-    params: WindParams,
-    speed: f64,
-    heading: f64,
-    model: Wind,
-}
-
-impl WindInstance {
-    fn new(p: &RrsParams) -> Result<WindInstance, String> {
-        let params = WindParams {
-            seed: p.wind_seed,
-            mean_speed: 10.0,
-            direction: FRAC_PI_2,
-            roll_coefficient: 2.35e-4,
-            yaw_coefficient: 2.3e-5,
-            ..WindParams::default()
-        };
-        Ok(WindInstance {
-            model: Wind::new(params.clone(), START_TIME)?,
-            params,
-            speed: SPEED,
-            heading: 0.0,
-        })
-    }
-
-    fn initialize(&mut self) -> Result<(), String> {
-        self.model = Wind::new(self.params.clone(), START_TIME)?;
-        self.model.set_inputs(self.speed, self.heading);
-        Ok(())
-    }
-
-    fn calculate_outputs(&mut self) {
-        self.model.set_inputs(self.speed, self.heading);
-    }
-
-    fn do_step(&mut self, t: f64, h: f64) {
-        self.model.set_inputs(self.speed, self.heading);
-        self.model.advance_to(t + h);
-    }
-
-    fn outputs(&self) -> Moments {
-        Moments {
-            roll_moment: self.model.roll_moment(),
-            yaw_moment: self.model.yaw_moment(),
-        }
-    }
+fn wind_instance(p: &RrsParams) -> Result<WindInstance, String> {
+    let params = WindParams {
+        seed: p.wind_seed,
+        mean_speed: 10.0,
+        direction: FRAC_PI_2,
+        roll_coefficient: 2.35e-4,
+        yaw_coefficient: 2.3e-5,
+        ..WindParams::default()
+    };
+    WindInstance::new(params, SPEED, START_TIME)
 }
 
 /// Channels of `models::sensors` the system uses.
@@ -560,8 +468,8 @@ impl RrsLoop {
             values: RrsValues::default(),
             ship: Ship::new(),
             gear: Gear::new()?,
-            waves: WavesInstance::new(params)?,
-            wind: WindInstance::new(params)?,
+            waves: waves_instance(params)?,
+            wind: wind_instance(params)?,
             sensors: SensorsInstance::new(params)?,
             filter: FilterInstance::new()?,
             autopilot: AutopilotInstance::new(params)?,
@@ -593,8 +501,8 @@ impl RrsLoop {
     fn initialize_models(&mut self) -> Result<(), String> {
         self.ship.initialize();
         self.gear.initialize()?;
-        self.waves.initialize()?;
-        self.wind.initialize()?;
+        self.waves.initialize(START_TIME)?;
+        self.wind.initialize(START_TIME)?;
         self.sensors.initialize()?;
         self.filter.initialize()?;
         self.autopilot.initialize()
