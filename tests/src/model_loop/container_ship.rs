@@ -13,11 +13,10 @@
 //! order of the addition does not change a bit (IEEE 754 addition is commutative).
 
 pub use super::disturbances::Moments;
-use super::disturbances::{WavesInstance, WindInstance};
+use super::disturbances::{bretschneider, WavesInstance, WindInstance};
 use super::{link, n_steps, LoopSummary};
 use models::controllers::loop_shaped::presets::HeadingPreset;
 use models::controllers::loop_shaped::{HeadingAutopilot, HeadingDesign, HeadingReference};
-use models::disturbances::waves::{SeaState, SpectrumKind, WaveParams};
 use models::disturbances::wind::WindParams;
 use models::hull::container_ship::{
     ContainerShip, ContainerShipInputs, ContainerShipOutputs, ContainerShipParams,
@@ -176,18 +175,12 @@ impl Ship {
 
 /// `waves`: the file's Bretschneider sea, gains and seed, the FMU's other defaults.
 fn waves_instance(p: &SeawayParams) -> Result<WavesInstance, String> {
-    let params = WaveParams {
-        sea: SeaState {
-            spectrum: SpectrumKind::Bretschneider,
-            hs: p.significant_wave_height,
-            period: p.wave_period,
-            ..WaveParams::default().sea
-        },
-        roll_gain: p.wave_gains.0,
-        yaw_gain: p.wave_gains.1,
-        seed: p.waves_seed,
-        ..WaveParams::default()
-    };
+    let params = bretschneider(
+        p.significant_wave_height,
+        p.wave_period,
+        p.wave_gains,
+        p.waves_seed,
+    );
     WavesInstance::new(params, p.wave_direction, 0.0, START_TIME)
 }
 

@@ -3,7 +3,9 @@
 //! public API as the FMU uses it, so a faster wave or wind model changes the FMU systems and the
 //! loops alike. A loop builds the model parameters from its system file.
 
-use models::disturbances::waves::{encounter_angle, wf_sigma_for_std, WaveParams, Waves};
+use models::disturbances::waves::{
+    encounter_angle, wf_sigma_for_std, SeaState, SpectrumKind, WaveParams, Waves,
+};
 use models::disturbances::wind::{Wind, WindParams};
 
 /// A disturbance's published outputs (`waves.*`, `wind.*`): the rudder-equivalent moments.
@@ -11,6 +13,29 @@ use models::disturbances::wind::{Wind, WindParams};
 pub struct Moments {
     pub roll_moment: f64,
     pub yaw_moment: f64,
+}
+
+/// The parameters of the `Waves` FMU with a Bretschneider sea of significant height `hs` [m]
+/// and mean period `period` [s], the rudder-equivalent gains and the seed of a system file; the
+/// FMU's defaults otherwise.
+pub(super) fn bretschneider(
+    hs: f64,
+    period: f64,
+    (roll_gain, yaw_gain): (f64, f64),
+    seed: u64,
+) -> WaveParams {
+    WaveParams {
+        sea: SeaState {
+            spectrum: SpectrumKind::Bretschneider,
+            hs,
+            period,
+            ..WaveParams::default().sea
+        },
+        roll_gain,
+        yaw_gain,
+        seed,
+        ..WaveParams::default()
+    }
 }
 
 /// `waves` (`fmus/waves`): the model with the FMU's derived σ_i (`WavesFmu::model_params`: the

@@ -13,10 +13,9 @@
 //! `wf_sigma_for_std`), so a faster wave model changes the FMU system and this loop alike.
 
 pub use super::disturbances::Moments;
-use super::disturbances::{WavesInstance, WindInstance};
+use super::disturbances::{bretschneider, WavesInstance, WindInstance};
 use super::{link, n_steps, LoopSummary};
 use models::controllers::rrs::{RollMode, RrsAutopilot, RrsAutopilotParams, RrsInputs, RrsOutputs};
-use models::disturbances::waves::{SeaState, SpectrumKind, WaveParams};
 use models::disturbances::wind::WindParams;
 use models::error::check_positive;
 use models::hull::rrs_ship::{RrsShip, RrsShipInputs};
@@ -267,18 +266,12 @@ impl Gear {
 
 /// `waves` (`fmus/waves`): a Bretschneider-ITTC sea from the file, the FMU's other defaults.
 fn waves_instance(p: &RrsParams) -> Result<WavesInstance, String> {
-    let params = WaveParams {
-        sea: SeaState {
-            spectrum: SpectrumKind::Bretschneider,
-            hs: p.significant_wave_height,
-            period: p.wave_period,
-            ..WaveParams::default().sea
-        },
-        roll_gain: p.wave_roll_gain,
-        yaw_gain: 0.002,
-        seed: p.waves_seed,
-        ..WaveParams::default()
-    };
+    let params = bretschneider(
+        p.significant_wave_height,
+        p.wave_period,
+        (p.wave_roll_gain, 0.002),
+        p.waves_seed,
+    );
     WavesInstance::new(params, p.wave_direction, SPEED, START_TIME)
 }
 
