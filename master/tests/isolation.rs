@@ -210,6 +210,26 @@ fn isolate_true_in_the_system_file_isolates_that_instance() {
     );
 }
 
+/// A library whose load-time initializer segfaults: isolated, the master never loads it (every
+/// instance of the FMU is isolated), and the child's crash is an error naming the instance and
+/// the call that loads it; nothing is left behind.
+#[test]
+fn isolated_crash_while_loading_the_library_is_an_error() {
+    let d = tempfile::tempdir().unwrap();
+    evil_fmu(d.path(), "evil", &["EVIL_LOAD_SEGV"]);
+    system(d.path());
+    let err = failing(d.path(), &["run", "sys.toml", "-q", "--isolate=evil"]);
+    assert!(
+        err.contains(
+            "error: instance 'evil': the FMU's process was killed by signal 11 (SIGSEGV, a \
+             segmentation fault) during fmi2Instantiate (isolated: the master and the other \
+             instances are unaffected)"
+        ),
+        "{err}"
+    );
+    assert_no_temp_dirs(d.path());
+}
+
 #[test]
 fn isolated_hang_is_killed_after_the_call_timeout() {
     let (d, err) = isolated_failure(&["EVIL_HANG"], &["--call-timeout", "0.5"]);

@@ -8,6 +8,7 @@
  *   EVIL_NAN         fmi2DoStep returns fmi2OK with y = NaN
  *   EVIL_INIT_FAIL   fmi2ExitInitializationMode returns fmi2Error
  *   EVIL_REJECT_NAN  fmi2SetReal returns fmi2Error for a non-finite value
+ *   EVIL_LOAD_SEGV   the library's load-time initializer (a constructor) segfaults
  *
  * each at the step with index EVIL_AT_STEP (default 3: after three completed steps), and with
  * EVIL_IF_U_ABOVE=X only when the input u is above X (for campaigns that vary u). Every
@@ -27,6 +28,15 @@
 
 #ifndef EVIL_AT_STEP
 #define EVIL_AT_STEP 3
+#endif
+
+#ifdef EVIL_LOAD_SEGV
+/* Through a volatile pointer: the compiler drops a constructor whose store it can prove is to
+ * NULL (undefined), and raise(SIGSEGV) would return from Rust's stack-overflow handler. */
+static int *volatile evil_null = 0;
+__attribute__((constructor)) static void evil_load(void) {
+    *evil_null = 1;
+}
 #endif
 
 EXPORT fmi2Status fmi2DoStep(fmi2Component c, fmi2Real t, fmi2Real h, fmi2Boolean noprior) {
