@@ -36,6 +36,17 @@ pub enum Error {
     #[error("checkpoint file {}: {message}", file.display())]
     Checkpoint { file: PathBuf, message: String },
 
+    /// An isolated instance's process died, was killed after the call time limit, or answered
+    /// wrongly during `function` ([`crate::isolate`]); `message` says how, with the FMU's last
+    /// log messages.
+    #[error("{message}")]
+    Isolated {
+        instance: String,
+        function: &'static str,
+        time: Option<f64>,
+        message: String,
+    },
+
     /// The run was interrupted (Ctrl-C) at the given time.
     #[error("interrupted at t = {time} s")]
     Interrupted { time: f64 },

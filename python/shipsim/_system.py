@@ -194,6 +194,8 @@ class System:
         algorithm: Optional[str] = None,
         verbose: bool = False,
         as_frame: Optional[bool] = None,
+        isolate=None,
+        call_timeout: Optional[float] = None,
     ):
         """Runs the system and returns the recorded variables.
 
@@ -207,10 +209,23 @@ class System:
         real-time factor) and ``df.attrs["warnings"]``; without pandas (or with
         ``as_frame=False``), a :class:`Columns` dict of numpy arrays with ``time``.
 
+        ``isolate`` runs FMU instances out of process (docs/isolation.md), like ``shipsim run
+        --isolate``: ``True`` or ``"all"`` (every instance), ``"foreign"`` (FMUs not built by
+        this project), or a list of instance names. A segfault, ``abort()``, ``exit()`` or hang
+        of an isolated FMU then raises :class:`SimulationError` naming the instance, the call
+        and the time, and this Python process lives on. ``call_timeout`` [s] kills an isolated
+        FMU call that runs longer. Instances with ``isolate = true`` in the system file are
+        isolated whatever the argument.
+
         The GIL is released while the master runs. Ctrl-C stops the run at its next
         communication point and raises ``KeyboardInterrupt``. FMU log messages go to the
         ``shipsim.fmu`` logger (warnings and worse; everything with ``verbose``).
         """
+        if isolate is True:
+            isolate = "all"
+        names = None
+        if isolate is not None and not isinstance(isolate, str):
+            names, isolate = [str(n) for n in isolate], None
         raw = self._native.run(
             stop_time=stop_time,
             variables=None if variables is None else list(variables),
@@ -218,6 +233,9 @@ class System:
             step_size=step_size,
             algorithm=algorithm,
             verbose=verbose,
+            isolate=None if isolate is False else isolate,
+            isolate_instances=names,
+            call_timeout=call_timeout,
         )
         for w in raw["warnings"]:
             warnings.warn(w, ShipsimWarning, stacklevel=2)

@@ -92,6 +92,20 @@ fn py_err(py: Python<'_>, e: Error) -> PyErr {
                 ("time", obj(py, time)),
             ],
         ),
+        Error::Isolated {
+            instance,
+            function,
+            time,
+            ..
+        } => (
+            SimulationError::new_err(message),
+            vec![
+                ("instance", obj(py, instance)),
+                ("function", obj(py, function)),
+                ("status", py.None()),
+                ("time", obj(py, time)),
+            ],
+        ),
         Error::System { file, line, .. } => (
             SystemFileError::new_err(message),
             vec![("file", obj(py, file)), ("line", obj(py, line))],
@@ -374,6 +388,47 @@ impl PySystem {
     }
 
     /// Checks `instance.variable` (or `instance.*` when `wildcard`), with "did you mean".
+    /// The run's isolation (`System.run(isolate=..., call_timeout=...)`): `isolate` "all" or
+    /// "foreign", or the named instances; a call time limit in seconds.
+    fn isolation(
+        &self,
+        isolate: Option<String>,
+        instances: Option<Vec<String>>,
+        call_timeout: Option<f64>,
+    ) -> PyResult<shipsim::isolate::Isolation> {
+        use shipsim::isolate::{IsolateMode, Isolation};
+        let mode = match (isolate.as_deref(), instances) {
+            (None, None) => IsolateMode::None,
+            (Some("all"), None) => IsolateMode::All,
+            (Some("foreign"), None) => IsolateMode::Foreign,
+            (None, Some(names)) => {
+                for n in &names {
+                    self.check_name(&format!("{n}.*"), true)?;
+                }
+                IsolateMode::Instances(names)
+            }
+            (Some(other), _) => return Err(pyo3::exceptions::PyValueError::new_err(format!(
+                "isolate={other:?}: use True or \"all\", \"foreign\", or a list of instance names"
+            ))),
+        };
+        let call_timeout = match call_timeout {
+            None => None,
+            Some(s) if s.is_finite() && s > 0.0 && s <= 1e9 => {
+                Some(std::time::Duration::from_secs_f64(s))
+            }
+            Some(s) => {
+                return Err(pyo3::exceptions::PyValueError::new_err(format!(
+                    "call_timeout={s}: give a positive number of seconds"
+                )))
+            }
+        };
+        Ok(Isolation {
+            mode,
+            call_timeout,
+            host: None,
+        })
+    }
+
     fn check_name(&self, name: &str, wildcard: bool) -> PyResult<()> {
         let instances = || self.system.instances.iter().map(|i| i.name.as_str());
         let (inst, var) = match name.split_once('.') {
@@ -500,7 +555,7 @@ impl PySystem {
     }
 
     /// Runs the system and returns its recorded columns; see the Python `System.run`.
-    #[pyo3(signature = (stop_time=None, variables=None, start_time=None, step_size=None, algorithm=None, verbose=false))]
+    #[pyo3(signature = (stop_time=None, variables=None, start_time=None, step_size=None, algorithm=None, verbose=false, isolate=None, isolate_instances=None, call_timeout=None))]
     #[allow(clippy::too_many_arguments)]
     fn run<'py>(
         &self,
@@ -511,7 +566,11 @@ impl PySystem {
         step_size: Option<f64>,
         algorithm: Option<String>,
         verbose: bool,
+        isolate: Option<String>,
+        isolate_instances: Option<Vec<String>>,
+        call_timeout: Option<f64>,
     ) -> PyResult<Bound<'py, PyDict>> {
+        let isolation = self.isolation(isolate, isolate_instances, call_timeout)?;
         let mut sys = self.system.clone();
         if let Some(v) = &variables {
             for name in v {
@@ -547,6 +606,7 @@ impl PySystem {
             verbose,
             interrupt: Some(interrupt.clone()),
             log_sink: Some(logs.sink(verbose)),
+            isolation,
             ..Default::default()
         };
         let mut rec = MemoryRecorder::new();
@@ -962,8 +1022,23 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(inspect, m)?)?;
     m.add_function(wrap_pyfunction!(worker_run, m)?)?;
     m.add_function(wrap_pyfunction!(fmu_load_count, m)?)?;
+    m.add_function(wrap_pyfunction!(fmu_host, m)?)?;
     m.add_class::<PySystem>()?;
     m.add_class::<PyCampaign>()?;
     m.add_class::<PyCollector>()?;
+    // Isolated FMU instances (`isolate=`, `isolate = true`, campaigns' foreign FMUs) run in
+    // processes of this interpreter: `python -m shipsim._fmu_host fmu-host FMU`.
+    let executable: Option<PathBuf> = py.import("sys")?.getattr("executable")?.extract().ok();
+    if let Some(exe) = executable.filter(|e| !e.as_os_str().is_empty()) {
+        shipsim::isolate::set_host_command(exe, vec!["-m".into(), "shipsim._fmu_host".into()]);
+    }
     Ok(())
+}
+
+/// The FMU host of an isolated instance (`shipsim._fmu_host`): serves the FMI calls of the
+/// master on this process's stdin and stdout until the instance is freed; returns the exit
+/// status (the caller ends the process with it).
+#[pyfunction]
+fn fmu_host(py: Python<'_>, fmu: PathBuf) -> i32 {
+    py.detach(|| shipsim::isolate::host::serve(&fmu))
 }

@@ -431,11 +431,13 @@ pub(super) fn to_do(journal: &Journal, run: &Run, retry_failed: bool) -> bool {
 /// The isolation of a campaign's runs: the instances of FMUs not built by this project run in
 /// their own processes ([`crate::isolate`]), so one that crashes, exits or hangs fails its run
 /// only. Our FMUs run in process (their calls are tested and fuzzed, and in process is faster).
-/// Without a `shipsim` executable to host them (the library in another program, and no
-/// `$SHIPSIM_FMU_HOST`), every FMU runs in process.
+/// Without a command to host them (the library in another program that set none with
+/// [`crate::isolate::set_host_command`], and no `$SHIPSIM_FMU_HOST`), every FMU runs in
+/// process. The Python package sets one, so campaigns from Python and on Dask workers isolate
+/// foreign FMUs too.
 fn foreign_isolation() -> Isolation {
     let iso = Isolation::foreign();
-    match iso.host_executable() {
+    match iso.host_command() {
         Ok(_) => iso,
         Err(_) => Isolation::default(),
     }

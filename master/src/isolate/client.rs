@@ -84,8 +84,9 @@ impl Client {
         iso: &Isolation,
         interrupt: Option<Arc<AtomicBool>>,
     ) -> Result<Client> {
-        let host = iso.host_executable()?;
+        let (host, host_args) = iso.host_command()?;
         let mut child = Command::new(&host)
+            .args(&host_args)
             .arg("fmu-host")
             .arg(fmu)
             .stdin(Stdio::piped())
@@ -350,30 +351,33 @@ impl Client {
             true => String::new(),
             false => format!(" at t = {t} s"),
         };
-        let msg = match &self.failure {
+        let (function, msg) = match &self.failure {
             Some(Failure::Interrupted) => return Error::Interrupted { time: t },
-            Some(Failure::Died { function, how }) => format!(
+            Some(Failure::Died { function, how }) => (*function, format!(
                 "instance '{}': the FMU's process {how} during {function}{at} (isolated: the master and the other instances are unaffected)",
                 self.instance
-            ),
-            Some(Failure::TimedOut { function, limit }) => format!(
+            )),
+            Some(Failure::TimedOut { function, limit }) => (*function, format!(
                 "instance '{}': {function}{at} did not return within {} s (the call time limit); its process was killed",
                 self.instance,
                 limit.as_secs_f64()
-            ),
-            Some(Failure::Closed) => format!(
+            )),
+            Some(Failure::Closed) => ("", format!(
                 "instance '{}': called after fmi2FreeInstance",
                 self.instance
-            ),
-            None => format!("instance '{}': the FMU host answered wrongly", self.instance),
+            )),
+            None => ("", format!("instance '{}': the FMU host answered wrongly", self.instance)),
         };
         let log = self.log.recent_lines();
-        match log.is_empty() {
-            true => Error::Other(msg),
-            false => Error::Other(format!(
-                "{msg}; last FMU log messages:\n    {}",
-                log.join("\n    ")
-            )),
+        let message = match log.is_empty() {
+            true => msg,
+            false => format!("{msg}; last FMU log messages:\n    {}", log.join("\n    ")),
+        };
+        Error::Isolated {
+            instance: self.instance.clone(),
+            function,
+            time: (!t.is_nan()).then_some(t),
+            message,
         }
     }
 

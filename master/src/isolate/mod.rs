@@ -23,7 +23,9 @@ pub mod protocol;
 
 use crate::error::{Error, Result};
 use crate::model_description::ModelDescription;
+use std::ffi::OsString;
 use std::path::PathBuf;
+use std::sync::OnceLock;
 use std::time::Duration;
 
 pub use monitor::CallMonitor;
@@ -85,25 +87,40 @@ impl Isolation {
         }
     }
 
-    /// The executable that hosts FMUs: [`Isolation::host`], `$SHIPSIM_FMU_HOST`, or this
-    /// executable when it is `shipsim`.
-    pub fn host_executable(&self) -> Result<PathBuf> {
+    /// The command that hosts FMUs, run as `PROGRAM ARGS... fmu-host FMU`:
+    /// [`Isolation::host`], `$SHIPSIM_FMU_HOST`, this executable when it is `shipsim`, or the
+    /// command the embedding program set ([`set_host_command`]: the Python package's
+    /// interpreter with `-m shipsim._fmu_host`).
+    pub fn host_command(&self) -> Result<(PathBuf, Vec<OsString>)> {
         if let Some(h) = &self.host {
-            return Ok(h.clone());
+            return Ok((h.clone(), Vec::new()));
         }
         if let Some(h) = std::env::var_os("SHIPSIM_FMU_HOST") {
-            return Ok(PathBuf::from(h));
+            return Ok((PathBuf::from(h), Vec::new()));
         }
         let exe = std::env::current_exe().ok();
         let is_shipsim = exe
             .as_ref()
             .and_then(|e| e.file_name())
             .is_some_and(|n| n == "shipsim");
-        match exe {
-            Some(e) if is_shipsim => Ok(e),
+        match (exe, HOST_COMMAND.get()) {
+            (Some(e), _) if is_shipsim => Ok((e, Vec::new())),
+            (_, Some((program, args))) => Ok((program.clone(), args.clone())),
             _ => Err(Error::Other(
                 "isolated FMU instances run in `shipsim fmu-host` processes, and this process is not shipsim: set SHIPSIM_FMU_HOST to the shipsim executable".into(),
             )),
         }
     }
+}
+
+/// The host command of a program that embeds the library ([`set_host_command`]).
+static HOST_COMMAND: OnceLock<(PathBuf, Vec<OsString>)> = OnceLock::new();
+
+/// Sets, once per process, the command that hosts isolated FMUs in a program that is not
+/// `shipsim` (`PROGRAM ARGS... fmu-host FMU` must call [`host::serve`] for FMU and exit with its
+/// status). The Python package sets its interpreter with `-m shipsim._fmu_host`, so that runs
+/// and campaigns from Python, Dask workers included, isolate FMUs as the command line does.
+/// A second call is ignored.
+pub fn set_host_command(program: PathBuf, args: Vec<OsString>) {
+    let _ = HOST_COMMAND.set((program, args));
 }
