@@ -17,6 +17,20 @@
 
 use nalgebra::SMatrix;
 
+/// The passes a sampling or noise-grid loop has due when it lags `ahead` of its intervals behind
+/// the time it advances to (for the work bound of one FMU step, `FmuModel::internal_steps`):
+/// `ahead` when positive, 0 when negative (nothing due), and NaN kept. `ahead.max(0.0)` would
+/// turn NaN into 0: an infinite interval in a restored state gives (t − ∞)/∞ = NaN, and the
+/// loop that compares t₀ + k·∞ ≤ t + 1e-9·∞ never ends (the fuzzer's `replay state Sensors
+/// 2186 39`); a NaN count is refused by the bound.
+pub fn due_passes(ahead: f64) -> f64 {
+    if ahead < 0.0 {
+        0.0
+    } else {
+        ahead
+    }
+}
+
 /// Number of equal sub-steps used to cover `h` with sub-steps no longer than `h_max`.
 /// Returns 0 for `h <= 0` (and for non-finite input), so a zero-length step is a no-op.
 pub fn substeps(h: f64, h_max: f64) -> usize {

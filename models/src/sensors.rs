@@ -29,6 +29,7 @@
 //! A global `noise_scale` multiplies every σ ([Parsons1980] uses 1, 0.001 and 0).
 
 use crate::error::{check_non_negative, check_positive};
+use crate::integrate::due_passes;
 use crate::random::{channel, NoiseStream};
 use serde::{Deserialize, Serialize};
 
@@ -242,7 +243,7 @@ impl Sensors {
         for (i, name) in CHANNEL_INTERVALS.iter().enumerate() {
             let interval = self.params.channels[i].interval;
             let passes = if interval > 0.0 {
-                ((t - self.instant(i, self.state[i].k)) / interval).max(0.0)
+                due_passes((t - self.instant(i, self.state[i].k)) / interval)
             } else {
                 f64::INFINITY
             };

@@ -407,9 +407,11 @@ impl PySystem {
                 }
                 IsolateMode::Instances(names)
             }
-            (Some(other), _) => return Err(pyo3::exceptions::PyValueError::new_err(format!(
+            (Some(other), _) => {
+                return Err(pyo3::exceptions::PyValueError::new_err(format!(
                 "isolate={other:?}: use True or \"all\", \"foreign\", or a list of instance names"
-            ))),
+            )))
+            }
         };
         let call_timeout = match call_timeout {
             None => None,

@@ -139,4 +139,11 @@ impl FmuModel for SensorsFmu {
     fn internal_steps(&self, t: f64, h: f64, each: &mut dyn FnMut(&'static str, f64, f64)) {
         self.sensors.internal_steps(t + h, each);
     }
+
+    /// The model's own copy of the parameters (sample intervals, σ), which a restored state
+    /// carries besides the variables': valid as `Sensors::new` requires (an infinite interval
+    /// made the sampling loop endless).
+    fn check_restored(&self, _time: f64) -> Result<(), String> {
+        self.sensors.params().validate()
+    }
 }

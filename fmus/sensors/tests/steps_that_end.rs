@@ -61,3 +61,48 @@ fn a_step_at_a_time_too_large_for_the_sample_interval_is_refused() {
         "{line}"
     );
 }
+
+/// Fuzz run (seed 2027): a serialized state whose model copy of the parameters has an infinite
+/// sample interval (heading_rate_interval, byte 300 of the state) was restored, and the next
+/// fmi2DoStep spun: t0 + k·∞ ≤ t + 1e-9·∞ holds for every k, and the work bound read the
+/// loop's (t − ∞)/∞ = NaN passes as 0. Replay: `fuzz replay state Sensors 2186 39`.
+#[test]
+fn a_state_with_an_infinite_sample_interval_is_refused() {
+    use fmi2_export::fmi2::{fmi2Error, fmi2OK};
+    use fmi2_export::testing::{functions, Harness};
+    let mut fmu = Harness::<sensors_fmu::SensorsFmu>::instantiate(
+        functions::<sensors_fmu::SensorsFmu>(),
+        "restored",
+    );
+    fmu.initialize(0.0);
+    let mut t = 0.0;
+    for _ in 0..4 {
+        fmu.step(t, 0.1);
+        t += 0.1;
+    }
+    let s = fmu.get_state();
+    let mut bytes = fmu.serialize(s);
+    // The model's copy of the interval of channel 3, found by its value (0.1 s) after the
+    // variables' copy of the same parameter.
+    let interval = 0.1f64.to_le_bytes();
+    let at: Vec<usize> = (0..bytes.len() - 8)
+        .filter(|&i| bytes[i..i + 8] == interval)
+        .collect();
+    assert_eq!(
+        at.len(),
+        4,
+        "two 0.1 s channels, each in two copies of the parameters"
+    );
+    bytes[at[3]..at[3] + 8].copy_from_slice(&f64::INFINITY.to_le_bytes());
+    let (status, _) = fmu.deserialize(&bytes);
+    assert_eq!(status, fmi2Error);
+    let line = fmu.log().last();
+    assert!(
+        line.contains("fmi2DeSerializeFMUstate")
+            && line.contains("interval")
+            && line.contains("inf"),
+        "{line}"
+    );
+    // The instance is unharmed.
+    assert_eq!(fmu.try_step(t, 0.1), fmi2OK);
+}

@@ -41,6 +41,7 @@ use crate::error::{
     check_finite, check_non_negative, check_positive, check_positive_or_infinite, require,
 };
 use crate::hull::tokyo_maru::{TokyoMaruCoefficients, L, U};
+use crate::integrate::due_passes;
 pub use crate::observers::path_model::{DisturbanceModel, PathDesignModel, A44, A55, EPSILON};
 use nalgebra::{DMatrix, SMatrix, SVector};
 use serde::{Deserialize, Serialize};
@@ -514,7 +515,7 @@ impl PathController {
         let interval = self.params.update_interval;
         let reached = self.time_prime + h * scale - self.next_update;
         let passes = if interval > 0.0 && self.next_update + interval != self.next_update {
-            (reached / interval).max(0.0) + 1.0
+            due_passes(reached / interval) + 1.0
         } else {
             f64::INFINITY
         };

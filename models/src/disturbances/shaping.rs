@@ -17,6 +17,7 @@
 //! Parameters may change while running (tunable FMU parameters, input-dependent encounter
 //! frequency): the new Φ and Q_d apply from the next grid interval that is drawn.
 
+use crate::integrate::due_passes;
 use crate::random::NoiseStream;
 
 /// Time quantum of the disturbance models [s]: every time handed to `advance_to` is rounded to
@@ -61,7 +62,7 @@ impl Grid {
     /// positive number).
     fn passes_to(&self, t: f64) -> (f64, f64) {
         let passes = if self.dt > 0.0 {
-            ((t - self.time(self.k)) / self.dt).max(0.0)
+            due_passes((t - self.time(self.k)) / self.dt)
         } else {
             f64::INFINITY
         };
