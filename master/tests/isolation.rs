@@ -197,6 +197,26 @@ fn isolate_true_in_the_system_file_isolates_that_instance() {
     assert_names_call(&err, "was killed by signal 11 (SIGSEGV");
     assert_three_steps_kept(d.path());
     assert_no_temp_dirs(d.path());
+    // OSP and SSP cannot carry it: the exports say so.
+    for (cmd, out, format) in [
+        (
+            "export-osp",
+            "OspSystemStructure.xml",
+            "OspSystemStructure.xml",
+        ),
+        ("export-ssp", "sys.ssp", "SSP 1.0"),
+    ] {
+        let o = shipsim(d.path(), &[cmd, "sys.toml", "-o", out]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(o.status.success(), "{cmd}: {err}");
+        assert!(
+            err.contains(&format!(
+                "warning: `isolate = true` (evil) is not part of {format} and is left out: run \
+                 it with --isolate=evil"
+            )),
+            "{cmd}: {err}"
+        );
+    }
     // The flag is a boolean; anything else is refused at its line (11).
     std::fs::write(
         &sys,

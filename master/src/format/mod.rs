@@ -48,3 +48,22 @@ pub(crate) fn collected(mut errors: Vec<Error>) -> Result<()> {
         _ => Err(Error::Many(errors)),
     }
 }
+
+/// The warning of an export to `format` (a file OSP or SSP tools read) for the instances with
+/// `isolate = true`, which neither format can carry; None when there are none.
+pub(crate) fn isolation_left_out(sys: &crate::system::System, format: &str) -> Option<String> {
+    let isolated: Vec<&str> = sys
+        .instances
+        .iter()
+        .filter(|i| i.isolate)
+        .map(|i| i.name.as_str())
+        .collect();
+    (!isolated.is_empty()).then(|| {
+        format!(
+            "`isolate = true` ({}) is not part of {format} and is left out: run it with \
+             --isolate={}",
+            isolated.join(", "),
+            isolated.join(",")
+        )
+    })
+}

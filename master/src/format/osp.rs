@@ -454,20 +454,7 @@ fn lost_in_export(sys: &System, scenario_path: &Path) -> Vec<String> {
     if sys.output.file.is_some() || sys.output.variables.is_some() {
         warnings.push("output settings are not part of OspSystemStructure.xml".to_string());
     }
-    let isolated: Vec<&str> = sys
-        .instances
-        .iter()
-        .filter(|i| i.isolate)
-        .map(|i| i.name.as_str())
-        .collect();
-    if !isolated.is_empty() {
-        warnings.push(format!(
-            "`isolate = true` ({}) is not part of OspSystemStructure.xml: run it with \
-             --isolate={}",
-            isolated.join(", "),
-            isolated.join(",")
-        ));
-    }
+    warnings.extend(super::isolation_left_out(sys, "OspSystemStructure.xml"));
     warnings
 }
 

@@ -188,20 +188,7 @@ fn left_out(sys: &System, plan: &Plan) -> Vec<String> {
                 .to_string(),
         );
     }
-    let isolated: Vec<&str> = sys
-        .instances
-        .iter()
-        .filter(|i| i.isolate)
-        .map(|i| i.name.as_str())
-        .collect();
-    if !isolated.is_empty() {
-        warnings.push(format!(
-            "`isolate = true` ({}) is not part of SSP 1.0 and is left out: run the archive with \
-             --isolate={}",
-            isolated.join(", "),
-            isolated.join(",")
-        ));
-    }
+    warnings.extend(crate::format::isolation_left_out(sys, "SSP 1.0"));
     let mapped: Vec<&str> = plan
         .connections
         .iter()
