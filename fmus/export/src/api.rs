@@ -895,16 +895,18 @@ pub unsafe fn set_real<M: FmuModel>(
             } => {
                 if !x.is_finite() {
                     return Err(refused(format_args!(
-                        "{:?} = {x} refused: not a finite number",
-                        v.name
+                        "{:?} = {} refused: not a finite number",
+                        v.name,
+                        Num(x)
                     )));
                 }
                 if min.is_some_and(|lo| x < lo) || max.is_some_and(|hi| x > hi) {
                     return Err(refused(format_args!(
-                        "{:?} = {x} refused: outside [{}, {}]",
+                        "{:?} = {} refused: outside [{}, {}]",
                         v.name,
-                        min.unwrap_or(f64::NEG_INFINITY),
-                        max.unwrap_or(f64::INFINITY)
+                        Num(x),
+                        Num(min.unwrap_or(f64::NEG_INFINITY)),
+                        Num(max.unwrap_or(f64::INFINITY))
                     )));
                 }
                 let old = old_value(v, m, get);

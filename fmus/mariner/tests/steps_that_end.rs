@@ -73,3 +73,25 @@ fn a_corrupt_state_is_refused_or_bounded() {
         Corrupt::StepRefused("internal steps of max_substep = "),
     );
 }
+
+/// Fuzz run (seed 2027, `replay param Mariner 2228 135`): nominal_speed = 1e-100 with
+/// max_substep = 1e-6 made a 1 s step of 1e6 RK4 sub-steps (within the work bound) run on
+/// denormal numbers, 1.2 s instead of 0.18 s. The declared minimum of nominal_speed is now
+/// 0.1 m/s; at that minimum the same step ends with finite outputs.
+#[test]
+fn nominal_speeds_below_the_declared_minimum_are_refused() {
+    probe(
+        &[],
+        &[("nominal_speed", 1e-100)],
+        1.0,
+        1,
+        Error("\"nominal_speed\" = 1e-100 refused: outside [0.1, inf]"),
+    );
+    probe(
+        &[],
+        &[("nominal_speed", 0.1), ("max_substep", 1e-6)],
+        1.0,
+        1,
+        Finite,
+    );
+}
