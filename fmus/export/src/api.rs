@@ -546,8 +546,9 @@ fn update_outputs<M: FmuModel>(inst: &mut Instance<M>) {
 /// what the check costs (the "output check" row of docs/bench.md; issue 19: at most 1 %).
 const OUTPUT_CHECK: bool = !cfg!(shipsim_no_output_check);
 
-/// A value a getter hands out: the bits of `x - x` for a Real (0 when finite: `x - x` is +0.0;
-/// a NaN's bits, never 0, for NaN and the infinities), 0 for the other types. A getter ORs them
+/// A value a getter hands out: the bits of `x - x` for a Real (±0.0 when finite, +0.0 unless
+/// the importer rounds downward; a NaN's bits, nonzero without the sign bit, for NaN and the
+/// infinities), 0 for the other types. A getter ORs them
 /// over its values in an integer register, which survives the getters' indirect calls (a
 /// floating-point sum is spilled around each: about 0.3 % more of the RRS system).
 trait Handed: Copy {
@@ -611,7 +612,9 @@ unsafe fn get_values<M: FmuModel, T: Handed>(
             }
             *out.add(i) = x;
         }
-        if bad != 0 {
+        // Shifted out: the sign bit, which a finite x - x has set when the importer rounds
+        // downward (fesetround(FE_DOWNWARD) makes it -0.0).
+        if bad << 1 != 0 {
             let values = std::slice::from_raw_parts(out, n);
             return non_finite_value(inst, vrs, values);
         }
@@ -668,7 +671,7 @@ fn non_finite_value<M: FmuModel, T: Handed>(
     vrs: &[fmi2ValueReference],
     values: &[T],
 ) -> fmi2Status {
-    let Some(k) = values.iter().position(|x| x.not_finite() != 0) else {
+    let Some(k) = values.iter().position(|x| x.not_finite() << 1 != 0) else {
         return fmi2OK;
     };
     inst.core.state = LifeState::Error;

@@ -1061,3 +1061,29 @@ fn the_harness_names_a_missing_variable() {
     let fmu = Harness::<Table>::instantiate(functions::<Table>(), "table");
     fmu.real("speed");
 }
+
+/// The finiteness check of `fmi2GetReal` holds whatever the importer's rounding mode: rounding
+/// downward, x - x of a finite x is -0.0 (sign bit set), which is no reason for an error.
+#[test]
+fn finite_outputs_pass_the_check_when_the_importer_rounds_downward() {
+    extern "C" {
+        fn fesetround(round: i32) -> i32;
+        fn fegetround() -> i32;
+    }
+    // <fenv.h> on x86-64 and aarch64 Linux.
+    #[cfg(target_arch = "x86_64")]
+    const FE_DOWNWARD: i32 = 0x400;
+    #[cfg(target_arch = "aarch64")]
+    const FE_DOWNWARD: i32 = 0x800000;
+    let host = Host::new();
+    let fmu = host.instantiate("rounding");
+    fmu.init();
+    trajectory(&fmu, 0, 3);
+    let before = unsafe { fegetround() };
+    assert_eq!(unsafe { fesetround(FE_DOWNWARD) }, 0);
+    let x = std::hint::black_box(0.1f64);
+    assert!((x - x).is_sign_negative(), "the rounding mode took effect");
+    let got = fmu.get_reals(&[VR_Y, VR_GAIN]);
+    unsafe { fesetround(before) };
+    assert_eq!(got.0, fmi2OK, "{}", host.0.log().last());
+}
