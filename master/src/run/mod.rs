@@ -202,14 +202,15 @@ pub fn load_fmus_with(
         IsolateMode::Instances(names) => names,
         _ => &[],
     };
-    let named_in_process: Vec<PathBuf> = match &isolation.mode {
+    // A set: systems of 20,000 instances are loaded in one go.
+    let named_in_process: std::collections::HashSet<PathBuf> = match &isolation.mode {
         IsolateMode::None | IsolateMode::Instances(_) => system
             .instances
             .iter()
             .filter(|i| !i.isolate && !by_name.contains(&i.name))
             .map(key_of)
             .collect(),
-        _ => Vec::new(),
+        _ => Default::default(),
     };
     for inst in &system.instances {
         let key = key_of(inst);
