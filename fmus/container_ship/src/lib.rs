@@ -247,7 +247,10 @@ fmi2_export::fmu! {
             "Rudder command saturation of the built-in servo (section 2.6: 10 deg; exRRD2.m: 20 deg). \
             It also limits a SteeringGear's rudder_angle connected to rudder_command: raise it to \
             at least the gear's angle limit";
-        tunable real "rudder_rate_max" ["rad/s"] (params.rudder_rate_max).min(0.0),
+        // Declared minimum 1e-3 rad/s (was 0): at 1e-300 the rate-limited rudder ran on
+        // denormal numbers and a 1 s step of 1e6 RK4 sub-steps (the work bound) took 3.0 s
+        // instead of 0.38 s (fuzz run seed 2027, replay param ContainerShip 2368 273).
+        tunable real "rudder_rate_max" ["rad/s"] (params.rudder_rate_max).min(1e-3),
             "Rudder rate limit of the built-in servo (section 2.6: 5 deg/s; exRRD2.m: 20 deg/s). \
             When a SteeringGear drives rudder_command, open the servo up: rudder_rate_max well above \
             the gear's rate (e.g. 1 rad/s, as systems/autopilot_*_nonlinear.toml do); the servo's \

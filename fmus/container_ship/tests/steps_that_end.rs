@@ -171,3 +171,25 @@ fn a_corrupt_state_is_refused_or_bounded() {
         Corrupt::StepRefused("internal steps of max_substep = "),
     );
 }
+
+/// Fuzz run (seed 2027, `replay param ContainerShip 2368 273`): rudder_rate_max = 1e-300 with
+/// max_substep = 1e-6 made a 1 s step of 1e6 RK4 sub-steps (within the work bound) run on
+/// denormal numbers, 3.0 s instead of 0.38 s. The declared minimum of rudder_rate_max is now
+/// 1e-3 rad/s; at that minimum the same step ends with finite outputs.
+#[test]
+fn rudder_rates_below_the_declared_minimum_are_refused() {
+    probe(
+        &[],
+        &[("rudder_rate_max", 1e-300)],
+        1.0,
+        1,
+        Error("\"rudder_rate_max\" = 1e-300 refused: outside [0.001, inf]"),
+    );
+    probe(
+        &[],
+        &[("rudder_rate_max", 1e-3), ("max_substep", 1e-6)],
+        1.0,
+        1,
+        Finite,
+    );
+}
