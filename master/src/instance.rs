@@ -11,24 +11,23 @@
 //! them after fmi2Error) and `fmi2FreeInstance` (unless the FMU returned fmi2Fatal, after which
 //! the standard allows no more calls), so every path, including errors and Ctrl-C, cleans up.
 //!
-//! An instance runs in this process (the FMU's functions are called directly) or, isolated,
-//! in a `shipsim fmu-host` child process ([`crate::isolate`]): each call then goes to the
-//! child's [`Client`], and a crash, exit or hang of the child is an error naming the instance,
-//! the call and the time. The state machine, the status checks and the errors are the same.
+//! The calls go to a [`Slave`] ([`crate::slave`]): in this process ([`InProcess`]) or, isolated,
+//! in a `shipsim fmu-host` child process ([`Client`], [`crate::isolate`]), where a crash, exit or
+//! hang of the child is an error naming the instance, the call and the time. This file holds no
+//! FFI: the state machine, the status checks and the errors are the same for every slave.
 
 use crate::error::{Error, Result};
-use crate::fmu::{Api, Fmu, FmuLibrary, VR};
-use crate::isolate::client::{Client, GONE};
-use crate::isolate::protocol::Op;
-use crate::isolate::{CallMonitor, Isolation};
+use crate::fmu::{Fmu, VR};
+use crate::isolate::{Client, Isolation};
+use crate::log::{LogCtx, LogSink};
 use crate::model_description::CoSimulation;
-use fmi2::*;
-use std::collections::VecDeque;
-use std::ffi::{c_char, c_int, c_void, CString};
+use crate::slave::{CallMonitor, InProcess, Slave, StateHandle, GONE, MAX_STATE_BYTES};
+use fmi2::{fmi2Discard, fmi2Fatal, fmi2OK, fmi2Status, fmi2Warning};
+use std::ffi::CString;
 use std::marker::PhantomData;
 use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
 
 /// Type states.
 pub struct Instantiated;
@@ -39,140 +38,6 @@ pub struct Stepping;
 pub trait Readable {}
 impl Readable for Initializing {}
 impl Readable for Stepping {}
-
-/// One formatted FMU log message.
-#[derive(Debug, Clone)]
-pub struct LogRecord {
-    pub instance: String,
-    pub status: i32,
-    pub category: String,
-    pub message: String,
-}
-
-/// Where FMU log messages go. The default prints warnings and worse to stderr (all with verbose).
-pub type LogSink = Arc<dyn Fn(&LogRecord) + Send + Sync>;
-
-pub fn stderr_sink(verbose: bool) -> LogSink {
-    Arc::new(move |r: &LogRecord| {
-        if verbose || r.status >= fmi2Warning {
-            eprintln!(
-                "[{}] {} {}: {}",
-                r.instance,
-                status_name(r.status),
-                r.category,
-                r.message
-            );
-        }
-    })
-}
-
-/// An instance's log: the sink and the last messages (for error reports).
-pub(crate) struct LogCtx {
-    name: String,
-    sink: LogSink,
-    recent: Mutex<VecDeque<String>>,
-    /// The instance was instantiated with loggingOn = fmi2True (debug logging).
-    debug_logging: bool,
-}
-
-impl LogCtx {
-    /// The last messages, or, when the FMU logged none, one line that says so and, if debug
-    /// logging was off, how to switch it on: some FMUs (PythonFMU's) report even their errors
-    /// only with debug logging on.
-    fn recent_or_hint(&self, debug_logging: bool) -> Vec<String> {
-        let recent: Vec<String> = self
-            .recent
-            .lock()
-            .map(|r| r.iter().cloned().collect())
-            .unwrap_or_default();
-        if !recent.is_empty() {
-            recent
-        } else if debug_logging {
-            vec!["(none: the FMU logged no reason)".to_string()]
-        } else {
-            vec![NO_REASON_HINT.to_string()]
-        }
-    }
-
-    fn is_empty(&self) -> bool {
-        self.recent.lock().map(|r| r.is_empty()).unwrap_or(true)
-    }
-
-    /// The last messages.
-    pub(crate) fn recent_lines(&self) -> Vec<String> {
-        self.recent
-            .lock()
-            .map(|r| r.iter().cloned().collect())
-            .unwrap_or_default()
-    }
-
-    /// One message of the FMU (`instance` as it named itself, empty for this instance): kept
-    /// among the last ones and passed to the sink.
-    pub(crate) fn deliver(&self, instance: String, status: i32, category: String, message: String) {
-        let rec = LogRecord {
-            instance: if instance.is_empty() {
-                self.name.clone()
-            } else {
-                instance
-            },
-            status,
-            category,
-            message,
-        };
-        if let Ok(mut r) = self.recent.lock() {
-            if r.len() == RECENT {
-                r.pop_front();
-            }
-            r.push_back(format!(
-                "{} {}: {}",
-                status_name(rec.status),
-                rec.category,
-                rec.message
-            ));
-        }
-        (self.sink)(&rec);
-    }
-}
-
-/// What an error report says when an FMU with debug logging off logged nothing.
-const NO_REASON_HINT: &str = "(none: the FMU logged no reason with debug logging off; rerun \
-     with -v (loggingOn = true): some FMUs, PythonFMU's among them, report their errors only then)";
-
-const RECENT: usize = 8;
-
-unsafe extern "C" fn log_sink(
-    ctx: *mut c_void,
-    instance: *const c_char,
-    status: c_int,
-    category: *const c_char,
-    message: *const c_char,
-) {
-    // Never unwind into the FMU.
-    let _ = std::panic::catch_unwind(|| {
-        let ctx = &*(ctx as *const LogCtx);
-        ctx.deliver(
-            lossy_str(instance),
-            status,
-            lossy_str(category),
-            lossy_str(message),
-        );
-    });
-}
-
-extern "C" {
-    fn calloc(n: usize, size: usize) -> *mut c_void;
-    fn free(p: *mut c_void);
-}
-unsafe extern "C" fn fmi_calloc(n: usize, size: usize) -> *mut c_void {
-    calloc(n, size)
-}
-unsafe extern "C" fn fmi_free(p: *mut c_void) {
-    free(p)
-}
-
-/// The largest serialized FMU state accepted: a larger size reported by an FMU is an error,
-/// not an allocation.
-const MAX_STATE_BYTES: usize = 1 << 30;
 
 /// The FMU-state capability (FMI 2.0, sec. 4.3.1) a checkpoint needs that `cs` lacks, if any.
 fn missing_state_capability(cs: &CoSimulation) -> Option<&'static str> {
@@ -205,32 +70,85 @@ enum Phase {
     Terminated,
     Failed,
     Fatal,
-    /// fmi2FreeInstance was called (an isolated instance's [`Instance::terminate`]).
+    /// fmi2FreeInstance was called ([`Instance::terminate`]).
     Freed,
 }
 
+/// The slaves an instance can run on: one variant per [`Slave`] implementation, dispatched by a
+/// `match` (no indirect call in the step loop).
+enum AnySlave {
+    InProcess(InProcess),
+    Isolated(Box<Client>),
+}
+
+/// `impl Slave for AnySlave`: each call goes to the variant's implementation.
+macro_rules! dispatch {
+    ($(fn $f:ident(&mut self $(, $a:ident: $t:ty)*) -> $r:ty;)*) => {
+        impl Slave for AnySlave {
+            $(
+                #[inline(always)]
+                fn $f(&mut self $(, $a: $t)*) -> $r {
+                    match self {
+                        AnySlave::InProcess(s) => s.$f($($a),*),
+                        AnySlave::Isolated(s) => s.$f($($a),*),
+                    }
+                }
+            )*
+            fn lost(&self) -> Option<Error> {
+                match self {
+                    AnySlave::InProcess(s) => s.lost(),
+                    AnySlave::Isolated(s) => s.lost(),
+                }
+            }
+        }
+    };
+}
+
+dispatch! {
+    fn setup_experiment(&mut self, tolerance: Option<f64>, start: f64, stop: Option<f64>) -> fmi2Status;
+    fn enter_initialization_mode(&mut self) -> fmi2Status;
+    fn exit_initialization_mode(&mut self) -> fmi2Status;
+    fn do_step(&mut self, t: f64, h: f64) -> fmi2Status;
+    fn terminate(&mut self) -> fmi2Status;
+    fn free_instance(&mut self) -> fmi2Status;
+    fn set_real(&mut self, vrs: &[VR], values: &[f64]) -> fmi2Status;
+    fn set_integer(&mut self, vrs: &[VR], values: &[i32]) -> fmi2Status;
+    fn set_boolean(&mut self, vrs: &[VR], values: &[i32]) -> fmi2Status;
+    fn set_string(&mut self, vrs: &[VR], values: &[CString]) -> fmi2Status;
+    fn get_real(&mut self, vrs: &[VR], out: &mut [f64]) -> fmi2Status;
+    fn get_integer(&mut self, vrs: &[VR], out: &mut [i32]) -> fmi2Status;
+    fn get_boolean(&mut self, vrs: &[VR], out: &mut [i32]) -> fmi2Status;
+    fn get_string(&mut self, vrs: &[VR], out: &mut [String]) -> fmi2Status;
+    fn terminated(&mut self) -> (fmi2Status, bool);
+    fn last_successful_time(&mut self) -> (fmi2Status, f64);
+    fn get_state(&mut self) -> (fmi2Status, StateHandle);
+    fn set_state(&mut self, state: StateHandle) -> fmi2Status;
+    fn free_state(&mut self, state: StateHandle) -> (fmi2Status, StateHandle);
+    fn serialized_size(&mut self, state: StateHandle) -> (fmi2Status, usize);
+    fn serialize(&mut self, state: StateHandle, size: usize) -> (fmi2Status, Vec<u8>);
+    fn deserialize(&mut self, bytes: &[u8]) -> (fmi2Status, StateHandle);
+}
+
+/// What an instance knows besides its slave.
 struct Core {
     name: String,
-    lib: Arc<FmuLibrary>,
-    comp: fmi2Component,
     phase: Phase,
-    // Kept alive for the FMU, which may hold pointers to them (none for an isolated instance).
-    _callbacks: Option<Box<fmi2CallbackFunctions>>,
-    _target: Option<Box<LogTarget>>,
     log: Arc<LogCtx>,
-    _name_c: CString,
     /// The `.fmu` file, for errors about its capabilities.
     fmu_path: PathBuf,
     /// Which of canGetAndSetFMUstate and canSerializeFMUstate the FMU lacks (FMI 2.0,
     /// sec. 4.3.1), if any.
     missing_state_capability: Option<&'static str>,
-    /// The child process of an isolated instance.
-    remote: Option<Box<Client>>,
-    /// Where an in-process instance notes its calls, and its number there.
-    monitor: Option<(Arc<CallMonitor>, u16)>,
 }
 
-impl Core {
+/// An instance in any state: the slave and what the instance knows. Its drop ends the slave
+/// as the phase allows.
+struct Live {
+    slave: AnySlave,
+    core: Core,
+}
+
+impl Live {
     /// Ok for fmi2OK and fmi2Warning, else the error of `function` (the phase follows the
     /// status). Inlined into every call wrapper: the success path is one comparison.
     #[inline(always)]
@@ -256,90 +174,53 @@ impl Core {
         time: Option<f64>,
     ) -> Result<()> {
         if status == GONE {
-            // The isolated instance's process died, hung or was stopped: no more calls.
-            self.phase = Phase::Fatal;
-            if let Some(r) = &self.remote {
-                return Err(r.error());
+            // The slave's process died, hung or was stopped: no more calls.
+            self.core.phase = Phase::Fatal;
+            if let Some(e) = self.slave.lost() {
+                return Err(e);
             }
         }
         if status == fmi2Fatal {
-            self.phase = Phase::Fatal;
-        } else if status == fmi2Error || !(0..=5).contains(&status) {
-            self.phase = Phase::Failed;
+            self.core.phase = Phase::Fatal;
+        } else if status == fmi2::fmi2Error || !(0..=5).contains(&status) {
+            self.core.phase = Phase::Failed;
         }
         Err(self.fmi_error(function, status, time))
     }
 
     fn fmi_error(&self, function: &'static str, status: fmi2Status, time: Option<f64>) -> Error {
         Error::Fmi {
-            instance: self.name.clone(),
+            instance: self.core.name.clone(),
             function,
             status,
             time,
-            log: self.log.recent_or_hint(self.log.debug_logging),
+            log: self.core.log.recent_or_hint(self.core.log.debug_logging),
         }
     }
 }
 
-impl Drop for Core {
+impl Drop for Live {
     fn drop(&mut self) {
-        let (terminate, free) = match self.phase {
+        let (terminate, free) = match self.core.phase {
             Phase::Initialized => (true, true),
             Phase::Fatal | Phase::Freed => (false, false),
             _ => (false, true),
         };
-        if let Some(r) = self.remote.as_mut() {
-            if terminate {
-                r.simple(Op::Terminate);
-            }
-            if free {
-                r.free_instance();
-            }
-            // Dropping the client ends the child (without calls after fmi2Fatal).
-            return;
+        if terminate {
+            self.slave.terminate();
         }
-        let Some(api) = self.lib.api.as_ref() else {
-            return;
-        };
-        let monitor = self.monitor.as_ref();
-        let note = |op| {
-            if let Some((m, slot)) = monitor {
-                m.enter(*slot, op);
-            }
-        };
-        unsafe {
-            if terminate {
-                note(Op::Terminate);
-                (api.fmi2Terminate)(self.comp);
-            }
-            if free {
-                note(Op::FreeInstance);
-                (api.fmi2FreeInstance)(self.comp);
-            }
+        if free {
+            self.slave.free_instance();
         }
-        if let Some((m, _)) = monitor {
-            m.leave();
-        }
+        // Dropping an isolated slave ends its process (without calls after fmi2Fatal).
     }
 }
 
 /// A co-simulation slave instance in type state `S`.
 pub struct Instance<S> {
-    core: Box<Core>,
-    /// `core.comp` and the library's function table, kept next to the instance: a call in the
-    /// step loop loads them without going through the box and the `Arc` (null when isolated).
-    comp: fmi2Component,
-    api: *const Api,
-    /// The client in `core.remote`, or null in process.
-    remote: *mut Client,
-    /// The monitor in `core.monitor`, or null, and this instance's number there.
-    monitor: *const CallMonitor,
-    slot: u16,
+    live: Live,
     _s: PhantomData<S>,
 }
-
-// The FMU is only called from the thread that owns the instance.
-unsafe impl<S> Send for Instance<S> {}
 
 /// Result of a `fmi2DoStep`.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -384,154 +265,39 @@ impl Fmu {
         sink: LogSink,
         backend: Backend,
     ) -> Result<Instance<Instantiated>> {
-        let name_c = CString::new(name)
-            .map_err(|_| Error::Other(format!("instance name '{name}' contains a NUL byte")))?;
-        let log = Arc::new(LogCtx {
+        if name.contains('\0') {
+            return Err(Error::Other(format!(
+                "instance name '{name}' contains a NUL byte"
+            )));
+        }
+        let log = Arc::new(LogCtx::new(name, sink, logging_on));
+        let slave = match backend.isolate {
+            Some(iso) => AnySlave::Isolated(Box::new(Client::spawn(
+                &self.path,
+                name,
+                logging_on,
+                log.clone(),
+                iso,
+                backend.interrupt,
+            )?)),
+            None => AnySlave::InProcess(InProcess::instantiate(
+                self,
+                name,
+                log.clone(),
+                backend.monitor,
+            )?),
+        };
+        let core = Core {
             name: name.to_string(),
-            sink,
-            recent: Mutex::new(VecDeque::new()),
-            debug_logging: logging_on,
-        });
-        let mut core = Box::new(Core {
-            name: name.to_string(),
-            lib: self.lib.clone(),
-            comp: std::ptr::null_mut(),
             phase: Phase::Instantiated,
-            _callbacks: None,
-            _target: None,
-            log: log.clone(),
-            _name_c: name_c,
+            log,
             fmu_path: self.path.clone(),
             missing_state_capability: missing_state_capability(self.co_simulation()),
-            remote: None,
-            monitor: None,
-        });
-        match backend.isolate {
-            Some(iso) => {
-                let c = Client::spawn(&self.path, name, logging_on, log, iso, backend.interrupt)?;
-                core.remote = Some(Box::new(c));
-            }
-            None => self.instantiate_here(&mut core, logging_on, backend.monitor)?,
-        }
-        let remote = match core.remote.as_mut() {
-            Some(r) => &mut **r as *mut Client,
-            None => std::ptr::null_mut(),
-        };
-        let (monitor, slot) = match &core.monitor {
-            Some((m, slot)) => (Arc::as_ptr(m), *slot),
-            None => (std::ptr::null(), 0),
         };
         Ok(Instance {
-            comp: core.comp,
-            api: self
-                .lib
-                .api
-                .as_ref()
-                .map_or(std::ptr::null(), |a| a as *const Api),
-            core,
-            remote,
-            monitor,
-            slot,
+            live: Live { slave, core },
             _s: PhantomData,
         })
-    }
-
-    /// `fmi2Instantiate` in this process into `core`.
-    fn instantiate_here(
-        &self,
-        core: &mut Core,
-        logging_on: bool,
-        monitor: Option<Arc<CallMonitor>>,
-    ) -> Result<()> {
-        let Some(api) = self.lib.api.as_ref() else {
-            return Err(Error::fmu(
-                &self.path,
-                format!(
-                    "instance '{}': the FMU was opened for isolated instances only (its binary is not loaded in this process)",
-                    core.name
-                ),
-            ));
-        };
-        let guid = CString::new(self.guid())
-            .map_err(|_| Error::fmu(&self.path, "GUID contains a NUL byte"))?;
-        let res = CString::new(self.resource_uri()).expect("no NUL in a path URI");
-        let mut target = Box::new(LogTarget {
-            sink: Some(log_sink),
-            ctx: Arc::as_ptr(&core.log) as *mut c_void,
-        });
-        let callbacks = Box::new(fmi2CallbackFunctions {
-            logger: logger_proxy(),
-            allocateMemory: Some(fmi_calloc),
-            freeMemory: Some(fmi_free),
-            stepFinished: None,
-            componentEnvironment: &mut *target as *mut LogTarget as *mut c_void,
-        });
-        let slot = monitor.as_ref().map(|m| m.register(&core.name));
-        let call = |logging_on: bool| unsafe {
-            if let (Some(m), Some(slot)) = (&monitor, slot) {
-                m.enter(slot, Op::Instantiate);
-            }
-            let c = (api.fmi2Instantiate)(
-                core._name_c.as_ptr(),
-                fmi2CoSimulation,
-                guid.as_ptr(),
-                res.as_ptr(),
-                &*callbacks,
-                fmi2False,
-                if logging_on { fmi2True } else { fmi2False },
-            );
-            if let Some(m) = &monitor {
-                m.leave();
-            }
-            c
-        };
-        let comp = call(logging_on);
-        if comp.is_null() {
-            return Err(self.instantiate_failed(&core.name, &core.log, call));
-        }
-        core.comp = comp;
-        core._callbacks = Some(callbacks);
-        core._target = Some(target);
-        core.monitor = monitor.zip(slot);
-        Ok(())
-    }
-}
-
-impl Fmu {
-    /// The error for a NULL from `fmi2Instantiate`, with what the FMU logged. If it logged
-    /// nothing with debug logging off, it is instantiated once more with loggingOn = fmi2True
-    /// (`again`) to learn why: some FMUs, PythonFMU's among them, report even their errors only
-    /// with debug logging on. Those messages reach the sink like any other (errors and warnings
-    /// are shown by default) and the error.
-    #[cold]
-    #[inline(never)]
-    fn instantiate_failed(
-        &self,
-        name: &str,
-        log: &LogCtx,
-        again: impl FnOnce(bool) -> fmi2Component,
-    ) -> Error {
-        let mut debug_logging = log.debug_logging;
-        let mut note = "";
-        if !debug_logging && log.is_empty() {
-            debug_logging = true;
-            let comp = again(true);
-            if !comp.is_null() {
-                // The failure with loggingOn = fmi2False stands; this instance is not used.
-                if let Some(api) = self.lib.api.as_ref() {
-                    unsafe { (api.fmi2FreeInstance)(comp) };
-                }
-                note = " (it succeeded with loggingOn = true)";
-            }
-        }
-        Error::fmu(
-            &self.path,
-            format!(
-                "fmi2Instantiate returned NULL for instance '{name}' (GUID \"{}\"){note}; FMU log: {}",
-                self.guid(),
-                log.recent_or_hint(debug_logging).join(" | ")
-            ),
-        )
     }
 
     /// The FMU can save and restore serialized states (canGetAndSetFMUstate and
@@ -544,90 +310,29 @@ impl Fmu {
     }
 }
 
-/// The raw FMI calls, in process or through the child's client: each returns the status (or
-/// [`GONE`]); the typed wrappers below check it.
-impl<S> Instance<S> {
-    /// The isolated instance's client.
-    #[inline(always)]
-    fn remote(&mut self) -> Option<&mut Client> {
-        // SAFETY: `remote` points into `core.remote`, a box that lives as long as the instance.
-        unsafe { self.remote.as_mut() }
-    }
-
-    /// Calls `f` with the function table and the component, noting the call in the monitor.
-    #[inline(always)]
-    fn local<T>(&self, op: Op, f: impl FnOnce(&Api, fmi2Component) -> T) -> T {
-        // SAFETY: `monitor` points into `core.monitor`, an `Arc` the instance holds.
-        match unsafe { self.monitor.as_ref() } {
-            None => f(self.api(), self.comp),
-            Some(m) => {
-                m.enter(self.slot, op);
-                let r = f(self.api(), self.comp);
-                m.leave();
-                r
-            }
-        }
-    }
-
-    /// fmi2EnterInitializationMode, fmi2ExitInitializationMode or fmi2Terminate.
-    fn raw_simple(&mut self, op: Op) -> fmi2Status {
-        match self.remote() {
-            Some(r) => r.simple(op),
-            None => self.local(op, |api, c| unsafe {
-                match op {
-                    Op::EnterInitializationMode => (api.fmi2EnterInitializationMode)(c),
-                    Op::ExitInitializationMode => (api.fmi2ExitInitializationMode)(c),
-                    _ => (api.fmi2Terminate)(c),
-                }
-            }),
-        }
-    }
-
-    /// The (name, component) pair the FMU host calls with ([`crate::isolate::host`]).
-    pub(crate) fn raw(&self) -> (&Api, fmi2Component) {
-        (self.api(), self.comp)
-    }
-
-    /// Drops the instance without another FMI call (the host, when its master left).
-    pub(crate) fn abandon(mut self) {
-        self.core.phase = Phase::Fatal;
-    }
-}
-
 impl<S> Instance<S> {
     pub fn name(&self) -> &str {
-        &self.core.name
+        &self.live.core.name
     }
 
     /// The process id of an isolated instance's host (None in process).
     pub fn host_pid(&self) -> Option<u32> {
-        self.core.remote.as_ref().map(|r| r.pid())
+        match &self.live.slave {
+            AnySlave::Isolated(c) => Some(c.pid()),
+            AnySlave::InProcess(_) => None,
+        }
     }
 
     fn transition<T>(self) -> Instance<T> {
         Instance {
-            core: self.core,
-            comp: self.comp,
-            api: self.api,
-            remote: self.remote,
-            monitor: self.monitor,
-            slot: self.slot,
+            live: self.live,
             _s: PhantomData,
         }
     }
 
-    /// The library's function table (only in process: `local` calls it).
-    #[inline(always)]
-    fn api(&self) -> &Api {
-        // SAFETY: `api` points into the `FmuLibrary` that `core.lib` (an `Arc`) keeps alive for
-        // as long as this instance exists; it is only read for an in-process instance, whose
-        // library is loaded.
-        unsafe { &*self.api }
-    }
-
     /// The last few log messages of this instance (for error reports).
     pub fn recent_log(&self) -> Vec<String> {
-        self.core.log.recent_lines()
+        self.live.core.log.recent_lines()
     }
 
     /// `fmi2SetReal`, batched.
@@ -637,13 +342,8 @@ impl<S> Instance<S> {
         if vrs.is_empty() {
             return Ok(());
         }
-        let s = match self.remote() {
-            Some(r) => r.set(Op::SetReal, vrs, values),
-            None => self.local(Op::SetReal, |api, c| unsafe {
-                (api.fmi2SetReal)(c, vrs.as_ptr(), vrs.len(), values.as_ptr())
-            }),
-        };
-        self.core.check("fmi2SetReal", s, None)
+        let s = self.live.slave.set_real(vrs, values);
+        self.live.check("fmi2SetReal", s, None)
     }
 
     /// `fmi2SetInteger`, batched.
@@ -652,13 +352,8 @@ impl<S> Instance<S> {
         if vrs.is_empty() {
             return Ok(());
         }
-        let s = match self.remote() {
-            Some(r) => r.set(Op::SetInteger, vrs, values),
-            None => self.local(Op::SetInteger, |api, c| unsafe {
-                (api.fmi2SetInteger)(c, vrs.as_ptr(), vrs.len(), values.as_ptr())
-            }),
-        };
-        self.core.check("fmi2SetInteger", s, None)
+        let s = self.live.slave.set_integer(vrs, values);
+        self.live.check("fmi2SetInteger", s, None)
     }
 
     /// `fmi2SetBoolean`, batched (values are fmi2Boolean, 0 or 1).
@@ -667,13 +362,8 @@ impl<S> Instance<S> {
         if vrs.is_empty() {
             return Ok(());
         }
-        let s = match self.remote() {
-            Some(r) => r.set(Op::SetBoolean, vrs, values),
-            None => self.local(Op::SetBoolean, |api, c| unsafe {
-                (api.fmi2SetBoolean)(c, vrs.as_ptr(), vrs.len(), values.as_ptr())
-            }),
-        };
-        self.core.check("fmi2SetBoolean", s, None)
+        let s = self.live.slave.set_boolean(vrs, values);
+        self.live.check("fmi2SetBoolean", s, None)
     }
 
     /// `fmi2SetString`.
@@ -685,16 +375,8 @@ impl<S> Instance<S> {
                     .map_err(|_| Error::Other(format!("string value {v:?} contains a NUL byte")))
             })
             .collect::<Result<_>>()?;
-        let s = match self.remote() {
-            Some(r) => r.set_string(vrs, values),
-            None => {
-                let ptrs: Vec<fmi2String> = cs.iter().map(|c| c.as_ptr()).collect();
-                self.local(Op::SetString, |api, c| unsafe {
-                    (api.fmi2SetString)(c, vrs.as_ptr(), vrs.len(), ptrs.as_ptr())
-                })
-            }
-        };
-        self.core.check("fmi2SetString", s, None)
+        let s = self.live.slave.set_string(vrs, &cs);
+        self.live.check("fmi2SetString", s, None)
     }
 }
 
@@ -706,13 +388,8 @@ impl<S: Readable> Instance<S> {
         if vrs.is_empty() {
             return Ok(());
         }
-        let s = match self.remote() {
-            Some(r) => r.get_real(vrs, out),
-            None => self.local(Op::GetReal, |api, c| unsafe {
-                (api.fmi2GetReal)(c, vrs.as_ptr(), vrs.len(), out.as_mut_ptr())
-            }),
-        };
-        self.core.check("fmi2GetReal", s, None)
+        let s = self.live.slave.get_real(vrs, out);
+        self.live.check("fmi2GetReal", s, None)
     }
 
     /// `fmi2GetInteger`, batched.
@@ -721,13 +398,8 @@ impl<S: Readable> Instance<S> {
         if vrs.is_empty() {
             return Ok(());
         }
-        let s = match self.remote() {
-            Some(r) => r.get_int(Op::GetInteger, vrs, out),
-            None => self.local(Op::GetInteger, |api, c| unsafe {
-                (api.fmi2GetInteger)(c, vrs.as_ptr(), vrs.len(), out.as_mut_ptr())
-            }),
-        };
-        self.core.check("fmi2GetInteger", s, None)
+        let s = self.live.slave.get_integer(vrs, out);
+        self.live.check("fmi2GetInteger", s, None)
     }
 
     /// `fmi2GetBoolean`, batched.
@@ -736,65 +408,28 @@ impl<S: Readable> Instance<S> {
         if vrs.is_empty() {
             return Ok(());
         }
-        let s = match self.remote() {
-            Some(r) => r.get_int(Op::GetBoolean, vrs, out),
-            None => self.local(Op::GetBoolean, |api, c| unsafe {
-                (api.fmi2GetBoolean)(c, vrs.as_ptr(), vrs.len(), out.as_mut_ptr())
-            }),
-        };
-        self.core.check("fmi2GetBoolean", s, None)
+        let s = self.live.slave.get_boolean(vrs, out);
+        self.live.check("fmi2GetBoolean", s, None)
     }
 
-    /// `fmi2GetString` into caller-owned strings, in batches of up to 32 value references
-    /// (the FMU owns its strings only until the next call, so each is copied into `out[i]`,
-    /// reusing its buffer: in process, no allocation once a buffer is as long as the text;
-    /// invalid UTF-8 is replaced by U+FFFD, a null pointer reads as ""). For recording String
-    /// variables from the step loop.
+    /// `fmi2GetString` into caller-owned strings (the FMU owns its strings only until the next
+    /// call, so each is copied into `out[i]`, reusing its buffer: in process, no allocation once
+    /// a buffer is as long as the text; invalid UTF-8 is replaced by U+FFFD, a null pointer
+    /// reads as ""). For recording String variables from the step loop.
     pub fn get_string_into(&mut self, vrs: &[VR], out: &mut [String]) -> Result<()> {
         debug_assert_eq!(vrs.len(), out.len());
         if vrs.is_empty() {
             return Ok(());
         }
-        if let Some(r) = self.remote() {
-            let (s, values) = r.get_string(vrs);
-            self.core.check("fmi2GetString", s, None)?;
-            for (o, v) in out.iter_mut().zip(values) {
-                *o = v;
-            }
-            return Ok(());
-        }
-        const BATCH: usize = 32;
-        for (vrs, out) in vrs.chunks(BATCH).zip(out.chunks_mut(BATCH)) {
-            let mut ptrs: [fmi2String; BATCH] = [std::ptr::null(); BATCH];
-            let s = self.local(Op::GetString, |api, c| unsafe {
-                (api.fmi2GetString)(c, vrs.as_ptr(), vrs.len(), ptrs.as_mut_ptr())
-            });
-            self.core.check("fmi2GetString", s, None)?;
-            for (o, p) in out.iter_mut().zip(&ptrs) {
-                o.clear();
-                if !p.is_null() {
-                    // SAFETY: a NUL-terminated string the FMU owns until its next call.
-                    o.push_str(&unsafe { std::ffi::CStr::from_ptr(*p) }.to_string_lossy());
-                }
-            }
-        }
-        Ok(())
+        let s = self.live.slave.get_string(vrs, out);
+        self.live.check("fmi2GetString", s, None)
     }
 
     /// `fmi2GetString` (copies the strings, which the FMU owns only until the next call).
     pub fn get_string(&mut self, vrs: &[VR]) -> Result<Vec<String>> {
-        let (s, values) = match self.remote() {
-            Some(r) => r.get_string(vrs),
-            None => {
-                let mut ptrs: Vec<fmi2String> = vec![std::ptr::null(); vrs.len()];
-                let s = self.local(Op::GetString, |api, c| unsafe {
-                    (api.fmi2GetString)(c, vrs.as_ptr(), vrs.len(), ptrs.as_mut_ptr())
-                });
-                (s, ptrs.iter().map(|p| unsafe { lossy_str(*p) }).collect())
-            }
-        };
-        self.core.check("fmi2GetString", s, None)?;
-        Ok(values)
+        let mut out = vec![String::new(); vrs.len()];
+        self.get_string_into(vrs, &mut out)?;
+        Ok(out)
     }
 }
 
@@ -806,29 +441,14 @@ impl Instance<Instantiated> {
         start_time: f64,
         stop_time: Option<f64>,
     ) -> Result<Instance<Initializing>> {
-        // SAFETY: as in `local`.
-        if let Some(m) = unsafe { self.monitor.as_ref() } {
-            m.at(start_time);
-        }
-        let s = match self.remote() {
-            Some(r) => r.setup_experiment(tolerance, start_time, stop_time),
-            None => self.local(Op::SetupExperiment, |api, c| unsafe {
-                (api.fmi2SetupExperiment)(
-                    c,
-                    tolerance.is_some() as fmi2Boolean,
-                    tolerance.unwrap_or(0.0),
-                    start_time,
-                    stop_time.is_some() as fmi2Boolean,
-                    stop_time.unwrap_or(0.0),
-                )
-            }),
-        };
-        self.core
-            .check("fmi2SetupExperiment", s, Some(start_time))?;
-        let s = self.raw_simple(Op::EnterInitializationMode);
-        self.core
-            .check("fmi2EnterInitializationMode", s, Some(start_time))?;
-        self.core.phase = Phase::Initializing;
+        let live = &mut self.live;
+        let s = live
+            .slave
+            .setup_experiment(tolerance, start_time, stop_time);
+        live.check("fmi2SetupExperiment", s, Some(start_time))?;
+        let s = live.slave.enter_initialization_mode();
+        live.check("fmi2EnterInitializationMode", s, Some(start_time))?;
+        live.core.phase = Phase::Initializing;
         Ok(self.transition())
     }
 }
@@ -836,9 +456,9 @@ impl Instance<Instantiated> {
 impl Instance<Initializing> {
     /// `fmi2ExitInitializationMode`: the slave is then at its first communication point.
     pub fn exit_initialization_mode(mut self) -> Result<Instance<Stepping>> {
-        let s = self.raw_simple(Op::ExitInitializationMode);
-        self.core.check("fmi2ExitInitializationMode", s, None)?;
-        self.core.phase = Phase::Initialized;
+        let s = self.live.slave.exit_initialization_mode();
+        self.live.check("fmi2ExitInitializationMode", s, None)?;
+        self.live.core.phase = Phase::Initialized;
         Ok(self.transition())
     }
 }
@@ -850,22 +470,7 @@ impl Instance<Stepping> {
     /// the instance, the time and the status, with the FMU's last log lines.
     #[inline(always)]
     pub fn do_step(&mut self, t: f64, h: f64) -> Result<StepOutcome> {
-        let s = match self.remote() {
-            Some(r) => r.do_step(t, h),
-            None => {
-                // SAFETY: as in `local`.
-                let monitor = unsafe { self.monitor.as_ref() };
-                if let Some(m) = monitor {
-                    m.enter_step(self.slot, t);
-                }
-                let s = unsafe { (self.api().fmi2DoStep)(self.comp, t, h, fmi2True) };
-                if let Some(m) = monitor {
-                    m.at(t + h);
-                    m.leave();
-                }
-                s
-            }
-        };
+        let s = self.live.slave.do_step(t, h);
         if s == fmi2OK || s == fmi2Warning {
             return Ok(StepOutcome::Ok);
         }
@@ -877,40 +482,20 @@ impl Instance<Stepping> {
     #[cold]
     #[inline(never)]
     fn step_not_ok(&mut self, t: f64, s: fmi2Status) -> Result<StepOutcome> {
+        let answered = |st: fmi2Status| st == fmi2OK || st == fmi2Warning;
         if s == fmi2Discard {
-            let (st, terminated) = self.status_query(Op::GetBooleanStatus, fmi2Terminated);
-            if (fmi2OK..=fmi2Warning).contains(&st) && terminated != 0.0 {
-                let (st, last) = self.status_query(Op::GetRealStatus, fmi2LastSuccessfulTime);
-                let last = match (fmi2OK..=fmi2Warning).contains(&st) {
-                    true => last,
-                    false => t,
-                };
-                self.core.phase = Phase::Initialized;
+            let (st, terminated) = self.live.slave.terminated();
+            if answered(st) && terminated {
+                let (st, last) = self.live.slave.last_successful_time();
+                let last = if answered(st) { last } else { t };
+                self.live.core.phase = Phase::Initialized;
                 return Ok(StepOutcome::Terminated {
                     last_successful_time: last,
                 });
             }
         }
-        self.core.check("fmi2DoStep", s, Some(t))?;
-        Err(self.core.fmi_error("fmi2DoStep", s, Some(t)))
-    }
-
-    /// fmi2GetBooleanStatus (as 0.0 or 1.0) or fmi2GetRealStatus of `kind`.
-    fn status_query(&mut self, op: Op, kind: fmi2StatusKind) -> (fmi2Status, f64) {
-        if let Some(r) = self.remote() {
-            return r.status_query(op, kind);
-        }
-        self.local(op, |api, c| unsafe {
-            if op == Op::GetBooleanStatus {
-                let mut v: fmi2Boolean = fmi2False;
-                let s = (api.fmi2GetBooleanStatus)(c, kind, &mut v);
-                (s, (v != fmi2False) as i32 as f64)
-            } else {
-                let mut v = 0.0;
-                let s = (api.fmi2GetRealStatus)(c, kind, &mut v);
-                (s, v)
-            }
-        })
+        self.live.check("fmi2DoStep", s, Some(t))?;
+        Err(self.live.fmi_error("fmi2DoStep", s, Some(t)))
     }
 
     /// The instance's complete state as bytes (FMI 2.0, sec. 2.1.8): `fmi2GetFMUstate`,
@@ -920,18 +505,8 @@ impl Instance<Stepping> {
     /// canSerializeFMUstate is refused before any call.
     pub fn serialize_state(&mut self) -> Result<Vec<u8>> {
         self.require_state_support()?;
-        let mut state: fmi2FMUstate = std::ptr::null_mut();
-        let s = match self.remote() {
-            Some(r) => {
-                let (s, h) = r.state_call(Op::GetFmuState, 0, 0);
-                state = h as usize as fmi2FMUstate;
-                s
-            }
-            None => self.local(Op::GetFmuState, |api, c| unsafe {
-                (api.fmi2GetFMUstate)(c, &mut state)
-            }),
-        };
-        if let Err(e) = self.core.check("fmi2GetFMUstate", s, None) {
+        let (s, mut state) = self.live.slave.get_state();
+        if let Err(e) = self.live.check("fmi2GetFMUstate", s, None) {
             let _ = self.free_state(&mut state);
             return Err(e);
         }
@@ -946,33 +521,13 @@ impl Instance<Stepping> {
     /// `fmi2DeSerializeFMUstate`, `fmi2SetFMUstate`, then `fmi2FreeFMUstate`.
     pub fn restore_state(&mut self, bytes: &[u8]) -> Result<()> {
         self.require_state_support()?;
-        let mut state: fmi2FMUstate = std::ptr::null_mut();
-        let s = match self.remote() {
-            Some(r) => {
-                let (s, h) = r.deserialize(bytes);
-                state = h as usize as fmi2FMUstate;
-                s
-            }
-            None => self.local(Op::Deserialize, |api, c| unsafe {
-                (api.fmi2DeSerializeFMUstate)(
-                    c,
-                    bytes.as_ptr() as *const fmi2Byte,
-                    bytes.len(),
-                    &mut state,
-                )
-            }),
-        };
-        if let Err(e) = self.core.check("fmi2DeSerializeFMUstate", s, None) {
+        let (s, mut state) = self.live.slave.deserialize(bytes);
+        if let Err(e) = self.live.check("fmi2DeSerializeFMUstate", s, None) {
             let _ = self.free_state(&mut state);
             return Err(e);
         }
-        let s = match self.remote() {
-            Some(r) => r.state_call(Op::SetFmuState, state as usize as u64, 0).0,
-            None => self.local(Op::SetFmuState, |api, c| unsafe {
-                (api.fmi2SetFMUstate)(c, state)
-            }),
-        };
-        let set = self.core.check("fmi2SetFMUstate", s, None);
+        let s = self.live.slave.set_state(state);
+        let set = self.live.check("fmi2SetFMUstate", s, None);
         let freed = self.free_state(&mut state);
         set?;
         freed
@@ -980,86 +535,53 @@ impl Instance<Stepping> {
 
     /// The FMU declares both FMU-state capabilities, else an error naming the FMU.
     fn require_state_support(&self) -> Result<()> {
-        match self.core.missing_state_capability {
+        let core = &self.live.core;
+        match core.missing_state_capability {
             None => Ok(()),
-            Some(cap) => Err(state_support_error(
-                &self.core.fmu_path,
-                &self.core.name,
-                cap,
-            )),
+            Some(cap) => Err(state_support_error(&core.fmu_path, &core.name, cap)),
         }
     }
 
     /// Serializes a state got by `fmi2GetFMUstate`.
-    fn serialize_held(&mut self, state: fmi2FMUstate) -> Result<Vec<u8>> {
-        let mut size = 0usize;
-        let s = match self.remote() {
-            Some(r) => {
-                let (s, n) = r.state_call(Op::SerializedSize, state as usize as u64, 0);
-                size = n as usize;
-                s
-            }
-            None => self.local(Op::SerializedSize, |api, c| unsafe {
-                (api.fmi2SerializedFMUstateSize)(c, state, &mut size)
-            }),
-        };
-        self.core.check("fmi2SerializedFMUstateSize", s, None)?;
+    fn serialize_held(&mut self, state: StateHandle) -> Result<Vec<u8>> {
+        let (s, size) = self.live.slave.serialized_size(state);
+        self.live.check("fmi2SerializedFMUstateSize", s, None)?;
         if size > MAX_STATE_BYTES {
             return Err(Error::Other(format!(
                 "instance '{}': fmi2SerializedFMUstateSize reported {size} bytes, more than the {MAX_STATE_BYTES} accepted",
-                self.core.name
+                self.live.core.name
             )));
         }
-        let (s, bytes) = match self.remote() {
-            Some(r) => r.serialize(state as usize as u64, size),
-            None => {
-                let mut bytes = vec![0u8; size];
-                let s = self.local(Op::Serialize, |api, c| unsafe {
-                    (api.fmi2SerializeFMUstate)(c, state, bytes.as_mut_ptr() as *mut fmi2Byte, size)
-                });
-                (s, bytes)
-            }
-        };
-        self.core.check("fmi2SerializeFMUstate", s, None)?;
+        let (s, bytes) = self.live.slave.serialize(state, size);
+        self.live.check("fmi2SerializeFMUstate", s, None)?;
         if bytes.len() != size {
             return Err(Error::Other(format!(
                 "instance '{}': fmi2SerializeFMUstate gave {} bytes, expected {size}",
-                self.core.name,
+                self.live.core.name,
                 bytes.len()
             )));
         }
         Ok(bytes)
     }
 
-    /// `fmi2FreeFMUstate` of a state the FMU handed out (nothing for NULL or after fmi2Fatal).
-    fn free_state(&mut self, state: &mut fmi2FMUstate) -> Result<()> {
-        if state.is_null() || self.core.phase == Phase::Fatal {
+    /// `fmi2FreeFMUstate` of a state the FMU handed out (nothing for none or after fmi2Fatal).
+    fn free_state(&mut self, state: &mut StateHandle) -> Result<()> {
+        if *state == 0 || self.live.core.phase == Phase::Fatal {
             return Ok(());
         }
-        let s = match self.remote() {
-            Some(r) => {
-                let (s, h) = r.state_call(Op::FreeFmuState, *state as usize as u64, 0);
-                *state = h as usize as fmi2FMUstate;
-                s
-            }
-            None => self.local(Op::FreeFmuState, |api, c| unsafe {
-                (api.fmi2FreeFMUstate)(c, state)
-            }),
-        };
-        self.core.check("fmi2FreeFMUstate", s, None)
+        let (s, left) = self.live.slave.free_state(*state);
+        *state = left;
+        self.live.check("fmi2FreeFMUstate", s, None)
     }
 
-    /// `fmi2Terminate` then `fmi2FreeInstance` (for an isolated instance the free is checked
-    /// too: its process may die in it).
+    /// `fmi2Terminate` then `fmi2FreeInstance`, both checked (an isolated instance's process
+    /// may die in either).
     pub fn terminate(mut self) -> Result<()> {
-        let s = self.raw_simple(Op::Terminate);
-        self.core.phase = Phase::Terminated;
-        self.core.check("fmi2Terminate", s, None)?;
-        if let Some(r) = self.remote() {
-            let s = r.free_instance();
-            self.core.phase = Phase::Freed;
-            self.core.check("fmi2FreeInstance", s, None)?;
-        }
-        Ok(())
+        let s = self.live.slave.terminate();
+        self.live.core.phase = Phase::Terminated;
+        self.live.check("fmi2Terminate", s, None)?;
+        let s = self.live.slave.free_instance();
+        self.live.core.phase = Phase::Freed;
+        self.live.check("fmi2FreeInstance", s, None)
     }
 }

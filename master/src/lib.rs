@@ -33,9 +33,11 @@ pub mod inspect;
 pub mod instance;
 pub mod isolate;
 pub mod limits;
+pub mod log;
 pub mod model_description;
 pub mod plot;
 pub mod run;
+pub mod slave;
 pub mod system;
 pub mod units;
 

@@ -8,7 +8,7 @@
 mod common;
 use common::*;
 use shipsim::fmu::Fmu;
-use shipsim::instance::LogRecord;
+use shipsim::log::LogRecord;
 use std::process::Command;
 use std::sync::{Arc, Mutex};
 

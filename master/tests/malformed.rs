@@ -164,7 +164,7 @@ fn wrong_guid() {
         },
     );
     let fmu = Fmu::load(&p).unwrap();
-    let e = match fmu.instantiate("inst1", false, shipsim::instance::stderr_sink(false)) {
+    let e = match fmu.instantiate("inst1", false, shipsim::log::stderr_sink(false)) {
         Ok(_) => panic!("instantiated with a wrong GUID"),
         Err(e) => e.to_string(),
     };

@@ -2,7 +2,7 @@
 //! events, gain/offset, Integer/Boolean connections, logging, CLI run and Ctrl-C.
 mod common;
 use common::*;
-use shipsim::instance::LogRecord;
+use shipsim::log::LogRecord;
 use shipsim::run::{run_system, Output, RunOptions};
 use shipsim::system::System;
 use std::process::Command;

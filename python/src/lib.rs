@@ -23,7 +23,7 @@ use shipsim::campaign::table::{ColumnData, Table};
 use shipsim::campaign::{Campaign, Run};
 use shipsim::error::{did_you_mean, Error};
 use shipsim::fmu::{Fmu, UnpackedFmu};
-use shipsim::instance::{LogRecord, LogSink};
+use shipsim::log::{LogRecord, LogSink};
 use shipsim::model_description::{ModelDescription, ScalarVariable, VarType};
 use shipsim::run::{self, MemoryRecorder, RunOptions, Summary};
 use shipsim::system::{System, Value, VarRef};

@@ -13,10 +13,12 @@
 //!   (docs/fuzzing.md); its fixed-seed suite is a step of `test`.
 //! * `artifacts DIR` / `artifacts --compare A B`: captures the model descriptions, documentation,
 //!   system CSVs and report of a commit and compares two captures byte for byte (see artifacts.rs).
+//! * `lint`: the lint step of `test`: the master's layers (layers.rs), rustfmt, clippy.
 
 mod artifacts;
 mod fmu;
 mod fuzz;
+mod layers;
 
 use anyhow::{bail, Context, Result};
 use std::path::{Path, PathBuf};
@@ -34,6 +36,7 @@ fn main() {
         Some("export-ssp") => export_ssp(),
         Some("wheel") => wheel(),
         Some("artifacts") => artifacts::main(&args[1..]),
+        Some("lint") => lint(&workspace_root()),
         Some("fuzz") => fuzz::main(&args[1..]),
         _ => {
             eprintln!(
@@ -49,7 +52,8 @@ fn main() {
                  bench        master overhead vs libcosim and FMPy, every system's speed and profile, campaigns (docs/bench.md)\n  \
                  fuzz --minutes N [--seed S]  seeded FMI and file fuzzing for N minutes (target/fuzz)\n  \
                  artifacts DIR          FMU model descriptions, system CSVs and report into DIR\n  \
-                 artifacts --compare A B  byte-compare two artifact folders (refactor check)"
+                 artifacts --compare A B  byte-compare two artifact folders (refactor check)\n  \
+                 lint         the master's layers (no import cycle, no file over 1,000 lines), rustfmt, clippy"
             );
             std::process::exit(2);
         }
@@ -201,10 +205,13 @@ fn test(extra: &[String]) -> Result<()> {
     Ok(())
 }
 
-/// Formatting (rustfmt, whole workspace) and the master's function-length rule: no function in
+/// The master's seams (no import cycle, no file over 1,000 lines: layers.rs), formatting
+/// (rustfmt, whole workspace) and the master's function-length rule: no function in
 /// `master/src` over 100 lines (`master/clippy.toml`), so that each concern stays readable in
 /// one screen.
 fn lint(root: &Path) -> Result<()> {
+    eprintln!("xtask: no import cycle and no file over 1,000 lines in master/src");
+    layers::check(root)?;
     for (tool, component) in [("fmt", "rustfmt"), ("clippy", "clippy")] {
         let found = cargo().args([tool, "--version"]).output();
         if !found.map(|o| o.status.success()).unwrap_or(false) {

@@ -12,7 +12,8 @@
 //!   its normal error path.
 
 use shipsim::error::Error;
-use shipsim::isolate::{CallMonitor, IsolateMode, Isolation};
+use shipsim::isolate::{IsolateMode, Isolation};
+use shipsim::slave::CallMonitor;
 use std::sync::{Arc, OnceLock};
 use std::time::{Duration, Instant};
 

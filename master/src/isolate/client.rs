@@ -1,17 +1,21 @@
 //! The master's end of an isolated instance: the `shipsim fmu-host` child process and the two
-//! pipes to it ([`super::protocol`]). [`crate::instance`] calls these methods instead of the
-//! FMU's functions; each returns the fmi2Status the FMU returned, or [`GONE`] when the child
-//! died, hung past the call time limit or was interrupted ([`Client::error`] then says which).
+//! pipes to it ([`super::protocol`]). [`Client`] is the out-of-process [`Slave`]: each call is
+//! one request, answered by the host's in-process slave; each returns the fmi2Status the FMU
+//! returned, or [`GONE`] when the child died, hung past the call time limit or was interrupted
+//! ([`Client::error`] then says which).
 //!
 //! The request and reply buffers are allocated once: a call whose arguments and results fit
 //! the buffers (every call of the step loop after its first) allocates nothing. Log messages
 //! from the child are the exception: they are delivered to the instance's log sink as they come.
 
-use super::protocol::{self, Op, Put, Reader, HEADER, LOG, MAX_FRAME, REPLY};
+use super::protocol::{self, Put, Reader, HEADER, LOG, MAX_FRAME, REPLY};
 use super::Isolation;
 use crate::error::{Error, Result};
-use crate::instance::LogCtx;
+use crate::fmu::VR;
+use crate::log::LogCtx;
+use crate::slave::{Op, Slave, StateHandle, GONE};
 use fmi2::fmi2Status;
+use std::ffi::CString;
 use std::io::{Read, Write};
 use std::os::fd::AsRawFd;
 use std::os::unix::process::{CommandExt, ExitStatusExt};
@@ -20,9 +24,6 @@ use std::process::{Child, ChildStdin, ChildStdout, Command, ExitStatus, Stdio};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
-
-/// The status of a call that got no reply: the child is gone ([`Client::error`]).
-pub const GONE: fmi2Status = -0x4000;
 
 /// How long the master waits between checks of the interrupt flag while a call runs.
 const SLICE_MS: i32 = 100;
@@ -435,10 +436,11 @@ fn describe(status: Option<ExitStatus>) -> String {
     }
 }
 
-/// The raw FMI calls, one request each (FMI 2.0, sec. 2.1 and 4.2). The arguments and results
-/// are those of the C functions; FMU states are handles into the child.
-impl Client {
-    pub fn setup_experiment(&mut self, tol: Option<f64>, start: f64, stop: Option<f64>) -> i32 {
+/// The FMI calls, one request each (FMI 2.0, sec. 2.1 and 4.2). The arguments and results are
+/// those of the C functions; FMU states are handles into the child. The calls of the step loop
+/// are out of line, so that the in-process path of an instance's calls stays small.
+impl Slave for Client {
+    fn setup_experiment(&mut self, tol: Option<f64>, start: f64, stop: Option<f64>) -> fmi2Status {
         self.time = start;
         self.request(Op::SetupExperiment, |o| {
             (tol.is_some() as i32).put(o);
@@ -449,13 +451,16 @@ impl Client {
         })
     }
 
-    pub fn simple(&mut self, op: Op) -> i32 {
-        self.request(op, |_| {})
+    fn enter_initialization_mode(&mut self) -> fmi2Status {
+        self.request(Op::EnterInitializationMode, |_| {})
     }
 
-    // Out of line: the in-process path of the instance's calls stays small.
+    fn exit_initialization_mode(&mut self) -> fmi2Status {
+        self.request(Op::ExitInitializationMode, |_| {})
+    }
+
     #[inline(never)]
-    pub fn do_step(&mut self, t: f64, h: f64) -> i32 {
+    fn do_step(&mut self, t: f64, h: f64) -> fmi2Status {
         self.time = t;
         let s = self.request(Op::DoStep, |o| {
             t.put(o);
@@ -467,92 +472,16 @@ impl Client {
         s
     }
 
-    // Out of line: the in-process path of the instance's calls stays small.
-    #[inline(never)]
-    pub fn set<T: Copy>(&mut self, op: Op, vrs: &[u32], values: &[T]) -> i32
-    where
-        for<'a> &'a [T]: Put,
-    {
-        self.request(op, |o| {
-            (vrs.len() as u32).put(o);
-            vrs.put(o);
-            values.put(o);
-        })
-    }
-
-    // Out of line: the in-process path of the instance's calls stays small.
-    #[inline(never)]
-    pub fn get_real(&mut self, vrs: &[u32], out: &mut [f64]) -> i32 {
-        let s = self.get(Op::GetReal, vrs);
-        self.results().fill(out, Reader::f64);
-        s
-    }
-
-    // Out of line: the in-process path of the instance's calls stays small.
-    #[inline(never)]
-    pub fn get_int(&mut self, op: Op, vrs: &[u32], out: &mut [i32]) -> i32 {
-        let s = self.get(op, vrs);
-        self.results().fill(out, Reader::i32);
-        s
-    }
-
-    fn get(&mut self, op: Op, vrs: &[u32]) -> i32 {
-        self.request(op, |o| {
-            (vrs.len() as u32).put(o);
-            vrs.put(o);
-        })
-    }
-
-    pub fn set_string(&mut self, vrs: &[u32], values: &[&str]) -> i32 {
-        self.request(Op::SetString, |o| {
-            (vrs.len() as u32).put(o);
-            vrs.put(o);
-            for v in values {
-                v.put(o);
-            }
-        })
-    }
-
-    pub fn get_string(&mut self, vrs: &[u32]) -> (i32, Vec<String>) {
-        let s = self.get(Op::GetString, vrs);
-        let mut r = self.results();
-        (s, vrs.iter().map(|_| r.string()).collect())
-    }
-
-    /// fmi2GetBooleanStatus / fmi2GetRealStatus of `kind`: the status and the value as f64.
-    pub fn status_query(&mut self, op: Op, kind: i32) -> (i32, f64) {
-        let s = self.request(op, |o| kind.put(o));
-        (s, self.results().f64())
-    }
-
-    /// A call on an FMU state handle (or none) that returns a handle or size as u64.
-    pub fn state_call(&mut self, op: Op, handle: u64, arg: u64) -> (i32, u64) {
-        let s = self.request(op, |o| {
-            handle.put(o);
-            arg.put(o);
-        });
-        (s, self.results().u64())
-    }
-
-    pub fn serialize(&mut self, handle: u64, size: usize) -> (i32, Vec<u8>) {
-        let s = self.request(Op::Serialize, |o| {
-            handle.put(o);
-            (size as u64).put(o);
-        });
-        (s, self.results().bytes().to_vec())
-    }
-
-    pub fn deserialize(&mut self, bytes: &[u8]) -> (i32, u64) {
-        let s = self.request(Op::Deserialize, |o| bytes.put(o));
-        (s, self.results().u64())
+    fn terminate(&mut self) -> fmi2Status {
+        self.request(Op::Terminate, |_| {})
     }
 
     /// fmi2FreeInstance: the child frees the instance and exits.
-    pub fn free_instance(&mut self) -> i32 {
+    fn free_instance(&mut self) -> fmi2Status {
         if self.freed || self.failure.is_some() {
             return fmi2::fmi2OK;
         }
-        let s = self.simple(Op::FreeInstance);
+        let s = self.request(Op::FreeInstance, |_| {});
         if s != GONE {
             self.freed = true;
             let status = self.reap();
@@ -563,5 +492,134 @@ impl Client {
             self.failure = Some(Failure::Closed);
         }
         s
+    }
+
+    #[inline(never)]
+    fn set_real(&mut self, vrs: &[VR], values: &[f64]) -> fmi2Status {
+        self.set(Op::SetReal, vrs, values)
+    }
+
+    #[inline(never)]
+    fn set_integer(&mut self, vrs: &[VR], values: &[i32]) -> fmi2Status {
+        self.set(Op::SetInteger, vrs, values)
+    }
+
+    #[inline(never)]
+    fn set_boolean(&mut self, vrs: &[VR], values: &[i32]) -> fmi2Status {
+        self.set(Op::SetBoolean, vrs, values)
+    }
+
+    fn set_string(&mut self, vrs: &[VR], values: &[CString]) -> fmi2Status {
+        self.request(Op::SetString, |o| {
+            (vrs.len() as u32).put(o);
+            vrs.put(o);
+            for v in values {
+                v.as_bytes().put(o);
+            }
+        })
+    }
+
+    #[inline(never)]
+    fn get_real(&mut self, vrs: &[VR], out: &mut [f64]) -> fmi2Status {
+        let s = self.get(Op::GetReal, vrs);
+        self.results().fill(out, Reader::f64);
+        s
+    }
+
+    #[inline(never)]
+    fn get_integer(&mut self, vrs: &[VR], out: &mut [i32]) -> fmi2Status {
+        let s = self.get(Op::GetInteger, vrs);
+        self.results().fill(out, Reader::i32);
+        s
+    }
+
+    #[inline(never)]
+    fn get_boolean(&mut self, vrs: &[VR], out: &mut [i32]) -> fmi2Status {
+        let s = self.get(Op::GetBoolean, vrs);
+        self.results().fill(out, Reader::i32);
+        s
+    }
+
+    fn get_string(&mut self, vrs: &[VR], out: &mut [String]) -> fmi2Status {
+        let s = self.get(Op::GetString, vrs);
+        let mut r = self.results();
+        for o in out.iter_mut() {
+            *o = r.string();
+        }
+        s
+    }
+
+    fn terminated(&mut self) -> (fmi2Status, bool) {
+        let s = self.request(Op::GetBooleanStatus, |_| {});
+        (s, self.results().i32() != 0)
+    }
+
+    fn last_successful_time(&mut self) -> (fmi2Status, f64) {
+        let s = self.request(Op::GetRealStatus, |_| {});
+        (s, self.results().f64())
+    }
+
+    fn get_state(&mut self) -> (fmi2Status, StateHandle) {
+        self.state_call(Op::GetFmuState, 0, 0)
+    }
+
+    fn set_state(&mut self, state: StateHandle) -> fmi2Status {
+        self.state_call(Op::SetFmuState, state, 0).0
+    }
+
+    fn free_state(&mut self, state: StateHandle) -> (fmi2Status, StateHandle) {
+        self.state_call(Op::FreeFmuState, state, 0)
+    }
+
+    fn serialized_size(&mut self, state: StateHandle) -> (fmi2Status, usize) {
+        let (s, n) = self.state_call(Op::SerializedSize, state, 0);
+        (s, n as usize)
+    }
+
+    fn serialize(&mut self, state: StateHandle, size: usize) -> (fmi2Status, Vec<u8>) {
+        let s = self.state_call(Op::Serialize, state, size as u64).0;
+        (s, self.results().bytes().to_vec())
+    }
+
+    fn deserialize(&mut self, bytes: &[u8]) -> (fmi2Status, StateHandle) {
+        let s = self.request(Op::Deserialize, |o| bytes.put(o));
+        (s, self.results().u64())
+    }
+
+    fn lost(&self) -> Option<Error> {
+        self.failure.as_ref().map(|_| self.error())
+    }
+}
+
+impl Client {
+    fn set<T: Copy>(&mut self, op: Op, vrs: &[u32], values: &[T]) -> fmi2Status
+    where
+        for<'a> &'a [T]: Put,
+    {
+        self.request(op, |o| {
+            (vrs.len() as u32).put(o);
+            vrs.put(o);
+            values.put(o);
+        })
+    }
+
+    fn get(&mut self, op: Op, vrs: &[u32]) -> fmi2Status {
+        self.request(op, |o| {
+            (vrs.len() as u32).put(o);
+            vrs.put(o);
+        })
+    }
+
+    /// A call on an FMU state handle (or none) with a u64 argument that returns a handle or a
+    /// size as u64 (the serialized bytes of [`Op::Serialize`] are in the results).
+    fn state_call(&mut self, op: Op, handle: StateHandle, arg: u64) -> (fmi2Status, u64) {
+        let s = self.request(op, |o| {
+            handle.put(o);
+            arg.put(o);
+        });
+        if op == Op::Serialize {
+            return (s, 0);
+        }
+        (s, self.results().u64())
     }
 }

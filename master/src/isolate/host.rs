@@ -8,9 +8,10 @@
 //! descriptors first, and stdout is pointed at stderr, so whatever the FMU prints cannot
 //! corrupt the replies. On Linux the host dies with its master (PR_SET_PDEATHSIG).
 
-use super::protocol::{self, Op, Put, Reader, HEADER, LOG, MAX_FRAME, REPLY};
-use crate::fmu::{Api, Fmu};
-use crate::instance::{Instance, Instantiated, LogRecord, LogSink};
+use super::protocol::{self, Put, Reader, HEADER, LOG, MAX_FRAME, REPLY};
+use crate::fmu::Fmu;
+use crate::log::{LogCtx, LogRecord, LogSink};
+use crate::slave::{InProcess, Op, Slave, MAX_STATE_BYTES};
 use fmi2::*;
 use std::ffi::CString;
 use std::fs::File;
@@ -18,9 +19,6 @@ use std::io::{BufReader, BufWriter, Read, Write};
 use std::os::fd::FromRawFd;
 use std::path::Path;
 use std::sync::{Arc, Mutex};
-
-/// The largest serialized state a host hands out (as [`crate::instance`] accepts).
-const MAX_STATE_BYTES: u64 = 1 << 30;
 
 type Out = Arc<Mutex<BufWriter<File>>>;
 
@@ -43,7 +41,8 @@ pub fn serve(fmu: &Path) -> i32 {
     let name = r.string();
     let logging_on = r.i32() != 0;
     let loaded = Fmu::load(fmu).and_then(|f| {
-        let inst = f.instantiate(&name, logging_on, log_sink(output.clone()))?;
+        let log = Arc::new(LogCtx::new(&name, log_sink(output.clone()), logging_on));
+        let inst = InProcess::instantiate(&f, &name, log, None)?;
         Ok((f, inst))
     });
     let (fmu, inst) = match loaded {
@@ -57,21 +56,20 @@ pub fn serve(fmu: &Path) -> i32 {
     reply(&output, fmi2OK, |o| dir.as_str().put(o));
     let mut host = Host {
         out: output,
-        inst: Some(inst),
+        inst,
         vrs: Vec::new(),
         reals: Vec::new(),
         ints: Vec::new(),
+        strings: Vec::new(),
     };
     while let Some(op) = read_frame(&mut input, &mut payload) {
         if !host.call(op, &payload) {
             break;
         }
     }
-    if let Some(inst) = host.inst.take() {
-        // The master left without fmi2FreeInstance: no more FMI calls (after fmi2Fatal none
-        // is allowed).
-        inst.abandon();
-    }
+    // The instance is dropped without another FMI call: freed on request, or the master left
+    // without fmi2FreeInstance (after fmi2Fatal none is allowed).
+    drop(host);
     drop(fmu);
     0
 }
@@ -151,10 +149,12 @@ fn log_sink(out: Out) -> LogSink {
 
 struct Host {
     out: Out,
-    inst: Option<Instance<Instantiated>>,
+    /// The instance, served through the same in-process slave the master uses.
+    inst: InProcess,
     vrs: Vec<fmi2ValueReference>,
     reals: Vec<f64>,
     ints: Vec<i32>,
+    strings: Vec<String>,
 }
 
 impl Host {
@@ -163,175 +163,136 @@ impl Host {
         let Some(op) = Op::from_u32(op) else {
             return false;
         };
-        if op == Op::FreeInstance {
-            drop(self.inst.take());
-            reply(&self.out, fmi2OK, |_| {});
-            return false;
-        }
-        let Some(inst) = self.inst.as_ref() else {
-            return false;
-        };
-        let (api, c) = inst.raw();
-        // The table lives in the loaded library, which outlives this call.
-        let api: *const Api = api;
         let mut r = Reader::new(payload);
-        // SAFETY: the calls of FMI 2.0 with the arguments the master sent, on the instance
-        // this host made; buffers are sized to the counts passed.
-        unsafe {
-            let api = &*api;
-            match op {
-                Op::SetupExperiment => {
-                    let (td, tol, t0, sd, stop) = (r.i32(), r.f64(), r.f64(), r.i32(), r.f64());
-                    let s = (api.fmi2SetupExperiment)(c, td, tol, t0, sd, stop);
-                    reply(&self.out, s, |_| {});
-                    true
-                }
-                Op::EnterInitializationMode => self.simple((api.fmi2EnterInitializationMode)(c)),
-                Op::ExitInitializationMode => self.simple((api.fmi2ExitInitializationMode)(c)),
-                Op::Terminate => self.simple((api.fmi2Terminate)(c)),
-                Op::DoStep => {
-                    let (t, h) = (r.f64(), r.f64());
-                    self.simple((api.fmi2DoStep)(c, t, h, fmi2True))
-                }
-                _ => self.values(api, c, op, r),
+        let inst = &mut self.inst;
+        let s = match op {
+            Op::FreeInstance => {
+                let s = inst.free_instance();
+                reply(&self.out, s, |_| {});
+                return false;
             }
-        }
-    }
-
-    fn simple(&self, s: fmi2Status) -> bool {
+            Op::SetupExperiment => {
+                let (td, tol, t0, sd, stop) = (r.i32(), r.f64(), r.f64(), r.i32(), r.f64());
+                inst.setup_experiment((td != 0).then_some(tol), t0, (sd != 0).then_some(stop))
+            }
+            Op::EnterInitializationMode => inst.enter_initialization_mode(),
+            Op::ExitInitializationMode => inst.exit_initialization_mode(),
+            Op::Terminate => inst.terminate(),
+            Op::DoStep => {
+                let (t, h) = (r.f64(), r.f64());
+                inst.do_step(t, h)
+            }
+            Op::GetBooleanStatus => {
+                let (s, terminated) = inst.terminated();
+                reply(&self.out, s, |o| (terminated as i32).put(o));
+                return true;
+            }
+            Op::GetRealStatus => {
+                let (s, t) = inst.last_successful_time();
+                reply(&self.out, s, |o| t.put(o));
+                return true;
+            }
+            Op::SetString => return self.set_string(r),
+            Op::GetString => return self.get_string(r),
+            Op::SetReal | Op::SetInteger | Op::SetBoolean => return self.set(op, r),
+            Op::GetReal | Op::GetInteger | Op::GetBoolean => return self.get(op, r),
+            _ => return self.state(op, r),
+        };
         reply(&self.out, s, |_| {});
         true
     }
 
-    /// The calls that move values or states.
-    unsafe fn values(&mut self, api: &Api, c: fmi2Component, op: Op, mut r: Reader) -> bool {
-        match op {
-            Op::SetReal
-            | Op::SetInteger
-            | Op::SetBoolean
-            | Op::GetReal
-            | Op::GetInteger
-            | Op::GetBoolean => self.batch(api, c, op, r),
-            Op::SetString => {
-                self.read_vrs(&mut r);
-                let cs: Vec<CString> = self
-                    .vrs
-                    .iter()
-                    .map(|_| CString::new(r.bytes()).unwrap_or_default())
-                    .collect();
-                let ptrs: Vec<fmi2String> = cs.iter().map(|s| s.as_ptr()).collect();
-                let n = self.vrs.len().min(ptrs.len());
-                self.simple((api.fmi2SetString)(c, self.vrs.as_ptr(), n, ptrs.as_ptr()))
-            }
-            Op::GetString => {
-                self.read_vrs(&mut r);
-                let mut ptrs: Vec<fmi2String> = vec![std::ptr::null(); self.vrs.len()];
-                let s = (api.fmi2GetString)(c, self.vrs.as_ptr(), ptrs.len(), ptrs.as_mut_ptr());
-                reply(&self.out, s, |o| {
-                    for p in &ptrs {
-                        lossy_str(*p).as_str().put(o);
-                    }
-                });
-                true
-            }
-            Op::GetBooleanStatus => {
-                let mut v: fmi2Boolean = fmi2False;
-                let s = (api.fmi2GetBooleanStatus)(c, r.i32(), &mut v);
-                reply(&self.out, s, |o| (v as f64).put(o));
-                true
-            }
-            Op::GetRealStatus => {
-                let mut v = 0.0;
-                let s = (api.fmi2GetRealStatus)(c, r.i32(), &mut v);
-                reply(&self.out, s, |o| v.put(o));
-                true
-            }
-            Op::Deserialize => {
-                let bytes = r.bytes();
-                let mut st: fmi2FMUstate = std::ptr::null_mut();
-                let s = (api.fmi2DeSerializeFMUstate)(
-                    c,
-                    bytes.as_ptr() as *const fmi2Byte,
-                    bytes.len(),
-                    &mut st,
-                );
-                reply(&self.out, s, |o| (st as usize as u64).put(o));
-                true
-            }
-            _ => self.state(api, c, op, r),
-        }
-    }
-
-    /// Batched fmi2Set/GetReal, Integer, Boolean into the host's reused buffers.
-    unsafe fn batch(&mut self, api: &Api, c: fmi2Component, op: Op, mut r: Reader) -> bool {
+    /// Batched fmi2SetReal, Integer, Boolean from the host's reused buffers.
+    fn set(&mut self, op: Op, mut r: Reader) -> bool {
         self.read_vrs(&mut r);
-        let (vr, n) = (self.vrs.as_ptr(), self.vrs.len());
+        let n = self.vrs.len();
         let s = match op {
             Op::SetReal => {
                 self.reals.resize(n, 0.0);
                 r.fill(&mut self.reals, Reader::f64);
-                (api.fmi2SetReal)(c, vr, n, self.reals.as_ptr())
-            }
-            Op::SetInteger | Op::SetBoolean => {
-                self.ints.resize(n, 0);
-                r.fill(&mut self.ints, Reader::i32);
-                match op {
-                    Op::SetInteger => (api.fmi2SetInteger)(c, vr, n, self.ints.as_ptr()),
-                    _ => (api.fmi2SetBoolean)(c, vr, n, self.ints.as_ptr()),
-                }
-            }
-            Op::GetReal => {
-                self.reals.resize(n, 0.0);
-                let s = (api.fmi2GetReal)(c, vr, n, self.reals.as_mut_ptr());
-                reply(&self.out, s, |o| self.reals.as_slice().put(o));
-                return true;
+                self.inst.set_real(&self.vrs, &self.reals)
             }
             _ => {
                 self.ints.resize(n, 0);
-                let s = match op {
-                    Op::GetInteger => (api.fmi2GetInteger)(c, vr, n, self.ints.as_mut_ptr()),
-                    _ => (api.fmi2GetBoolean)(c, vr, n, self.ints.as_mut_ptr()),
-                };
-                reply(&self.out, s, |o| self.ints.as_slice().put(o));
-                return true;
+                r.fill(&mut self.ints, Reader::i32);
+                match op {
+                    Op::SetInteger => self.inst.set_integer(&self.vrs, &self.ints),
+                    _ => self.inst.set_boolean(&self.vrs, &self.ints),
+                }
             }
         };
-        self.simple(s)
+        reply(&self.out, s, |_| {});
+        true
+    }
+
+    /// Batched fmi2GetReal, Integer, Boolean into the host's reused buffers.
+    fn get(&mut self, op: Op, mut r: Reader) -> bool {
+        self.read_vrs(&mut r);
+        let n = self.vrs.len();
+        if op == Op::GetReal {
+            self.reals.resize(n, 0.0);
+            let s = self.inst.get_real(&self.vrs, &mut self.reals);
+            reply(&self.out, s, |o| self.reals.as_slice().put(o));
+            return true;
+        }
+        self.ints.resize(n, 0);
+        let s = match op {
+            Op::GetInteger => self.inst.get_integer(&self.vrs, &mut self.ints),
+            _ => self.inst.get_boolean(&self.vrs, &mut self.ints),
+        };
+        reply(&self.out, s, |o| self.ints.as_slice().put(o));
+        true
+    }
+
+    fn set_string(&mut self, mut r: Reader) -> bool {
+        self.read_vrs(&mut r);
+        let cs: Vec<CString> = self
+            .vrs
+            .iter()
+            .map(|_| CString::new(r.bytes()).unwrap_or_default())
+            .collect();
+        let s = self.inst.set_string(&self.vrs, &cs);
+        reply(&self.out, s, |_| {});
+        true
+    }
+
+    fn get_string(&mut self, mut r: Reader) -> bool {
+        self.read_vrs(&mut r);
+        self.strings.resize(self.vrs.len(), String::new());
+        let s = self.inst.get_string(&self.vrs, &mut self.strings);
+        reply(&self.out, s, |o| {
+            for v in &self.strings {
+                v.as_str().put(o);
+            }
+        });
+        true
     }
 
     /// FMU-state calls (FMI 2.0, sec. 2.1.8); a state is a handle: the FMU's pointer.
-    unsafe fn state(&mut self, api: &Api, c: fmi2Component, op: Op, mut r: Reader) -> bool {
-        let mut handle = r.u64() as usize as fmi2FMUstate;
+    fn state(&mut self, op: Op, mut r: Reader) -> bool {
+        if op == Op::Deserialize {
+            let (s, state) = self.inst.deserialize(r.bytes());
+            reply(&self.out, s, |o| state.put(o));
+            return true;
+        }
+        let handle = r.u64();
         let arg = r.u64();
         let (s, result) = match op {
-            Op::GetFmuState => {
-                let s = (api.fmi2GetFMUstate)(c, &mut handle);
-                (s, handle as usize as u64)
-            }
+            Op::GetFmuState => self.inst.get_state(),
             Op::SerializedSize => {
-                let mut size = 0usize;
-                let s = (api.fmi2SerializedFMUstateSize)(c, handle, &mut size);
+                let (s, size) = self.inst.serialized_size(handle);
                 (s, size as u64)
             }
             Op::Serialize => {
-                if arg > MAX_STATE_BYTES {
+                if arg > MAX_STATE_BYTES as u64 {
                     return false;
                 }
-                let mut bytes = vec![0u8; arg as usize];
-                let s = (api.fmi2SerializeFMUstate)(
-                    c,
-                    handle,
-                    bytes.as_mut_ptr() as *mut fmi2Byte,
-                    bytes.len(),
-                );
+                let (s, bytes) = self.inst.serialize(handle, arg as usize);
                 reply(&self.out, s, |o| bytes.as_slice().put(o));
                 return true;
             }
-            Op::SetFmuState => ((api.fmi2SetFMUstate)(c, handle), 0),
-            Op::FreeFmuState => {
-                let s = (api.fmi2FreeFMUstate)(c, &mut handle);
-                (s, handle as usize as u64)
-            }
+            Op::SetFmuState => (self.inst.set_state(handle), 0),
+            Op::FreeFmuState => self.inst.free_state(handle),
             _ => return false,
         };
         reply(&self.out, s, |o| result.put(o));

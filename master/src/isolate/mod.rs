@@ -7,19 +7,17 @@
 //!
 //! - [`protocol`]: the frames on the two pipes (one FMI call per request, log messages and one
 //!   reply back);
-//! - [`client`]: the master's end, which [`crate::instance`] calls instead of the FMU's
-//!   functions (preallocated buffers: a step allocates nothing);
+//! - [`client`]: the master's end, [`Client`], the out-of-process [`crate::slave::Slave`]
+//!   (preallocated buffers: a step allocates nothing);
 //! - [`host`]: the child's end, `shipsim fmu-host FMU`, which loads the FMU with the same
-//!   importer ([`crate::fmu`]) and makes the calls;
-//! - [`monitor`]: for instances in process, which call is in progress (for the CLI's `exit()`
-//!   hook and in-process watchdog).
+//!   importer ([`crate::fmu`]) and serves each request through the in-process slave
+//!   ([`crate::slave::InProcess`]), so that the FMU is called the same way in both.
 //!
 //! docs/isolation.md is the user's guide.
 
-pub mod client;
+mod client;
 pub mod host;
-pub mod monitor;
-pub mod protocol;
+mod protocol;
 
 use crate::error::{Error, Result};
 use crate::model_description::ModelDescription;
@@ -28,7 +26,7 @@ use std::path::PathBuf;
 use std::sync::OnceLock;
 use std::time::Duration;
 
-pub use monitor::CallMonitor;
+pub use client::Client;
 
 /// Which instances of a run are isolated.
 #[derive(Clone, Debug, Default, PartialEq)]

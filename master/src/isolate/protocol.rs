@@ -4,7 +4,7 @@
 //! Every frame is an 8-byte header, `u32 tag` and `u32 length`, then `length` payload bytes,
 //! native-endian (both ends are the same executable on the same machine).
 //!
-//! - **Request** (master -> host): `tag` is an [`Op`]; the payload holds the call's arguments in
+//! - **Request** (master -> host): `tag` is an [`Op`](crate::slave::Op); the payload holds the call's arguments in
 //!   order: value references as `u32`, Reals as `f64`, Integers and Booleans as `i32`, strings
 //!   and byte strings as `u32` length + bytes, FMU-state handles as `u64`.
 //! - **Log** (host -> master, [`LOG`]): `i32` status, then category and message as strings; any
@@ -22,59 +22,8 @@ pub const REPLY: u32 = 0x101;
 /// Header bytes of every frame.
 pub const HEADER: usize = 8;
 /// The largest frame either end accepts (a serialized state is at most 1 GiB, see
-/// [`crate::instance`]).
+/// [`crate::slave::MAX_STATE_BYTES`]).
 pub const MAX_FRAME: usize = (1 << 30) + 4096;
-
-macro_rules! ops {
-    ($($op:ident = $n:literal, $name:literal;)*) => {
-        /// The FMI calls a host makes for the master (FMI 2.0, sec. 2.1 and 4.2).
-        #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-        #[repr(u8)]
-        pub enum Op {
-            $($op = $n,)*
-        }
-        impl Op {
-            /// The FMI function's name.
-            pub fn name(self) -> &'static str {
-                match self {
-                    $(Op::$op => $name,)*
-                }
-            }
-            pub fn from_u32(n: u32) -> Option<Op> {
-                match n {
-                    $($n => Some(Op::$op),)*
-                    _ => None,
-                }
-            }
-        }
-    };
-}
-
-ops! {
-    Instantiate = 1, "fmi2Instantiate";
-    SetupExperiment = 2, "fmi2SetupExperiment";
-    EnterInitializationMode = 3, "fmi2EnterInitializationMode";
-    ExitInitializationMode = 4, "fmi2ExitInitializationMode";
-    DoStep = 5, "fmi2DoStep";
-    Terminate = 6, "fmi2Terminate";
-    FreeInstance = 7, "fmi2FreeInstance";
-    SetReal = 8, "fmi2SetReal";
-    SetInteger = 9, "fmi2SetInteger";
-    SetBoolean = 10, "fmi2SetBoolean";
-    SetString = 11, "fmi2SetString";
-    GetReal = 12, "fmi2GetReal";
-    GetInteger = 13, "fmi2GetInteger";
-    GetBoolean = 14, "fmi2GetBoolean";
-    GetString = 15, "fmi2GetString";
-    GetBooleanStatus = 16, "fmi2GetBooleanStatus";
-    GetRealStatus = 17, "fmi2GetRealStatus";
-    GetFmuState = 18, "fmi2GetFMUstate";
-    SerializedSize = 19, "fmi2SerializedFMUstateSize";
-    Serialize = 20, "fmi2SerializeFMUstate";
-    Deserialize = 21, "fmi2DeSerializeFMUstate";
-    SetFmuState = 22, "fmi2SetFMUstate";
-    FreeFmuState = 23, "fmi2FreeFMUstate";
-}
 
 /// Appends native-endian values to a frame being written.
 pub trait Put {
@@ -223,16 +172,5 @@ mod tests {
         assert!(!r.short);
         assert_eq!(r.u32(), 0);
         assert!(r.short);
-    }
-
-    #[test]
-    fn every_op_has_its_number() {
-        for n in 0..40 {
-            if let Some(op) = Op::from_u32(n) {
-                assert_eq!(op as u32, n);
-                assert!(op.name().starts_with("fmi2"));
-            }
-        }
-        assert_eq!(Op::from_u32(5), Some(Op::DoStep));
     }
 }

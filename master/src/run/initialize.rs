@@ -18,7 +18,8 @@ use super::slot::{set_value, Slot};
 use super::RunOptions;
 use crate::error::{Error, Result};
 use crate::fmu::Fmu;
-use crate::instance::{stderr_sink, Backend, Instance, Stepping};
+use crate::instance::{Backend, Instance, Stepping};
+use crate::log::stderr_sink;
 use crate::system::{Plan, PlanInstance};
 use std::sync::Arc;
 

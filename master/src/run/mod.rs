@@ -23,9 +23,10 @@
 
 use crate::error::{Error, Result};
 use crate::fmu::Fmu;
-use crate::instance::LogSink;
-use crate::isolate::{CallMonitor, IsolateMode, Isolation};
+use crate::isolate::{IsolateMode, Isolation};
+use crate::log::LogSink;
 use crate::model_description::ModelDescription;
+use crate::slave::CallMonitor;
 use crate::system::{Algorithm as AlgorithmChoice, Plan, System};
 use std::collections::HashMap;
 use std::io::Write;
@@ -73,7 +74,7 @@ pub struct RunOptions {
     /// loaded for it ([`load_fmus_for`]).
     pub isolation: Isolation,
     /// Where in-process instances note the call in progress (for a caller's exit hook or
-    /// watchdog, [`crate::isolate::monitor`]).
+    /// watchdog, [`crate::slave::CallMonitor`]).
     pub monitor: Option<Arc<CallMonitor>>,
 }
 

@@ -7,7 +7,7 @@
 //! call (and the time at each step); readers on other threads (or in the `atexit` hook) load
 //! them. Nothing allocates after the instances are registered.
 
-use super::protocol::Op;
+use super::Op;
 use std::sync::atomic::{AtomicU64, Ordering::Relaxed};
 use std::sync::Mutex;
 
