@@ -42,17 +42,7 @@ const SHIPSIM: &str = env!("CARGO_BIN_EXE_shipsim");
 /// Builds `dir/<name>.fmu` from tests/c/evilfmu.c with `defines` (the test FMU's model
 /// description).
 fn evil_fmu(dir: &Path, name: &str, defines: &[&str]) -> PathBuf {
-    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/c/evilfmu.c");
-    let so = dir.join(format!("{name}.so"));
-    let mut cmd = Command::new("gcc");
-    cmd.args(["-shared", "-fPIC", "-O2", "-fvisibility=hidden", "-o"])
-        .arg(&so)
-        .arg(&src);
-    for d in defines {
-        cmd.arg(format!("-D{d}"));
-    }
-    let st = cmd.arg("-lm").status().expect("gcc must be installed");
-    assert!(st.success(), "gcc failed for {name}");
+    let so = compile(dir, name, &c_source("evilfmu.c"), defines);
     let fmu = dir.join(format!("{name}.fmu"));
     zip_files(
         &fmu,

@@ -42,7 +42,7 @@ fn allocs() -> usize {
 /// before every `nth` fmi2DoStep (counted from its first): the C source includes testfmu.c with
 /// its fmi2DoStep renamed and wraps it.
 fn busy_fmu(dir: &Path, name: &str, iterations: u32, nth: u32) -> PathBuf {
-    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/c/testfmu.c");
+    let src = c_source("testfmu.c");
     let wrapper = dir.join(format!("{name}.c"));
     std::fs::write(
         &wrapper,
@@ -62,15 +62,7 @@ EXPORT fmi2Status fmi2DoStep(fmi2Component c, fmi2Real t, fmi2Real h, fmi2Boolea
         ),
     )
     .unwrap();
-    let so = dir.join(format!("{name}.so"));
-    let st = Command::new("gcc")
-        .args(["-shared", "-fPIC", "-O2", "-fvisibility=hidden", "-o"])
-        .arg(&so)
-        .arg(&wrapper)
-        .arg("-lm")
-        .status()
-        .expect("gcc must be installed to build the test FMU");
-    assert!(st.success(), "gcc failed for {name}");
+    let so = compile(dir, name, &wrapper, &[]);
     let fmu = dir.join(format!("{name}.fmu"));
     zip_files(
         &fmu,

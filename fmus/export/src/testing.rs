@@ -634,41 +634,122 @@ pub fn check_corrupt_state<M: FmuModel>(
     fmu.free_state(state);
 }
 
-/// For a test file of an FMU crate with the cases of the reliability probe: declares the FMI
-/// symbols the crate exports and, over them, `probe(integers, reals, h, steps, expect)`
-/// ([`check_probe`]) and `corrupt(integers, find, replace, expect)` ([`check_corrupt_state`] of
-/// every copy of `find`). Use once per test file: `fmi2_export::probe_cases!(my_fmu::MyFmu);`.
+/// The cases of the reliability probe for one FMU crate, as a table: one `#[test]` per row, named
+/// `<fmu>::<group>::<row>` (so that a failure names the FMU and the case). Declares the FMI
+/// symbols the crate exports, in module `<fmu>`, and runs each row over them. Use once per test
+/// file:
+///
+/// ```text
+/// fmi2_export::probe_cases! {
+///     my_fmu = my_fmu::MyFmu;
+///
+///     /// Where the cases of this group come from.
+///     group_name: probe(integers = [("order", 2)], h = 0.1, steps = 50) {
+///         gain_1e300: [("gain", 1e300)] => Error("output \"y\" = NaN is not a finite number"),
+///         gain_1e6: [("gain", 1e6)] => Finite,
+///     }
+///
+///     another_group: corrupt() {
+///         interval_1p5e_neg40: 0.1 -> 1.5e-40 => StepRefused("internal steps of dt = "),
+///     }
+/// }
+/// ```
+///
+/// A `probe` group shares the Integers (optional, set first), the step size `h` and the number of
+/// steps; each row gives the Reals to set and the [`Outcome`] (`Error(text)` or `Finite`), and is
+/// a [`check_probe`]. A `corrupt` group shares the Integers; each row replaces every copy of a
+/// value in the serialized state and gives the [`Corrupt`] outcome (`Refused(text)` or
+/// `StepRefused(text)`), and is a [`check_corrupt_state`]. Doc comments and attributes are kept on
+/// the groups (modules) and rows (tests). The probe tables name a row after what it sets, with
+/// `p` for a decimal point and `neg` for a minus sign (`gm_1e300`, `max_substep_1e_neg300`,
+/// `initial_sway_velocity_neg_1e6`; `defaults` when it sets nothing), and a corrupt row after the
+/// value written (`interval_1p5e_neg40`).
 #[macro_export]
 macro_rules! probe_cases {
-    ($model:ty) => {
-        $crate::fmi2::declare_fmi2_functions!();
+    (
+        $fmu:ident = $model:ty;
+        $(
+            $(#[$group_meta:meta])*
+            $group:ident : $kind:ident ( $($args:tt)* ) { $($rows:tt)* }
+        )*
+    ) => {
+        /// The probe cases of the FMU, over the FMI symbols its crate exports.
+        mod $fmu {
+            $crate::fmi2::declare_fmi2_functions!();
 
-        /// `integers` and `reals` set in Initialization Mode, then `steps` steps of `h` from 0.
-        #[allow(dead_code)]
-        fn probe(
-            integers: &[(&str, i32)],
-            reals: &[(&str, f64)],
-            h: f64,
-            steps: usize,
-            expect: $crate::testing::Outcome,
-        ) {
-            let f = linked_fmi2_functions();
-            $crate::testing::check_probe::<$model>(f, integers, reals, h, steps, expect);
-        }
+            /// The FMU under test.
+            type Model = $model;
 
-        /// The serialized state after three default steps with every copy of `find` replaced.
-        #[allow(dead_code)]
-        fn corrupt(
-            integers: &[(&str, i32)],
-            find: f64,
-            replace: f64,
-            expect: $crate::testing::Corrupt,
-        ) {
-            let f = linked_fmi2_functions();
-            $crate::testing::check_corrupt_state::<$model>(
-                f, integers, find, None, replace, expect,
-            );
+            $(
+                $(#[$group_meta])*
+                mod $group {
+                    $crate::__probe_rows!($kind ($($args)*) { $($rows)* });
+                }
+            )*
         }
+    };
+}
+
+/// The rows of one group of [`probe_cases!`](crate::probe_cases), as `#[test]` functions of a
+/// module inside the FMU's module.
+#[doc(hidden)]
+#[macro_export]
+macro_rules! __probe_rows {
+    (probe (h = $h:expr, steps = $steps:expr) $rows:tt) => {
+        $crate::__probe_rows!(probe (integers = [], h = $h, steps = $steps) $rows);
+    };
+    (
+        probe (integers = $integers:tt, h = $h:expr, steps = $steps:expr) {
+            $(
+                $(#[$meta:meta])*
+                $row:ident : [ $($reals:tt)* ] => $expect:expr
+            ),* $(,)?
+        }
+    ) => {
+        $(
+            $(#[$meta])*
+            #[test]
+            fn $row() {
+                #[allow(unused_imports)]
+                use $crate::testing::Outcome::*;
+                $crate::testing::check_probe::<super::Model>(
+                    super::linked_fmi2_functions(),
+                    &$integers,
+                    &[$($reals)*],
+                    $h,
+                    $steps,
+                    $expect,
+                );
+            }
+        )*
+    };
+    (corrupt () $rows:tt) => {
+        $crate::__probe_rows!(corrupt (integers = []) $rows);
+    };
+    (
+        corrupt (integers = $integers:tt) {
+            $(
+                $(#[$meta:meta])*
+                $row:ident : $find:literal -> $replace:literal => $expect:expr
+            ),* $(,)?
+        }
+    ) => {
+        $(
+            $(#[$meta])*
+            #[test]
+            fn $row() {
+                #[allow(unused_imports)]
+                use $crate::testing::Corrupt::*;
+                $crate::testing::check_corrupt_state::<super::Model>(
+                    super::linked_fmi2_functions(),
+                    &$integers,
+                    $find,
+                    None,
+                    $replace,
+                    $expect,
+                );
+            }
+        )*
     };
 }
 

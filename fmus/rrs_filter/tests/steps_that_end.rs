@@ -1,103 +1,48 @@
 //! The issue-19 reliability probe's cases (`../shared/reliability/`, main 616074e) for RrsFilter:
 //! each ends with the error named or finite outputs (a case that hung, with the error of the
-//! bound on the work of one step). See `fmi2_export::testing::check_probe`.
+//! bound on the work of one step). See `fmi2_export::testing::check_probe`. One test per row,
+//! `rrs_filter::<group>::<row>` (see `fmi2_export::probe_cases!`).
 
-use fmi2_export::testing::{Corrupt, Outcome::*};
+fmi2_export::probe_cases! {
+    rrs_filter = rrs_filter_fmu::RrsFilterFmu;
 
-fmi2_export::probe_cases!(rrs_filter_fmu::RrsFilterFmu);
+    /// bigstep_all.txt: one fmi2DoStep of 1e9 s.
+    one_step_of_1e9_s_ends: probe(h = 1000000000.0, steps = 1) {
+        defaults: [] => Error("internal steps of sample_time = "),
+    }
 
-/// bigstep_all.txt: one fmi2DoStep of 1e9 s.
-#[test]
-fn one_step_of_1e9_s_ends() {
-    probe(
-        &[],
-        &[],
-        1000000000.0,
-        1,
-        Error("internal steps of sample_time = "),
-    );
-}
+    /// tinystep_all.txt: a 1 s step with a tiny positive sub-step or sample parameter.
+    tiny_internal_steps_end: probe(h = 1.0, steps = 1) {
+        sample_time_1e_neg300: [("sample_time", 1e-300)]
+            => Error("internal steps of sample_time = "),
+    }
 
-/// tinystep_all.txt: a 1 s step with a tiny positive sub-step or sample parameter.
-#[test]
-fn tiny_internal_steps_end() {
-    probe(
-        &[],
-        &[("sample_time", 1e-300)],
-        1.0,
-        1,
-        Error("internal steps of sample_time = "),
-    );
-}
+    /// param_sweep_all.txt: extreme in-range parameters that gave fmi2OK with NaN or inf (50 steps of the default experiment).
+    extreme_parameters_give_an_error_not_nan: probe(h = 0.1, steps = 50) {
+        design_speed_1e6: [("design_speed", 1000000.0)]
+            => Error("output \"yaw_k1\" = -inf is not a finite number"),
+        yaw_a_1e6: [("yaw_a", 1000000.0)]
+            => Error("output \"yaw_k1\" = NaN is not a finite number"),
+        heading_measured_1e300: [("heading_measured", 1e+300)]
+            => Error("output \"yaw_e_w3_used\" = NaN is not a finite number"),
+        heading_measured_neg_1e300: [("heading_measured", -1e+300)]
+            => Error("output \"yaw_e_w3_used\" = NaN is not a finite number"),
+        course_rudder_1e300: [("course_rudder", 1e+300)]
+            => Error("output \"yaw_e_w3_used\" = NaN is not a finite number"),
+        course_rudder_neg_1e300: [("course_rudder", -1e+300)]
+            => Error("output \"yaw_e_w3_used\" = NaN is not a finite number"),
+    }
 
-/// param_sweep_all.txt: extreme in-range parameters that gave fmi2OK with NaN or inf (50 steps of the default experiment).
-#[test]
-fn extreme_parameters_give_an_error_not_nan() {
-    probe(
-        &[],
-        &[("design_speed", 1000000.0)],
-        0.1,
-        50,
-        Error("output \"yaw_k1\" = -inf is not a finite number"),
-    );
-    probe(
-        &[],
-        &[("yaw_a", 1000000.0)],
-        0.1,
-        50,
-        Error("output \"yaw_k1\" = NaN is not a finite number"),
-    );
-    probe(
-        &[],
-        &[("heading_measured", 1e+300)],
-        0.1,
-        50,
-        Error("output \"yaw_e_w3_used\" = NaN is not a finite number"),
-    );
-    probe(
-        &[],
-        &[("heading_measured", -1e+300)],
-        0.1,
-        50,
-        Error("output \"yaw_e_w3_used\" = NaN is not a finite number"),
-    );
-    probe(
-        &[],
-        &[("course_rudder", 1e+300)],
-        0.1,
-        50,
-        Error("output \"yaw_e_w3_used\" = NaN is not a finite number"),
-    );
-    probe(
-        &[],
-        &[("course_rudder", -1e+300)],
-        0.1,
-        50,
-        Error("output \"yaw_e_w3_used\" = NaN is not a finite number"),
-    );
-}
+    /// param_sweep_all.txt: extreme in-range parameters that hung (50 steps of the default experiment).
+    extreme_parameters_that_hung_end: probe(h = 0.1, steps = 50) {
+        sample_time_1e_neg300: [("sample_time", 1e-300)]
+            => Error("internal steps of sample_time = "),
+    }
 
-/// param_sweep_all.txt: extreme in-range parameters that hung (50 steps of the default experiment).
-#[test]
-fn extreme_parameters_that_hung_end() {
-    probe(
-        &[],
-        &[("sample_time", 1e-300)],
-        0.1,
-        50,
-        Error("internal steps of sample_time = "),
-    );
-}
-
-/// fuzz_state_all.txt: a state whose sub-step or sample interval (every copy of 0.1) is
-/// 1.5e-40 (the mutated states that hung) is refused, or restores within the declared range and
-/// its next step is refused by the bound.
-#[test]
-fn a_corrupt_state_is_refused_or_bounded() {
-    corrupt(
-        &[],
-        0.1,
-        1.5e-40,
-        Corrupt::StepRefused("internal steps of sample_time = "),
-    );
+    /// fuzz_state_all.txt: a state whose sub-step or sample interval (every copy of 0.1) is
+    /// 1.5e-40 (the mutated states that hung) is refused, or restores within the declared range and
+    /// its next step is refused by the bound.
+    a_corrupt_state_is_refused_or_bounded: corrupt() {
+        interval_1p5e_neg40: 0.1 -> 1.5e-40 => StepRefused("internal steps of sample_time = "),
+    }
 }

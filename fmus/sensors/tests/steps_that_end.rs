@@ -1,40 +1,28 @@
 //! The issue-19 reliability probe's cases (`../shared/reliability/`, main 616074e) for Sensors:
 //! each ends with the error named or finite outputs (a case that hung, with the error of the
-//! bound on the work of one step). See `fmi2_export::testing::check_probe`.
+//! bound on the work of one step). See `fmi2_export::testing::check_probe`. One test per row,
+//! `sensors::<group>::<row>` (see `fmi2_export::probe_cases!`).
 
-use fmi2_export::testing::{Corrupt, Outcome::*};
+fmi2_export::probe_cases! {
+    sensors = sensors_fmu::SensorsFmu;
 
-fmi2_export::probe_cases!(sensors_fmu::SensorsFmu);
+    /// bigstep_all.txt: one fmi2DoStep of 1e9 s.
+    one_step_of_1e9_s_ends: probe(h = 1000000000.0, steps = 1) {
+        defaults: [] => Error("internal steps of roll_interval = "),
+    }
 
-/// bigstep_all.txt: one fmi2DoStep of 1e9 s.
-#[test]
-fn one_step_of_1e9_s_ends() {
-    probe(
-        &[],
-        &[],
-        1000000000.0,
-        1,
-        Error("internal steps of roll_interval = "),
-    );
-}
+    /// tinystep_all.txt: a 1 s step with a tiny positive sub-step or sample parameter.
+    tiny_internal_steps_end: probe(h = 1.0, steps = 1) {
+        heading_interval_1e_neg6: [("heading_interval", 1e-06)] => Finite,
+    }
 
-/// tinystep_all.txt: a 1 s step with a tiny positive sub-step or sample parameter.
-#[test]
-fn tiny_internal_steps_end() {
-    probe(&[], &[("heading_interval", 1e-06)], 1.0, 1, Finite);
-}
-
-/// fuzz_state_all.txt: a state whose sub-step or sample interval (every copy of 0.23488120950323976) is
-/// 1.5e-40 (the mutated states that hung) is refused, or restores within the declared range and
-/// its next step is refused by the bound.
-#[test]
-fn a_corrupt_state_is_refused_or_bounded() {
-    corrupt(
-        &[],
-        0.23488120950323976,
-        1.5e-40,
-        Corrupt::Refused("is not a finite number in [1e-6, inf]"),
-    );
+    /// fuzz_state_all.txt: a state whose sub-step or sample interval (every copy of 0.23488120950323976) is
+    /// 1.5e-40 (the mutated states that hung) is refused, or restores within the declared range and
+    /// its next step is refused by the bound.
+    a_corrupt_state_is_refused_or_bounded: corrupt() {
+        interval_1p5e_neg40: 0.23488120950323976 -> 1.5e-40
+            => Refused("is not a finite number in [1e-6, inf]"),
+    }
 }
 
 /// Fuzz run (seed 2027): at t = 1e300 a 0.1 s sample interval is lost in rounding

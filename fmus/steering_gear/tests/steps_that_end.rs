@@ -1,38 +1,26 @@
 //! The issue-19 reliability probe's cases (`../shared/reliability/`, main 616074e) for SteeringGear:
 //! each ends with the error named or finite outputs (a case that hung, with the error of the
-//! bound on the work of one step). See `fmi2_export::testing::check_probe`.
+//! bound on the work of one step). See `fmi2_export::testing::check_probe`. One test per row,
+//! `steering_gear::<group>::<row>` (see `fmi2_export::probe_cases!`).
 
-use fmi2_export::testing::{Corrupt, Outcome::*};
+fmi2_export::probe_cases! {
+    steering_gear = steering_gear_fmu::SteeringGearFmu;
 
-fmi2_export::probe_cases!(steering_gear_fmu::SteeringGearFmu);
+    /// bigstep_all.txt: one fmi2DoStep of 1e9 s.
+    one_step_of_1e9_s_ends: probe(h = 1000000000.0, steps = 1) {
+        defaults: [] => Finite,
+    }
 
-/// bigstep_all.txt: one fmi2DoStep of 1e9 s.
-#[test]
-fn one_step_of_1e9_s_ends() {
-    probe(&[], &[], 1000000000.0, 1, Finite);
-}
+    /// tinystep_all.txt: a 1 s step with a tiny positive sub-step or sample parameter.
+    tiny_internal_steps_end: probe(integers = [("servo_order", 2)], h = 1.0, steps = 1) {
+        max_substep_1e_neg300: [("max_substep", 1e-300)]
+            => Error("internal steps of max_substep = "),
+    }
 
-/// tinystep_all.txt: a 1 s step with a tiny positive sub-step or sample parameter.
-#[test]
-fn tiny_internal_steps_end() {
-    probe(
-        &[("servo_order", 2)],
-        &[("max_substep", 1e-300)],
-        1.0,
-        1,
-        Error("internal steps of max_substep = "),
-    );
-}
-
-/// fuzz_state_all.txt: a state whose sub-step or sample interval (every copy of 0.001) is
-/// 1.5e-40 (the mutated states that hung) is refused, or restores within the declared range and
-/// its next step is refused by the bound.
-#[test]
-fn a_corrupt_state_is_refused_or_bounded() {
-    corrupt(
-        &[("servo_order", 2)],
-        0.001,
-        1.5e-40,
-        Corrupt::StepRefused("internal steps of max_substep = "),
-    );
+    /// fuzz_state_all.txt: a state whose sub-step or sample interval (every copy of 0.001) is
+    /// 1.5e-40 (the mutated states that hung) is refused, or restores within the declared range and
+    /// its next step is refused by the bound.
+    a_corrupt_state_is_refused_or_bounded: corrupt(integers = [("servo_order", 2)]) {
+        interval_1p5e_neg40: 0.001 -> 1.5e-40 => StepRefused("internal steps of max_substep = "),
+    }
 }

@@ -1,71 +1,38 @@
 //! The issue-19 reliability probe's cases (`../shared/reliability/`, main 616074e) for Waves:
 //! each ends with the error named or finite outputs (a case that hung, with the error of the
-//! bound on the work of one step). See `fmi2_export::testing::check_probe`.
+//! bound on the work of one step). See `fmi2_export::testing::check_probe`. One test per row,
+//! `waves::<group>::<row>` (see `fmi2_export::probe_cases!`).
 
-use fmi2_export::testing::{Corrupt, Outcome::*};
+fmi2_export::probe_cases! {
+    waves = waves_fmu::WavesFmu;
 
-fmi2_export::probe_cases!(waves_fmu::WavesFmu);
+    /// bigstep_all.txt: one fmi2DoStep of 1e9 s.
+    one_step_of_1e9_s_ends: probe(h = 1000000000.0, steps = 1) {
+        defaults: [] => Error("internal steps of internal_step = "),
+    }
 
-/// bigstep_all.txt: one fmi2DoStep of 1e9 s.
-#[test]
-fn one_step_of_1e9_s_ends() {
-    probe(
-        &[],
-        &[],
-        1000000000.0,
-        1,
-        Error("internal steps of internal_step = "),
-    );
-}
+    /// tinystep_all.txt: a 1 s step with a tiny positive sub-step or sample parameter.
+    tiny_internal_steps_end: probe(h = 1.0, steps = 1) {
+        internal_step_1e_neg4: [("internal_step", 0.0001)] => Finite,
+    }
 
-/// tinystep_all.txt: a 1 s step with a tiny positive sub-step or sample parameter.
-#[test]
-fn tiny_internal_steps_end() {
-    probe(&[], &[("internal_step", 0.0001)], 1.0, 1, Finite);
-}
+    /// param_sweep_all.txt: extreme in-range parameters that gave fmi2OK with NaN or inf (50 steps of the default experiment).
+    extreme_parameters_give_an_error_not_nan: probe(h = 0.1, steps = 50) {
+        wf_omega0_1e300: [("wf_omega0", 1e+300)]
+            => Error("output \"wf_motion_surge\" = NaN is not a finite number"),
+        wf_std_surge_1e300: [("wf_std_surge", 1e+300)]
+            => Error("output \"wf_motion_surge\" = NaN is not a finite number"),
+        wf_std_sway_1e300: [("wf_std_sway", 1e+300)]
+            => Error("output \"wf_motion_sway\" = NaN is not a finite number"),
+        wf_std_yaw_1e300: [("wf_std_yaw", 1e+300)]
+            => Error("output \"wf_motion_yaw\" = NaN is not a finite number"),
+    }
 
-/// param_sweep_all.txt: extreme in-range parameters that gave fmi2OK with NaN or inf (50 steps of the default experiment).
-#[test]
-fn extreme_parameters_give_an_error_not_nan() {
-    probe(
-        &[],
-        &[("wf_omega0", 1e+300)],
-        0.1,
-        50,
-        Error("output \"wf_motion_surge\" = NaN is not a finite number"),
-    );
-    probe(
-        &[],
-        &[("wf_std_surge", 1e+300)],
-        0.1,
-        50,
-        Error("output \"wf_motion_surge\" = NaN is not a finite number"),
-    );
-    probe(
-        &[],
-        &[("wf_std_sway", 1e+300)],
-        0.1,
-        50,
-        Error("output \"wf_motion_sway\" = NaN is not a finite number"),
-    );
-    probe(
-        &[],
-        &[("wf_std_yaw", 1e+300)],
-        0.1,
-        50,
-        Error("output \"wf_motion_yaw\" = NaN is not a finite number"),
-    );
-}
-
-/// fuzz_state_all.txt: a state whose sub-step or sample interval (every copy of 0.05) is
-/// 1.5e-40 (the mutated states that hung) is refused, or restores within the declared range and
-/// its next step is refused by the bound.
-#[test]
-fn a_corrupt_state_is_refused_or_bounded() {
-    corrupt(
-        &[],
-        0.05,
-        1.5e-40,
-        Corrupt::Refused("\"internal_step\" = 1.5e-40 is not a finite number in [0.0001, 10.0]"),
-    );
+    /// fuzz_state_all.txt: a state whose sub-step or sample interval (every copy of 0.05) is
+    /// 1.5e-40 (the mutated states that hung) is refused, or restores within the declared range and
+    /// its next step is refused by the bound.
+    a_corrupt_state_is_refused_or_bounded: corrupt() {
+        interval_1p5e_neg40: 0.05 -> 1.5e-40
+            => Refused("\"internal_step\" = 1.5e-40 is not a finite number in [0.0001, 10.0]"),
+    }
 }

@@ -15,14 +15,21 @@ pub fn model_description(guid: &str, fmi_version: &str) -> String {
         .replace("GUID", guid)
 }
 
-/// Compiles testfmu.c into `dir/<tag>.so` with extra defines.
-pub fn compile(dir: &Path, tag: &str, defines: &[&str]) -> PathBuf {
-    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/c/testfmu.c");
+/// A C source of the test FMUs: `tests/c/<name>`.
+pub fn c_source(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/c")
+        .join(name)
+}
+
+/// Compiles the C source `src` (testfmu.c, or a file that includes it) into `dir/<tag>.so` with
+/// extra defines.
+pub fn compile(dir: &Path, tag: &str, src: &Path, defines: &[&str]) -> PathBuf {
     let out = dir.join(format!("{tag}.so"));
     let mut cmd = Command::new("gcc");
     cmd.args(["-shared", "-fPIC", "-O2", "-fvisibility=hidden", "-o"])
         .arg(&out)
-        .arg(&src);
+        .arg(src);
     for d in defines {
         cmd.arg(format!("-D{d}"));
     }
@@ -79,7 +86,7 @@ pub fn build_fmu(dir: &Path, name: &str, v: Variant) -> PathBuf {
         entries.push(("modelDescription.xml", md.into_bytes()));
     }
     if v.with_binary {
-        let so = compile(dir, name, v.defines);
+        let so = compile(dir, name, &c_source("testfmu.c"), v.defines);
         entries.push(("binaries/linux64/testfmu.so", std::fs::read(so).unwrap()));
     }
     entries.push(("resources/readme.txt", b"test".to_vec()));

@@ -62,7 +62,12 @@ pub fn archive(path: &Path, entries: &[Entry]) {
 
 /// The test FMU's model description and binary (compiled once per call into `dir`).
 pub fn testfmu(dir: &Path) -> (Vec<u8>, Vec<u8>) {
-    let so = crate::common::compile(dir, "testfmu_bin", &[]);
+    let so = crate::common::compile(
+        dir,
+        "testfmu_bin",
+        &crate::common::c_source("testfmu.c"),
+        &[],
+    );
     (
         crate::common::model_description(crate::common::GUID, "2.0").into_bytes(),
         std::fs::read(so).unwrap(),
