@@ -241,12 +241,12 @@ fn variable(s: &mut String, md: &ModelDescription, units: &DisplayUnits, v: &Sca
 
 /// The start value as written in the model description; a Real in its shortest round-trip
 /// form, with an exponent for very small and large magnitudes as in the CSV files
-/// ([`crate::run::recorder::write_real`]: `1e300`, not 301 digits).
+/// ([`crate::run::write_real`]: `1e300`, not 301 digits).
 fn start_text(v: &ScalarVariable) -> String {
     match v.real.as_ref().and_then(|r| r.start) {
         Some(x) => {
             let mut b = Vec::new();
-            let _ = crate::run::recorder::write_real(&mut b, x);
+            let _ = crate::run::write_real(&mut b, x);
             String::from_utf8_lossy(&b).into_owned()
         }
         None => v.start_text().unwrap_or_default(),

@@ -35,23 +35,23 @@ use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-pub mod algorithm;
-pub mod checkpoint;
-pub mod exchange;
-pub mod initialize;
-pub mod profile;
-pub mod progress;
-pub mod recorder;
-pub mod slot;
-pub mod stepping;
-pub mod time_grid;
+mod algorithm;
+mod checkpoint;
+mod exchange;
+mod initialize;
+mod profile;
+mod progress;
+mod recorder;
+mod slot;
+mod stepping;
+mod time_grid;
 
 use algorithm::{Algorithm, GaussSeidel, Jacobi};
 use checkpoint::Fingerprint;
 pub use checkpoint::{checkpoint_step, Checkpoint};
 use exchange::Exchange;
 pub use profile::{Profile, Sampling};
-pub use recorder::{ColumnInfo, CsvRecorder, MemoryRecorder, Recorder, Row, Sample};
+pub use recorder::{write_real, ColumnInfo, CsvRecorder, MemoryRecorder, Recorder, Row, Sample};
 use stepping::{Recording, Stepper};
 pub use time_grid::{LastStep, OffGrid, TimeGrid};
 

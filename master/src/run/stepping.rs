@@ -36,20 +36,20 @@ impl Recording<'_> {
 /// A run at communication point t_k, ready to step: at its first point, or at a checkpoint's
 /// ([`super::checkpoint`]).
 pub struct Stepper<'a> {
-    pub grid: TimeGrid,
-    pub events: &'a [PlanEvent],
-    pub slots: Vec<Slot<Stepping>>,
-    pub values: Values,
-    pub recording: Option<Recording<'a>>,
-    pub progress: Option<Progress>,
-    pub interrupt: Option<&'a AtomicBool>,
+    pub(super) grid: TimeGrid,
+    pub(super) events: &'a [PlanEvent],
+    pub(super) slots: Vec<Slot<Stepping>>,
+    pub(super) values: Values,
+    pub(super) recording: Option<Recording<'a>>,
+    pub(super) progress: Option<Progress>,
+    pub(super) interrupt: Option<&'a AtomicBool>,
     /// The next base step: the run is at t_k.
-    pub k: u64,
-    pub count: StepCount,
+    pub(super) k: u64,
+    pub(super) count: StepCount,
     /// Wall time spent stepping so far.
-    pub wall: Duration,
+    pub(super) wall: Duration,
     /// The sums of a profiled run ([`super::RunOptions::profile`]).
-    pub profile: Option<Accumulator>,
+    pub(super) profile: Option<Accumulator>,
 }
 
 /// How the step loop ended.

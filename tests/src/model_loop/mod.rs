@@ -11,7 +11,7 @@
 //!   initial exchange (as many rounds as instances; in each, every instance rebuilds its model
 //!   from its parameters and inputs, as `fmi2GetReal` in Initialization Mode does after a set,
 //!   then every input is set), then `initialize` once more (`fmi2ExitInitializationMode`);
-//! - **Jacobi** ([`shipsim::run::algorithm::Jacobi`]): every input of the instances due at k
+//! - **Jacobi** (shipsim's `run/algorithm.rs`, `Jacobi`): every input of the instances due at k
 //!   from the outputs published at t_k, then every due instance steps, then the outputs of the
 //!   instances whose step ends at t_(k+1) (every instance at the last point) are published;
 //! - **connections**: the master's `gain·x + offset` ([`link`]).
@@ -28,7 +28,7 @@ pub mod container_ship;
 mod disturbances;
 pub mod rrs;
 
-use shipsim::run::recorder::write_real;
+use shipsim::run::write_real;
 use std::io::Write;
 use std::time::Duration;
 
