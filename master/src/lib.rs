@@ -1,16 +1,29 @@
 //! `shipsim`: an FMI 2.0 co-simulation master for ship-control systems.
 //!
-//! The crate in layers (docs/ARCHITECTURE.md walks a run through them):
+//! The crate in layers, each depending only on those above it (docs/ARCHITECTURE.md walks a run
+//! through them; `cargo xtask lint` refuses an import cycle):
 //!
-//! - **Importer** (the only FFI): [`fmu`] unzips an FMU, reads its model description and
-//!   resolves every symbol once; [`instance`] is a slave instance whose FMI lifecycle is
-//!   enforced by types; [`model_description`] is the typed `modelDescription.xml`.
+//! - **Foundations**: [`error`] (errors that name file, line, instance, variable and value),
+//!   [`limits`] (bounded reads, unpacking limits), [`units`] (SI units, typed user values),
+//!   [`log`] (FMU log records and sinks).
+//! - **Importer**: [`fmu`] unzips an FMU, reads its model description and resolves every symbol
+//!   once; [`model_description`] is the typed `modelDescription.xml`.
+//! - **FMU calls**: [`slave`] is the one interface to an FMU instance (the FMI calls the master
+//!   makes) and its in-process implementation, the only FFI besides the loader; [`isolate`] is
+//!   the out-of-process implementation (a `shipsim fmu-host` child per instance, served by the
+//!   in-process one); [`instance`] is a slave instance whose FMI lifecycle is enforced by types.
 //! - **System**: [`system`] is the format-neutral system and its validation into a
-//!   [`system::Plan`]; [`format`](mod@format) holds the file formats that read into it (native TOML, OSP
-//!   `OspSystemStructure.xml`) and write out of it (OSP).
+//!   [`system::Plan`]; [`format`](mod@format) holds the file formats that read into it (native
+//!   TOML, OSP `OspSystemStructure.xml`, SSP 1.0) and write out of it (OSP, SSP).
 //! - **Master**: [`run`] executes a plan: exchange, recorders, Jacobi and Gauss-Seidel, the
-//!   step loop.
+//!   step loop, checkpoints.
+//! - **Campaigns**: [`campaign`] runs a system many times over factors, seeds and arms (each
+//!   run through [`run`]), with KPIs, durable journals, run tables and plots.
 //! - **Tools**: [`inspect`] (an FMU summary), [`plot`] (PNG plots of recorded CSVs).
+//!
+//! Entry functions are named by one rule: `f` is the common form; `f_with` takes the options
+//! `f` leaves at their defaults (`load_with`, `load_fmus_with`, `prepare_with`); `f_into`
+//! records into any [`run::Recorder`] (`run_into`, `resume_into`).
 //!
 //! The library holds no process-wide state (no signal handlers, no global logger): it is
 //! loaded into other processes (Python, Dask workers). The `shipsim` binary (`main.rs`) is the
