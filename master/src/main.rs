@@ -335,10 +335,7 @@ fn dispatch(cmd: Command, session: &Session) -> shipsim::Result<()> {
             };
             let mut sys = System::load(&system)?;
             sys.apply_overrides(&set)?;
-            if let Some(t) = stop_time {
-                sys.stop_time = Some(t);
-            }
-            shipsim::format::osp::require_end_time(&sys)?;
+            sys.apply_stop_time(stop_time)?;
             if let Some(a) = algorithm {
                 sys.algorithm = parse_algorithm(&a)?;
             }
@@ -655,7 +652,7 @@ fn output_note(sys: &System, file: Option<&Path>) {
         Some(f) if f.exists() => eprintln!("overwriting {}", f.display()),
         Some(_) => {}
         None => {
-            let how = match shipsim::format::osp::is_osp(sys) {
+            let how = match sys.format == shipsim::system::Format::Osp {
                 true => "pass -o FILE.csv",
                 false => "pass -o FILE.csv or add [output] file = \"FILE.csv\" to the system file",
             };

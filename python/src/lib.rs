@@ -581,9 +581,7 @@ impl PySystem {
             sys.output.variables = Some(v.clone());
         }
         sys.output.file = None;
-        if let Some(t) = stop_time {
-            sys.stop_time = Some(t);
-        }
+        sys.apply_stop_time(stop_time).map_err(|e| py_err(py, e))?;
         if let Some(t) = start_time {
             sys.start_time = t;
         }

@@ -75,10 +75,9 @@
 
 use super::{collected, line_of};
 use crate::error::{Error, Result};
-use crate::run::LastStep;
 use crate::system::{
-    Algorithm, ConnectionSpec, EventSpec, InstanceSpec, OutputSpec, System, Value, ValueSpec,
-    VarRef,
+    Algorithm, ConnectionSpec, EventSpec, Format, InstanceSpec, LastStep, OutputSpec, System,
+    Value, ValueSpec, VarRef,
 };
 use serde::Deserialize;
 use std::collections::BTreeMap;
@@ -210,6 +209,7 @@ pub fn parse(path: &Path, text: &str) -> Result<System> {
     collected(r.errors)?;
     Ok(System {
         source: path.to_path_buf(),
+        format: Format::Toml,
         start_time: sim.start_time,
         stop_time: sim.stop_time,
         step_size: sim.step_size,

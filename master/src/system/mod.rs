@@ -13,9 +13,11 @@ use crate::error::{did_you_mean, Error, Result};
 use crate::fmu::UnpackedFmu;
 use std::path::PathBuf;
 
+pub mod last_step;
 pub mod plan;
 pub mod validate;
 
+pub use last_step::{LastStep, OffGrid};
 pub use plan::{Plan, PlanConnection, PlanEvent, PlanInstance, PlanOutput, StartValue};
 
 /// Master algorithm (implemented in [`crate::run::algorithm`]).
@@ -26,6 +28,19 @@ pub enum Algorithm {
     Jacobi,
     /// Instances step one after another in connection order, each using the newest outputs.
     GaussSeidel,
+}
+
+/// The format of the file a [`System`] was read from (set by its reader in [`crate::format`]):
+/// what validation and the run's checks need to know about the file, without knowing the
+/// readers.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Format {
+    /// shipsim's native TOML (`format::toml`).
+    Toml,
+    /// OSP `OspSystemStructure.xml` (`format::osp`).
+    Osp,
+    /// SSP 1.0: an `.ssp` archive or a `.ssd` file (`format::ssp`).
+    Ssp,
 }
 
 /// A value given in a system file or on the command line.
@@ -193,6 +208,8 @@ pub struct OutputSpec {
 #[derive(Debug, Clone)]
 pub struct System {
     pub source: PathBuf,
+    /// The format of [`System::source`].
+    pub format: Format,
     pub start_time: f64,
     pub stop_time: Option<f64>,
     pub step_size: f64,
@@ -209,13 +226,49 @@ pub struct System {
     pub strict_units: bool,
     /// A stop time off the base-step grid: stop before it (the default) or take a short last
     /// step to it (TOML `[simulation] last_step`, `shipsim run --last-step`).
-    pub last_step: crate::run::LastStep,
+    pub last_step: LastStep,
     /// The unpacked SSP archive the FMU paths point into, kept as long as the system (set by
     /// the SSP reader for `.ssp` files).
     pub archive: Option<std::sync::Arc<tempfile::TempDir>>,
 }
 
+/// How a run whose file has no end time is given one, the same words for every entry point.
+const GIVE_STOP_TIME: &str = "give the run a stop time: shipsim run --stop-time SECONDS, \
+     System.run(stop_time=SECONDS) in Python, or stop_time = SECONDS in a campaign file";
+
 impl System {
+    /// The stop time of a run: the one its caller gives, if any (`shipsim run --stop-time`,
+    /// Python's `System.run(stop_time=...)`, a campaign file's `stop_time`), replaces the
+    /// file's; then the run must have one ([`System::require_stop_time`]). Every entry point
+    /// of a run calls this, so that all of them accept and refuse the same files with the same
+    /// message.
+    pub fn apply_stop_time(&mut self, given: Option<f64>) -> Result<()> {
+        if let Some(t) = given {
+            self.stop_time = Some(t);
+        }
+        self.require_stop_time()
+    }
+
+    /// The end-time rule of a run: an OSP file may leave out `<EndTime>` (libcosim then runs
+    /// until it is stopped) and an SSD `DefaultExperiment@stopTime`; shipsim needs an end. A
+    /// system read from such a file whose stop time was not set since is an error naming the
+    /// file, instead of the one-second run that the validation's default stop time
+    /// (start + 1 s) would give. A TOML file without `stop_time` keeps that default.
+    /// `shipsim check` and Python's `System.check` validate without this rule: they run
+    /// nothing.
+    pub fn require_stop_time(&self) -> Result<()> {
+        let missing = match (self.stop_time, self.format) {
+            (Some(_), _) | (None, Format::Toml) => return Ok(()),
+            (None, Format::Osp) => "<EndTime>",
+            (None, Format::Ssp) => "<DefaultExperiment stopTime=\"...\">",
+        };
+        Err(Error::system(
+            &self.source,
+            None,
+            format!("the file has no {missing}; {GIVE_STOP_TIME}"),
+        ))
+    }
+
     /// The instance's FMU file exists (an error naming the file, line and instance if not).
     pub fn require_fmu(&self, inst: &InstanceSpec) -> Result<()> {
         if inst.fmu.exists() {
