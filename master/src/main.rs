@@ -67,7 +67,8 @@ enum Command {
         /// Set a parameter or start value: --set instance.variable=value (repeatable).
         #[arg(long = "set", value_name = "INST.VAR=VALUE")]
         set: Vec<String>,
-        /// Override the algorithm: jacobi or gauss-seidel.
+        /// Override the algorithm: jacobi or gauss-seidel (any case; gauss_seidel, gaussseidel
+        /// and seidel name Gauss-Seidel too, as in system files).
         #[arg(long)]
         algorithm: Option<String>,
         /// Make a unit mismatch on a connection an error in any system file (an OSP
@@ -337,7 +338,9 @@ fn dispatch(cmd: Command, session: &Session) -> shipsim::Result<()> {
             sys.apply_overrides(&set)?;
             sys.apply_stop_time(stop_time)?;
             if let Some(a) = algorithm {
-                sys.algorithm = parse_algorithm(&a)?;
+                sys.algorithm = a
+                    .parse::<Algorithm>()
+                    .map_err(|e| Error::Other(e.to_string()))?;
             }
             sys.strict_units |= strict_units;
             if let Some(l) = last_step.as_deref().and_then(shipsim::run::LastStep::parse) {
@@ -498,16 +501,6 @@ fn check(
         plan.algorithm
     );
     Ok(())
-}
-
-fn parse_algorithm(a: &str) -> shipsim::Result<Algorithm> {
-    match a.to_lowercase().as_str() {
-        "jacobi" => Ok(Algorithm::Jacobi),
-        "gauss-seidel" | "gauss_seidel" | "gaussseidel" => Ok(Algorithm::GaussSeidel),
-        _ => Err(Error::Other(format!(
-            "--algorithm {a}: use jacobi or gauss-seidel"
-        ))),
-    }
 }
 
 /// `shipsim run --checkpoint-at T FILE` and `--resume FILE`.

@@ -201,8 +201,12 @@ class System:
 
         ``variables``: ``instance.variable`` or ``instance.*`` (every output of the instance);
         default: the system file's ``[output]`` list, else every output. ``stop_time``,
-        ``start_time``, ``step_size`` [s] and ``algorithm`` (``"jacobi"`` or
-        ``"gauss-seidel"``) override the file's.
+        ``start_time``, ``step_size`` [s] and ``algorithm`` override the file's.
+        ``algorithm`` is read as in system files and by ``shipsim run --algorithm``, in any
+        case: ``"jacobi"``, or ``"gauss-seidel"`` (also ``"gauss_seidel"``, ``"gauss seidel"``,
+        ``"gaussseidel"``, ``"seidel"``); another name raises ``ValueError``. An OSP or SSP
+        file without an end time needs ``stop_time`` (as ``shipsim run`` needs
+        ``--stop-time``): without it the run raises :class:`SystemFileError`.
 
         Returns a pandas DataFrame indexed by time [s], one column per variable, with
         ``df.attrs["units"]`` (column -> unit), ``df.attrs["summary"]`` (steps, wall time,

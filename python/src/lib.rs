@@ -589,15 +589,10 @@ impl PySystem {
             sys.step_size = h;
         }
         if let Some(a) = algorithm {
-            sys.algorithm = match a.to_lowercase().replace('_', "-").as_str() {
-                "jacobi" => shipsim::system::Algorithm::Jacobi,
-                "gauss-seidel" => shipsim::system::Algorithm::GaussSeidel,
-                _ => {
-                    return Err(pyo3::exceptions::PyValueError::new_err(format!(
-                        "algorithm '{a}': use 'jacobi' or 'gauss-seidel'"
-                    )))
-                }
-            };
+            // The library's parser, as for system files and `shipsim run --algorithm`.
+            sys.algorithm = a.parse().map_err(|e: shipsim::system::UnknownAlgorithm| {
+                pyo3::exceptions::PyValueError::new_err(e.to_string())
+            })?;
         }
         let plan = sys.validate(&self.mds()).map_err(|e| py_err(py, e))?;
         let interrupt = Arc::new(AtomicBool::new(false));

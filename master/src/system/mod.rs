@@ -21,6 +21,16 @@ pub use last_step::{LastStep, OffGrid};
 pub use plan::{Plan, PlanConnection, PlanEvent, PlanInstance, PlanOutput, StartValue};
 
 /// Master algorithm (implemented in [`crate::run::algorithm`]).
+///
+/// Its names are read by [`str::parse`] ([`Algorithm::from_str`](std::str::FromStr)), the one
+/// parser of the TOML `[simulation] algorithm`, `shipsim run --algorithm` and Python's
+/// `System.run(algorithm=...)`. Case does not matter (`Jacobi`, `GAUSS-SEIDEL`):
+///
+/// - `jacobi`: [`Algorithm::Jacobi`];
+/// - `gauss-seidel`, `gauss_seidel`, `gauss seidel`, `gaussseidel`, `seidel`:
+///   [`Algorithm::GaussSeidel`].
+///
+/// Any other name is an [`UnknownAlgorithm`], whose message is the same everywhere.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Algorithm {
     /// All instances step in parallel from the outputs of the previous communication point.
@@ -29,6 +39,38 @@ pub enum Algorithm {
     /// Instances step one after another in connection order, each using the newest outputs.
     GaussSeidel,
 }
+
+impl std::str::FromStr for Algorithm {
+    type Err = UnknownAlgorithm;
+
+    /// The names listed at [`Algorithm`], in any case.
+    fn from_str(name: &str) -> std::result::Result<Algorithm, UnknownAlgorithm> {
+        match name.to_lowercase().as_str() {
+            "jacobi" => Ok(Algorithm::Jacobi),
+            "gauss-seidel" | "gauss_seidel" | "gauss seidel" | "gaussseidel" | "seidel" => {
+                Ok(Algorithm::GaussSeidel)
+            }
+            _ => Err(UnknownAlgorithm(name.to_string())),
+        }
+    }
+}
+
+/// A name that is not one of [`Algorithm`]'s; its message:
+/// `unknown algorithm "NAME"; use "jacobi" or "gauss-seidel"`.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct UnknownAlgorithm(pub String);
+
+impl std::fmt::Display for UnknownAlgorithm {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "unknown algorithm \"{}\"; use \"jacobi\" or \"gauss-seidel\"",
+            self.0
+        )
+    }
+}
+
+impl std::error::Error for UnknownAlgorithm {}
 
 /// The format of the file a [`System`] was read from (set by its reader in [`crate::format`]):
 /// what validation and the run's checks need to know about the file, without knowing the
@@ -334,5 +376,35 @@ impl System {
             line: None,
         });
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Algorithm;
+
+    #[test]
+    fn algorithm_names_in_any_case_and_one_message_for_the_rest() {
+        for name in ["jacobi", "Jacobi", "JACOBI"] {
+            assert_eq!(name.parse(), Ok(Algorithm::Jacobi));
+        }
+        for name in [
+            "gauss-seidel",
+            "gauss_seidel",
+            "gauss seidel",
+            "gaussseidel",
+            "seidel",
+            "Gauss-Seidel",
+            "GAUSS_SEIDEL",
+            "Seidel",
+        ] {
+            assert_eq!(name.parse(), Ok(Algorithm::GaussSeidel), "{name}");
+        }
+        for name in ["", " jacobi", "gauss--seidel", "gauss", "rk4"] {
+            assert_eq!(
+                name.parse::<Algorithm>().unwrap_err().to_string(),
+                format!("unknown algorithm \"{name}\"; use \"jacobi\" or \"gauss-seidel\"")
+            );
+        }
     }
 }
