@@ -99,7 +99,7 @@ enum Command {
         /// Run FMU instances in their own processes, so that a crash, exit() or hang of an FMU
         /// is an error naming it and every completed step is kept: all of them (--isolate),
         /// those of FMUs not built by this project (--isolate=foreign) or the named ones
-        /// (--isolate=NAME,NAME). See docs/isolation.md.
+        /// (--isolate=NAME,NAME; each an instance of the system). See docs/isolation.md.
         #[arg(long, num_args = 0..=1, require_equals = true, default_missing_value = "all", value_name = "all|foreign|NAMES")]
         isolate: Option<String>,
         /// The longest wall time of one FMI call [s]: an isolated instance's process is then
@@ -352,7 +352,7 @@ fn dispatch(cmd: Command, session: &Session) -> shipsim::Result<()> {
                 profile: profile.map(|f| (f, profile_every)),
                 verbose,
                 quiet,
-                isolation: cli::isolate::isolation(isolate.as_deref(), call_timeout)?,
+                isolation: cli::isolate::isolation(isolate.as_deref(), call_timeout, &sys)?,
             };
             run_cli(&sys, &flags, checkpoints, session, &limits)
         }

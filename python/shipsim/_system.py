@@ -214,12 +214,15 @@ class System:
         ``as_frame=False``), a :class:`Columns` dict of numpy arrays with ``time``.
 
         ``isolate`` runs FMU instances out of process (docs/isolation.md), like ``shipsim run
-        --isolate``: ``True`` or ``"all"`` (every instance), ``"foreign"`` (FMUs not built by
-        this project), or a list of instance names. A segfault, ``abort()``, ``exit()`` or hang
-        of an isolated FMU then raises :class:`SimulationError` naming the instance, the call
-        and the time, and this Python process lives on. ``call_timeout`` [s] kills an isolated
-        FMU call that runs longer. Instances with ``isolate = true`` in the system file are
-        isolated whatever the argument.
+        --isolate``, with the same values and messages: ``True`` or ``"all"`` (every instance),
+        ``"foreign"`` (FMUs not built by this project), instance names separated by commas
+        (``"gear,autopilot"``) or a list of them; ``None`` or ``False``: none. A name that is no
+        instance raises :class:`VariableError`, an empty string ``ValueError``. A segfault,
+        ``abort()``, ``exit()`` or hang of an isolated FMU then raises
+        :class:`SimulationError` naming the instance, the call and the time, and this Python
+        process lives on. ``call_timeout`` [s] (a positive number, at most 1e9; else
+        ``ValueError``) kills an isolated FMU call that runs longer. Instances with
+        ``isolate = true`` in the system file are isolated whatever the argument.
 
         The GIL is released while the master runs. Ctrl-C stops the run at its next
         communication point and raises ``KeyboardInterrupt``. FMU log messages go to the
@@ -227,6 +230,8 @@ class System:
         """
         if isolate is True:
             isolate = "all"
+        elif isolate is False:
+            isolate = None
         names = None
         if isolate is not None and not isinstance(isolate, str):
             names, isolate = [str(n) for n in isolate], None
@@ -237,7 +242,7 @@ class System:
             step_size=step_size,
             algorithm=algorithm,
             verbose=verbose,
-            isolate=None if isolate is False else isolate,
+            isolate=isolate,
             isolate_instances=names,
             call_timeout=call_timeout,
         )

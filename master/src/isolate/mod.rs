@@ -12,13 +12,15 @@
 //! - [`host`]: the child's end, `shipsim fmu-host FMU`, which loads the FMU with the same
 //!   importer ([`crate::fmu`]) and makes the calls;
 //! - [`monitor`]: for instances in process, which call is in progress (for the CLI's `exit()`
-//!   hook and in-process watchdog).
+//!   hook and in-process watchdog);
+//! - [`options`]: the run's isolation options as the CLI and Python give them, one parser.
 //!
 //! docs/isolation.md is the user's guide.
 
 pub mod client;
 pub mod host;
 pub mod monitor;
+pub mod options;
 pub mod protocol;
 
 use crate::error::{Error, Result};
@@ -29,6 +31,7 @@ use std::sync::OnceLock;
 use std::time::Duration;
 
 pub use monitor::CallMonitor;
+pub use options::IsolationError;
 
 /// Which instances of a run are isolated.
 #[derive(Clone, Debug, Default, PartialEq)]
