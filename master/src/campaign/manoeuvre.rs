@@ -41,7 +41,7 @@ pub struct ManoeuvreKpi {
 }
 
 impl ManoeuvreKpi {
-    /// The KPI of `manoeuvre` executed at `execute_time` [s] by a ship of `length` [m];
+    /// The KPI of `manoeuvre` executed at `execute_time` (s) by a ship of `length` (m);
     /// `columns` are the recorded columns of its variables (x, y, heading for a turning
     /// circle; heading for a zig-zag: the campaign's `KpiSpec::variables`).
     pub fn new(

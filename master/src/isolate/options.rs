@@ -18,7 +18,7 @@ use crate::error::did_you_mean;
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
-/// The longest call time limit [s]: longer is no limit at all (about 31 years).
+/// The longest call time limit in seconds: longer is no limit at all (about 31 years).
 pub const MAX_CALL_TIMEOUT: f64 = 1e9;
 
 /// An isolation option that cannot be used.
