@@ -67,7 +67,8 @@ enum Command {
         /// Set a parameter or start value: --set instance.variable=value (repeatable).
         #[arg(long = "set", value_name = "INST.VAR=VALUE")]
         set: Vec<String>,
-        /// Override the algorithm: jacobi or gauss-seidel.
+        /// Override the algorithm: jacobi or gauss-seidel (any case; gauss_seidel, gaussseidel
+        /// and seidel name Gauss-Seidel too, as in system files).
         #[arg(long)]
         algorithm: Option<String>,
         /// Make a unit mismatch on a connection an error in any system file (an OSP
@@ -98,7 +99,7 @@ enum Command {
         /// Run FMU instances in their own processes, so that a crash, exit() or hang of an FMU
         /// is an error naming it and every completed step is kept: all of them (--isolate),
         /// those of FMUs not built by this project (--isolate=foreign) or the named ones
-        /// (--isolate=NAME,NAME). See docs/isolation.md.
+        /// (--isolate=NAME,NAME; each an instance of the system). See docs/isolation.md.
         #[arg(long, num_args = 0..=1, require_equals = true, default_missing_value = "all", value_name = "all|foreign|NAMES")]
         isolate: Option<String>,
         /// The longest wall time of one FMI call [s]: an isolated instance's process is then
@@ -335,12 +336,11 @@ fn dispatch(cmd: Command, session: &Session) -> shipsim::Result<()> {
             };
             let mut sys = System::load(&system)?;
             sys.apply_overrides(&set)?;
-            if let Some(t) = stop_time {
-                sys.stop_time = Some(t);
-            }
-            shipsim::format::osp::require_end_time(&sys)?;
+            sys.apply_stop_time(stop_time)?;
             if let Some(a) = algorithm {
-                sys.algorithm = parse_algorithm(&a)?;
+                sys.algorithm = a
+                    .parse::<Algorithm>()
+                    .map_err(|e| Error::Other(e.to_string()))?;
             }
             sys.strict_units |= strict_units;
             if let Some(l) = last_step.as_deref().and_then(shipsim::run::LastStep::parse) {
@@ -352,7 +352,7 @@ fn dispatch(cmd: Command, session: &Session) -> shipsim::Result<()> {
                 profile: profile.map(|f| (f, profile_every)),
                 verbose,
                 quiet,
-                isolation: cli::isolate::isolation(isolate.as_deref(), call_timeout)?,
+                isolation: cli::isolate::isolation(isolate.as_deref(), call_timeout, &sys)?,
             };
             run_cli(&sys, &flags, checkpoints, session, &limits)
         }
@@ -503,16 +503,6 @@ fn check(
     Ok(())
 }
 
-fn parse_algorithm(a: &str) -> shipsim::Result<Algorithm> {
-    match a.to_lowercase().as_str() {
-        "jacobi" => Ok(Algorithm::Jacobi),
-        "gauss-seidel" | "gauss_seidel" | "gaussseidel" => Ok(Algorithm::GaussSeidel),
-        _ => Err(Error::Other(format!(
-            "--algorithm {a}: use jacobi or gauss-seidel"
-        ))),
-    }
-}
-
 /// `shipsim run --checkpoint-at T FILE` and `--resume FILE`.
 struct Checkpoints {
     at: Option<(f64, PathBuf)>,
@@ -655,7 +645,7 @@ fn output_note(sys: &System, file: Option<&Path>) {
         Some(f) if f.exists() => eprintln!("overwriting {}", f.display()),
         Some(_) => {}
         None => {
-            let how = match shipsim::format::osp::is_osp(sys) {
+            let how = match sys.format == shipsim::system::Format::Osp {
                 true => "pass -o FILE.csv",
                 false => "pass -o FILE.csv or add [output] file = \"FILE.csv\" to the system file",
             };

@@ -201,8 +201,12 @@ class System:
 
         ``variables``: ``instance.variable`` or ``instance.*`` (every output of the instance);
         default: the system file's ``[output]`` list, else every output. ``stop_time``,
-        ``start_time``, ``step_size`` [s] and ``algorithm`` (``"jacobi"`` or
-        ``"gauss-seidel"``) override the file's.
+        ``start_time``, ``step_size`` [s] and ``algorithm`` override the file's.
+        ``algorithm`` is read as in system files and by ``shipsim run --algorithm``, in any
+        case: ``"jacobi"``, or ``"gauss-seidel"`` (also ``"gauss_seidel"``, ``"gauss seidel"``,
+        ``"gaussseidel"``, ``"seidel"``); another name raises ``ValueError``. An OSP or SSP
+        file without an end time needs ``stop_time`` (as ``shipsim run`` needs
+        ``--stop-time``): without it the run raises :class:`SystemFileError`.
 
         Returns a pandas DataFrame indexed by time [s], one column per variable, with
         ``df.attrs["units"]`` (column -> unit), ``df.attrs["summary"]`` (steps, wall time,
@@ -210,12 +214,15 @@ class System:
         ``as_frame=False``), a :class:`Columns` dict of numpy arrays with ``time``.
 
         ``isolate`` runs FMU instances out of process (docs/isolation.md), like ``shipsim run
-        --isolate``: ``True`` or ``"all"`` (every instance), ``"foreign"`` (FMUs not built by
-        this project), or a list of instance names. A segfault, ``abort()``, ``exit()`` or hang
-        of an isolated FMU then raises :class:`SimulationError` naming the instance, the call
-        and the time, and this Python process lives on. ``call_timeout`` [s] kills an isolated
-        FMU call that runs longer. Instances with ``isolate = true`` in the system file are
-        isolated whatever the argument.
+        --isolate``, with the same values and messages: ``True`` or ``"all"`` (every instance),
+        ``"foreign"`` (FMUs not built by this project), instance names separated by commas
+        (``"gear,autopilot"``) or a list of them; ``None`` or ``False``: none. A name that is no
+        instance raises :class:`VariableError`, an empty string ``ValueError``. A segfault,
+        ``abort()``, ``exit()`` or hang of an isolated FMU then raises
+        :class:`SimulationError` naming the instance, the call and the time, and this Python
+        process lives on. ``call_timeout`` [s] (a positive number, at most 1e9; else
+        ``ValueError``) kills an isolated FMU call that runs longer. Instances with
+        ``isolate = true`` in the system file are isolated whatever the argument.
 
         The GIL is released while the master runs. Ctrl-C stops the run at its next
         communication point and raises ``KeyboardInterrupt``. FMU log messages go to the
@@ -223,6 +230,8 @@ class System:
         """
         if isolate is True:
             isolate = "all"
+        elif isolate is False:
+            isolate = None
         names = None
         if isolate is not None and not isinstance(isolate, str):
             names, isolate = [str(n) for n in isolate], None
@@ -233,7 +242,7 @@ class System:
             step_size=step_size,
             algorithm=algorithm,
             verbose=verbose,
-            isolate=None if isolate is False else isolate,
+            isolate=isolate,
             isolate_instances=names,
             call_timeout=call_timeout,
         )

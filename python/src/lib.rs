@@ -387,50 +387,42 @@ impl PySystem {
         self.fmus.iter().map(|f| &f.model_description).collect()
     }
 
-    /// Checks `instance.variable` (or `instance.*` when `wildcard`), with "did you mean".
-    /// The run's isolation (`System.run(isolate=..., call_timeout=...)`): `isolate` "all" or
-    /// "foreign", or the named instances; a call time limit in seconds.
+    /// The run's isolation (`System.run(isolate=..., call_timeout=...)`), by the library's
+    /// parser that `shipsim run --isolate` uses too ([`shipsim::isolate::options`]): `isolate`
+    /// "all", "foreign" or instance names separated by commas, or a list of instance names; a
+    /// call time limit in seconds. An instance that does not exist is a [`VariableError`], a
+    /// value that cannot be used a `ValueError`; the messages are the CLI's.
     fn isolation(
         &self,
         isolate: Option<String>,
         instances: Option<Vec<String>>,
         call_timeout: Option<f64>,
     ) -> PyResult<shipsim::isolate::Isolation> {
-        use shipsim::isolate::{IsolateMode, Isolation};
-        let mode = match (isolate.as_deref(), instances) {
+        use shipsim::isolate::{IsolateMode, Isolation, IsolationError};
+        let to_py = |e: IsolationError| match e {
+            IsolationError::UnknownInstance { .. } => VariableError::new_err(e.to_string()),
+            e => pyo3::exceptions::PyValueError::new_err(e.to_string()),
+        };
+        let mode = match (isolate, instances) {
             (None, None) => IsolateMode::None,
-            (Some("all"), None) => IsolateMode::All,
-            (Some("foreign"), None) => IsolateMode::Foreign,
-            (None, Some(names)) => {
-                for n in &names {
-                    self.check_name(&format!("{n}.*"), true)?;
-                }
-                IsolateMode::Instances(names)
-            }
-            (Some(other), _) => {
-                return Err(pyo3::exceptions::PyValueError::new_err(format!(
-                "isolate={other:?}: use True or \"all\", \"foreign\", or a list of instance names"
-            )))
+            (Some(v), None) => IsolateMode::parse(&v).map_err(to_py)?,
+            (None, Some(names)) => IsolateMode::Instances(names),
+            (Some(_), Some(_)) => {
+                return Err(pyo3::exceptions::PyValueError::new_err(
+                    "isolate: give a value or a list of instance names, not both",
+                ))
             }
         };
-        let call_timeout = match call_timeout {
-            None => None,
-            Some(s) if s.is_finite() && s > 0.0 && s <= 1e9 => {
-                Some(std::time::Duration::from_secs_f64(s))
-            }
-            Some(s) => {
-                return Err(pyo3::exceptions::PyValueError::new_err(format!(
-                    "call_timeout={s}: give a positive number of seconds"
-                )))
-            }
-        };
-        Ok(Isolation {
-            mode,
-            call_timeout,
-            host: None,
-        })
+        let names: Vec<&str> = self
+            .system
+            .instances
+            .iter()
+            .map(|i| i.name.as_str())
+            .collect();
+        Isolation::from_options(mode, call_timeout, &self.system.source, &names).map_err(to_py)
     }
 
+    /// Checks `instance.variable` (or `instance.*` when `wildcard`), with "did you mean".
     fn check_name(&self, name: &str, wildcard: bool) -> PyResult<()> {
         let instances = || self.system.instances.iter().map(|i| i.name.as_str());
         let (inst, var) = match name.split_once('.') {
@@ -581,9 +573,7 @@ impl PySystem {
             sys.output.variables = Some(v.clone());
         }
         sys.output.file = None;
-        if let Some(t) = stop_time {
-            sys.stop_time = Some(t);
-        }
+        sys.apply_stop_time(stop_time).map_err(|e| py_err(py, e))?;
         if let Some(t) = start_time {
             sys.start_time = t;
         }
@@ -591,15 +581,10 @@ impl PySystem {
             sys.step_size = h;
         }
         if let Some(a) = algorithm {
-            sys.algorithm = match a.to_lowercase().replace('_', "-").as_str() {
-                "jacobi" => shipsim::system::Algorithm::Jacobi,
-                "gauss-seidel" => shipsim::system::Algorithm::GaussSeidel,
-                _ => {
-                    return Err(pyo3::exceptions::PyValueError::new_err(format!(
-                        "algorithm '{a}': use 'jacobi' or 'gauss-seidel'"
-                    )))
-                }
-            };
+            // The library's parser, as for system files and `shipsim run --algorithm`.
+            sys.algorithm = a.parse().map_err(|e: shipsim::system::UnknownAlgorithm| {
+                pyo3::exceptions::PyValueError::new_err(e.to_string())
+            })?;
         }
         let plan = sys.validate(&self.mds()).map_err(|e| py_err(py, e))?;
         let interrupt = Arc::new(AtomicBool::new(false));

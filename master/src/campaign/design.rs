@@ -28,14 +28,10 @@
 //! SHA-256 of everything that determines it: the base inputs' hash (system and FMU files),
 //! the stop time, the warm-up time and every value set, sorted.
 
-use super::spec::{CampaignSpec, Levels, SamplingMethod};
+use super::spec::{CampaignSpec, Levels, SamplingMethod, MAX_RUNS};
 use crate::error::{Error, Result};
 use crate::system::Value;
 use sha2::{Digest, Sha256};
-
-/// The most runs (and design points) a campaign file may expand to: every run is held in
-/// memory with the values it sets (about a kilobyte each).
-pub const MAX_RUNS: usize = 1_000_000;
 
 /// One run of the campaign.
 #[derive(Debug, Clone, PartialEq)]

@@ -19,8 +19,11 @@
 //!
 //! Manoeuvring KPIs feed the streaming trackers of `models::manoeuvre` (IMO MSC.137(76)).
 
+use super::manoeuvre::ManoeuvreKpi;
 use crate::error::{Error, Result};
 use crate::run::{ColumnInfo, Recorder, Row, Sample};
+
+pub use super::manoeuvre::Manoeuvre;
 
 /// A statistic over a time window.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -37,24 +40,6 @@ pub enum Stat {
     FirstAbove(f64),
     FirstBelow(f64),
     Settling { target: f64, band: f64 },
-}
-
-/// A ready-made manoeuvring KPI.
-#[derive(Debug, Clone, PartialEq)]
-pub enum Manoeuvre {
-    /// Advance, transfer and tactical diameter; IMO: advance < 4.5 L, tactical diameter < 5 L.
-    TurningCircle {
-        x: String,
-        y: String,
-        heading: String,
-    },
-    /// First and second overshoot angles; IMO limits by check angle (10/10, 20/20) and L/U.
-    ZigZag {
-        heading: String,
-        check_angle: f64,
-        rudder_sign: f64,
-        speed: f64,
-    },
 }
 
 /// A KPI declared in the campaign file.
@@ -240,7 +225,7 @@ impl StatAccumulator {
 /// One KPI's accumulator, bound to recorded columns.
 enum Accumulator {
     Stat { column: usize, acc: StatAccumulator },
-    Manoeuvre(Box<super::manoeuvre::ManoeuvreKpi>),
+    Manoeuvre(Box<ManoeuvreKpi>),
 }
 
 /// The KPIs of one run, as a [`Recorder`].
@@ -272,7 +257,15 @@ impl<'a> KpiRecorder<'a> {
         for a in &self.accumulators {
             match a {
                 Accumulator::Stat { acc, .. } => out.push(KpiValue::Number(acc.value())),
-                Accumulator::Manoeuvre(m) => m.values(&mut out),
+                Accumulator::Manoeuvre(m) => {
+                    let (numbers, pass) = m.values();
+                    out.extend(numbers.into_iter().map(KpiValue::Number));
+                    out.push(KpiValue::Verdict(match pass {
+                        Some(true) => "pass",
+                        Some(false) => "fail",
+                        None => "",
+                    }));
+                }
             }
         }
         out
@@ -315,13 +308,19 @@ impl Recorder for KpiRecorder<'_> {
                     column: find(variable)?,
                     acc: StatAccumulator::new(*stat, *window, *scale),
                 },
-                KpiSpec::Manoeuvre { .. } => {
+                KpiSpec::Manoeuvre {
+                    manoeuvre,
+                    execute_time,
+                    length,
+                    ..
+                } => {
                     let cols = k
                         .variables()
                         .into_iter()
                         .map(find)
                         .collect::<Result<Vec<_>>>()?;
-                    Accumulator::Manoeuvre(Box::new(super::manoeuvre::ManoeuvreKpi::new(k, &cols)))
+                    let m = ManoeuvreKpi::new(manoeuvre, *execute_time, *length, &cols);
+                    Accumulator::Manoeuvre(Box::new(m))
                 }
             });
         }

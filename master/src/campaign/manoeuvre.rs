@@ -1,10 +1,27 @@
 //! Manoeuvring KPIs of a run: the streaming trackers of `models::manoeuvre` fed from the
 //! recorded columns, judged against the IMO MSC.137(76) criteria.
 
-use super::kpi::{KpiSpec, KpiValue, Manoeuvre};
 use crate::run::Row;
 use models::hull::DEG;
 use models::manoeuvre::{imo, Sample, TurningCircleTracker, ZigZagMetrics, ZigZagTracker};
+
+/// A ready-made manoeuvring KPI.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Manoeuvre {
+    /// Advance, transfer and tactical diameter; IMO: advance < 4.5 L, tactical diameter < 5 L.
+    TurningCircle {
+        x: String,
+        y: String,
+        heading: String,
+    },
+    /// First and second overshoot angles; IMO limits by check angle (10/10, 20/20) and L/U.
+    ZigZag {
+        heading: String,
+        check_angle: f64,
+        rudder_sign: f64,
+        speed: f64,
+    },
+}
 
 // Both trackers are a few hundred bytes; the KPI is boxed as a whole (kpi.rs).
 #[allow(clippy::large_enum_variant)]
@@ -24,20 +41,18 @@ pub struct ManoeuvreKpi {
 }
 
 impl ManoeuvreKpi {
-    /// `columns` are the recorded columns of [`KpiSpec::variables`].
-    pub fn new(spec: &KpiSpec, columns: &[usize]) -> ManoeuvreKpi {
-        let KpiSpec::Manoeuvre {
-            manoeuvre,
-            execute_time,
-            length,
-            ..
-        } = spec
-        else {
-            unreachable!("a manoeuvre KPI")
-        };
+    /// The KPI of `manoeuvre` executed at `execute_time` (s) by a ship of `length` (m);
+    /// `columns` are the recorded columns of its variables (x, y, heading for a turning
+    /// circle; heading for a zig-zag: the campaign's `KpiSpec::variables`).
+    pub fn new(
+        manoeuvre: &Manoeuvre,
+        execute_time: f64,
+        length: f64,
+        columns: &[usize],
+    ) -> ManoeuvreKpi {
         let (tracker, speed, check_angle) = match manoeuvre {
             Manoeuvre::TurningCircle { .. } => (
-                Tracker::Turning(TurningCircleTracker::new(*execute_time)),
+                Tracker::Turning(TurningCircleTracker::new(execute_time)),
                 f64::NAN,
                 f64::NAN,
             ),
@@ -47,11 +62,7 @@ impl ManoeuvreKpi {
                 speed,
                 ..
             } => (
-                Tracker::ZigZag(ZigZagTracker::new(
-                    *execute_time,
-                    *rudder_sign,
-                    *check_angle,
-                )),
+                Tracker::ZigZag(ZigZagTracker::new(execute_time, *rudder_sign, *check_angle)),
                 *speed,
                 *check_angle,
             ),
@@ -59,7 +70,7 @@ impl ManoeuvreKpi {
         ManoeuvreKpi {
             tracker,
             columns: columns.to_vec(),
-            length: *length,
+            length,
             speed,
             check_angle,
         }
@@ -84,36 +95,24 @@ impl ManoeuvreKpi {
         }
     }
 
-    /// The KPI values in the order of [`KpiSpec::columns`]; NaN and "" where the run did not
-    /// reach the event a metric needs.
-    pub fn values(&self, out: &mut Vec<KpiValue>) {
-        let n = |x: f64| KpiValue::Number(x);
-        let verdict = |pass: Option<bool>| {
-            KpiValue::Verdict(match pass {
-                Some(true) => "pass",
-                Some(false) => "fail",
-                None => "",
-            })
-        };
+    /// The KPI's metrics and its IMO verdict (None: not judged), in the order of its columns
+    /// (advance, transfer, tactical diameter; first and second overshoot; the verdict last);
+    /// NaN and None where the run did not reach the event a metric needs.
+    pub fn values(&self) -> (Vec<f64>, Option<bool>) {
         match &self.tracker {
             Tracker::Turning(tr) => match tr.finish() {
                 Ok(m) => {
                     let pass = imo::check_turning(&m, self.length).ok().map(|c| c.pass);
-                    out.extend([
-                        n(m.advance),
-                        n(m.transfer),
-                        n(m.tactical_diameter),
-                        verdict(pass),
-                    ]);
+                    (vec![m.advance, m.transfer, m.tactical_diameter], pass)
                 }
-                Err(_) => out.extend([n(f64::NAN), n(f64::NAN), n(f64::NAN), verdict(None)]),
+                Err(_) => (vec![f64::NAN; 3], None),
             },
             Tracker::ZigZag(tr) => match tr.finish() {
                 Ok(m) => {
                     let pass = self.zigzag_pass(&m);
-                    out.extend([n(m.first_overshoot), n(m.second_overshoot), verdict(pass)]);
+                    (vec![m.first_overshoot, m.second_overshoot], pass)
                 }
-                Err(_) => out.extend([n(f64::NAN), n(f64::NAN), verdict(None)]),
+                Err(_) => (vec![f64::NAN; 2], None),
             },
         }
     }

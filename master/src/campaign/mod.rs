@@ -75,9 +75,7 @@ impl Campaign {
     /// A checked campaign file with its base system given (e.g. with the FMU paths pointed
     /// elsewhere): records the KPI variables, hashes the system file and FMUs, expands the runs.
     pub fn new(spec: CampaignSpec, mut system: System) -> Result<Campaign> {
-        if let Some(t) = spec.stop_time {
-            system.stop_time = Some(t);
-        }
+        system.apply_stop_time(spec.stop_time)?;
         let mut variables: Vec<String> = Vec::new();
         let series = spec.series.iter().flat_map(|s| s.variables.iter().cloned());
         for v in spec

@@ -19,6 +19,11 @@ use serde::{Deserialize, Serialize};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
+/// The file name of run `index`'s series in `series/`.
+pub(super) fn series_name(index: usize) -> String {
+    format!("run-{index:06}.csv")
+}
+
 /// The provenance sidecar.
 #[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
 pub struct Provenance {

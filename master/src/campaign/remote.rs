@@ -121,7 +121,7 @@ impl Collector {
             let dir = self.dir.join("series");
             std::fs::create_dir_all(&dir)
                 .map_err(|e| Error::io(format!("cannot create {}", dir.display()), e))?;
-            output::write_atomic(&dir.join(series_name(record.index)), bytes)?;
+            output::write_atomic(&dir.join(output::series_name(record.index)), bytes)?;
         }
         self.journal.append(record)?;
         Ok(true)
@@ -144,11 +144,6 @@ pub fn run_table(campaign: &Campaign, journal: &Journal) -> Table {
 /// The run table of a campaign's output folder (from its journal).
 pub fn read_run_table(campaign: &Campaign, dir: &Path) -> Result<Table> {
     Ok(run_table(campaign, &Journal::open(dir)?))
-}
-
-/// The file name of run `index`'s series in `series/`.
-pub(super) fn series_name(index: usize) -> String {
-    format!("run-{index:06}.csv")
 }
 
 /// A worker's side: the campaign and its FMUs, each loaded once for the life of the worker.
@@ -185,7 +180,7 @@ impl Worker {
         records
             .into_iter()
             .map(|r| {
-                let path = series.path().join(series_name(r.index));
+                let path = series.path().join(output::series_name(r.index));
                 let bytes = match path.exists() {
                     true => Some(
                         std::fs::read(&path)

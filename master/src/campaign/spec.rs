@@ -55,6 +55,10 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use toml::Spanned;
 
+/// The most runs (and design points) a campaign file may expand to: every run is held in
+/// memory with the values it sets (about a kilobyte each).
+pub const MAX_RUNS: usize = 1_000_000;
+
 /// A campaign file, checked.
 #[derive(Debug, Clone)]
 pub struct CampaignSpec {
@@ -545,13 +549,12 @@ impl Reader<'_> {
                 "[sampling] is given but no factor is uniform or normal".into(),
             );
         }
-        if s.samples == 0 || s.samples > super::design::MAX_RUNS {
+        if s.samples == 0 || s.samples > MAX_RUNS {
             self.error(
                 None,
                 format!(
                     "sampling: samples = {} must be 1 ..= {}",
-                    s.samples,
-                    super::design::MAX_RUNS
+                    s.samples, MAX_RUNS
                 ),
             );
         }

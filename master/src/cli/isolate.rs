@@ -11,9 +11,9 @@
 //!   Isolated instances have their own limit: their process is killed and the run ends through
 //!   its normal error path.
 
-use shipsim::error::Error;
 use shipsim::isolate::{IsolateMode, Isolation};
 use shipsim::slave::CallMonitor;
+use shipsim::system::System;
 use std::sync::{Arc, OnceLock};
 use std::time::{Duration, Instant};
 
@@ -23,34 +23,25 @@ pub const EXIT_FMU: i32 = 1;
 /// The monitor of the run in progress and the thread that runs it.
 static GUARDED: OnceLock<(Arc<CallMonitor>, libc::pthread_t)> = OnceLock::new();
 
-/// `--isolate[=all|foreign|NAME,...]` and `--call-timeout SECONDS` as run options.
-pub fn isolation(isolate: Option<&str>, call_timeout: Option<f64>) -> shipsim::Result<Isolation> {
+/// `--isolate[=all|foreign|NAME,...]` and `--call-timeout SECONDS` as the options of a run of
+/// `sys`: the library's parser ([`shipsim::isolate::options`]), which Python's `System.run`
+/// uses too.
+pub fn isolation(
+    isolate: Option<&str>,
+    call_timeout: Option<f64>,
+    sys: &System,
+) -> shipsim::Result<Isolation> {
     let mode = match isolate {
         None => IsolateMode::None,
-        Some("all") => IsolateMode::All,
-        Some("foreign") => IsolateMode::Foreign,
-        Some(names) => IsolateMode::Instances(
-            names
-                .split(',')
-                .map(|n| n.trim().to_string())
-                .filter(|n| !n.is_empty())
-                .collect(),
-        ),
+        Some(v) => IsolateMode::parse(v)?,
     };
-    let call_timeout = match call_timeout {
-        None => None,
-        Some(s) if s.is_finite() && s > 0.0 && s <= 1e9 => Some(Duration::from_secs_f64(s)),
-        Some(s) => {
-            return Err(Error::Other(format!(
-                "--call-timeout {s}: give a positive number of seconds"
-            )))
-        }
-    };
-    Ok(Isolation {
+    let names: Vec<&str> = sys.instances.iter().map(|i| i.name.as_str()).collect();
+    Ok(Isolation::from_options(
         mode,
         call_timeout,
-        host: None,
-    })
+        &sys.source,
+        &names,
+    )?)
 }
 
 /// Installs the `atexit` hook (and, with a limit, the watchdog) for a run on this thread; the

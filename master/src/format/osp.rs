@@ -11,7 +11,8 @@ use super::{collected, line_of};
 use crate::error::{Error, Result};
 use crate::model_description::{Causality, ModelDescription, ScalarVariable, VarType};
 use crate::system::{
-    Algorithm, InstanceSpec, OutputSpec, Plan, PlanConnection, System, TypedValue, Value, ValueSpec,
+    Algorithm, Format, InstanceSpec, OutputSpec, Plan, PlanConnection, System, TypedValue, Value,
+    ValueSpec,
 };
 use serde::Deserialize;
 use std::collections::HashMap;
@@ -224,6 +225,7 @@ pub fn parse(path: &Path, text: &str) -> Result<System> {
     collected(r.errors)?;
     Ok(System {
         source: path.to_path_buf(),
+        format: Format::Osp,
         start_time: root.start_time.unwrap_or(0.0),
         stop_time: root.end_time,
         step_size: h,
@@ -242,27 +244,11 @@ pub fn parse(path: &Path, text: &str) -> Result<System> {
     })
 }
 
-/// Was the system read from an OSP file (`.xml`, as [`System::load`] decides)?
-pub fn is_osp(sys: &System) -> bool {
-    sys.source
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("xml"))
-}
-
-/// An OSP file may leave out `<EndTime>` (libcosim then runs until it is stopped); shipsim
-/// needs an end. A system read from such a file (`.xml`, [`parse`]) whose stop time was not set
-/// since (`shipsim run --stop-time`) is an error naming the file, instead of the one-second run
-/// that the validation's default stop time (start + 1 s) would give. Other systems pass.
+/// The end-time rule of a run for a system read from an OSP or SSP file: the system's own
+/// [`System::require_stop_time`], which every entry point of a run applies (kept here for
+/// callers of this path).
 pub fn require_end_time(sys: &System) -> Result<()> {
-    super::ssp::require_stop_time(sys)?;
-    if is_osp(sys) && sys.stop_time.is_none() {
-        return Err(Error::system(
-            &sys.source,
-            None,
-            "the file has no <EndTime>; pass the stop time with --stop-time SECONDS",
-        ));
-    }
-    Ok(())
+    sys.require_stop_time()
 }
 
 impl Reader<'_> {

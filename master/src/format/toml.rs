@@ -8,7 +8,8 @@
 //! start_time = 0.0
 //! stop_time = 100.0
 //! step_size = 0.01          # base step h; t_k = start_time + k*h
-//! algorithm = "jacobi"      # or "gauss-seidel"
+//! algorithm = "jacobi"      # or "gauss-seidel" (any case; also gauss_seidel, gaussseidel,
+//!                           # seidel: the names of `Algorithm`'s `FromStr`)
 //! last_step = "drop"        # stop_time off the grid: "drop" stops at the grid point before
 //!                           # it, "short" takes a shorter last step to it
 //!
@@ -75,10 +76,9 @@
 
 use super::{collected, line_of};
 use crate::error::{Error, Result};
-use crate::run::LastStep;
 use crate::system::{
-    Algorithm, ConnectionSpec, EventSpec, InstanceSpec, OutputSpec, System, Value, ValueSpec,
-    VarRef,
+    Algorithm, ConnectionSpec, EventSpec, Format, InstanceSpec, LastStep, OutputSpec, System,
+    UnknownAlgorithm, Value, ValueSpec, VarRef,
 };
 use serde::Deserialize;
 use std::collections::BTreeMap;
@@ -210,6 +210,7 @@ pub fn parse(path: &Path, text: &str) -> Result<System> {
     collected(r.errors)?;
     Ok(System {
         source: path.to_path_buf(),
+        format: Format::Toml,
         start_time: sim.start_time,
         stop_time: sim.stop_time,
         step_size: sim.step_size,
@@ -256,18 +257,11 @@ impl Reader<'_> {
         let Some(a) = a else {
             return Algorithm::Jacobi;
         };
-        match a.get_ref().to_lowercase().replace(['_', ' '], "-").as_str() {
-            "jacobi" => Algorithm::Jacobi,
-            "gauss-seidel" | "gaussseidel" | "seidel" => Algorithm::GaussSeidel,
-            other => {
-                let line = self.line(a.span());
-                self.error(
-                    line,
-                    format!("unknown algorithm \"{other}\"; use \"jacobi\" or \"gauss-seidel\""),
-                );
-                Algorithm::Jacobi
-            }
-        }
+        a.get_ref().parse().unwrap_or_else(|e: UnknownAlgorithm| {
+            let line = self.line(a.span());
+            self.error(line, e.to_string());
+            Algorithm::Jacobi
+        })
     }
 
     fn instance(&mut self, inst: Spanned<RawInstance>) -> InstanceSpec {

@@ -11,12 +11,14 @@
 //!   (preallocated buffers: a step allocates nothing);
 //! - [`host`]: the child's end, `shipsim fmu-host FMU`, which loads the FMU with the same
 //!   importer ([`crate::fmu`]) and serves each request through the in-process slave
-//!   ([`crate::slave::InProcess`]), so that the FMU is called the same way in both.
+//!   ([`crate::slave::InProcess`]), so that the FMU is called the same way in both;
+//! - [`options`]: the run's isolation options as the CLI and Python give them, one parser.
 //!
 //! docs/isolation.md is the user's guide.
 
 mod client;
 pub mod host;
+pub mod options;
 mod protocol;
 
 use crate::error::{Error, Result};
@@ -27,6 +29,7 @@ use std::sync::OnceLock;
 use std::time::Duration;
 
 pub use client::Client;
+pub use options::IsolationError;
 
 /// Which instances of a run are isolated.
 #[derive(Clone, Debug, Default, PartialEq)]

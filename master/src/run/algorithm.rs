@@ -17,7 +17,8 @@
 //! [`super::profile::Off`], which compiles to nothing.
 //!
 //! To add one, implement the trait here, add a variant to [`crate::system::Algorithm`] (and
-//! its name to the readers), and dispatch to it in [`super::run_with`].
+//! its name to its `FromStr`, the one parser of the system files, the CLI and Python), and
+//! dispatch to it in [`super::run_with`].
 
 use super::exchange::Values;
 use super::profile::{Lap, Probe};

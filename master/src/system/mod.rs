@@ -13,12 +13,24 @@ use crate::error::{did_you_mean, Error, Result};
 use crate::fmu::UnpackedFmu;
 use std::path::PathBuf;
 
+pub mod last_step;
 pub mod plan;
 pub mod validate;
 
+pub use last_step::{LastStep, OffGrid};
 pub use plan::{Plan, PlanConnection, PlanEvent, PlanInstance, PlanOutput, StartValue};
 
 /// Master algorithm (implemented in [`crate::run::algorithm`]).
+///
+/// Its names are read by [`str::parse`] ([`Algorithm::from_str`](std::str::FromStr)), the one
+/// parser of the TOML `[simulation] algorithm`, `shipsim run --algorithm` and Python's
+/// `System.run(algorithm=...)`. Case does not matter (`Jacobi`, `GAUSS-SEIDEL`):
+///
+/// - `jacobi`: [`Algorithm::Jacobi`];
+/// - `gauss-seidel`, `gauss_seidel`, `gauss seidel`, `gaussseidel`, `seidel`:
+///   [`Algorithm::GaussSeidel`].
+///
+/// Any other name is an [`UnknownAlgorithm`], whose message is the same everywhere.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Algorithm {
     /// All instances step in parallel from the outputs of the previous communication point.
@@ -26,6 +38,51 @@ pub enum Algorithm {
     Jacobi,
     /// Instances step one after another in connection order, each using the newest outputs.
     GaussSeidel,
+}
+
+impl std::str::FromStr for Algorithm {
+    type Err = UnknownAlgorithm;
+
+    /// The names listed at [`Algorithm`], in any case.
+    fn from_str(name: &str) -> std::result::Result<Algorithm, UnknownAlgorithm> {
+        match name.to_lowercase().as_str() {
+            "jacobi" => Ok(Algorithm::Jacobi),
+            "gauss-seidel" | "gauss_seidel" | "gauss seidel" | "gaussseidel" | "seidel" => {
+                Ok(Algorithm::GaussSeidel)
+            }
+            _ => Err(UnknownAlgorithm(name.to_string())),
+        }
+    }
+}
+
+/// A name that is not one of [`Algorithm`]'s; its message:
+/// `unknown algorithm "NAME"; use "jacobi" or "gauss-seidel"`.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct UnknownAlgorithm(pub String);
+
+impl std::fmt::Display for UnknownAlgorithm {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "unknown algorithm \"{}\"; use \"jacobi\" or \"gauss-seidel\"",
+            self.0
+        )
+    }
+}
+
+impl std::error::Error for UnknownAlgorithm {}
+
+/// The format of the file a [`System`] was read from (set by its reader in [`crate::format`]):
+/// what validation and the run's checks need to know about the file, without knowing the
+/// readers.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Format {
+    /// shipsim's native TOML (`format::toml`).
+    Toml,
+    /// OSP `OspSystemStructure.xml` (`format::osp`).
+    Osp,
+    /// SSP 1.0: an `.ssp` archive or a `.ssd` file (`format::ssp`).
+    Ssp,
 }
 
 /// A value given in a system file or on the command line.
@@ -193,6 +250,8 @@ pub struct OutputSpec {
 #[derive(Debug, Clone)]
 pub struct System {
     pub source: PathBuf,
+    /// The format of [`System::source`].
+    pub format: Format,
     pub start_time: f64,
     pub stop_time: Option<f64>,
     pub step_size: f64,
@@ -209,13 +268,49 @@ pub struct System {
     pub strict_units: bool,
     /// A stop time off the base-step grid: stop before it (the default) or take a short last
     /// step to it (TOML `[simulation] last_step`, `shipsim run --last-step`).
-    pub last_step: crate::run::LastStep,
+    pub last_step: LastStep,
     /// The unpacked SSP archive the FMU paths point into, kept as long as the system (set by
     /// the SSP reader for `.ssp` files).
     pub archive: Option<std::sync::Arc<tempfile::TempDir>>,
 }
 
+/// How a run whose file has no end time is given one, the same words for every entry point.
+const GIVE_STOP_TIME: &str = "give the run a stop time: shipsim run --stop-time SECONDS, \
+     System.run(stop_time=SECONDS) in Python, or stop_time = SECONDS in a campaign file";
+
 impl System {
+    /// The stop time of a run: the one its caller gives, if any (`shipsim run --stop-time`,
+    /// Python's `System.run(stop_time=...)`, a campaign file's `stop_time`), replaces the
+    /// file's; then the run must have one ([`System::require_stop_time`]). Every entry point
+    /// of a run calls this, so that all of them accept and refuse the same files with the same
+    /// message.
+    pub fn apply_stop_time(&mut self, given: Option<f64>) -> Result<()> {
+        if let Some(t) = given {
+            self.stop_time = Some(t);
+        }
+        self.require_stop_time()
+    }
+
+    /// The end-time rule of a run: an OSP file may leave out `<EndTime>` (libcosim then runs
+    /// until it is stopped) and an SSD `DefaultExperiment@stopTime`; shipsim needs an end. A
+    /// system read from such a file whose stop time was not set since is an error naming the
+    /// file, instead of the one-second run that the validation's default stop time
+    /// (start + 1 s) would give. A TOML file without `stop_time` keeps that default.
+    /// `shipsim check` and Python's `System.check` validate without this rule: they run
+    /// nothing.
+    pub fn require_stop_time(&self) -> Result<()> {
+        let missing = match (self.stop_time, self.format) {
+            (Some(_), _) | (None, Format::Toml) => return Ok(()),
+            (None, Format::Osp) => "<EndTime>",
+            (None, Format::Ssp) => "<DefaultExperiment stopTime=\"...\">",
+        };
+        Err(Error::system(
+            &self.source,
+            None,
+            format!("the file has no {missing}; {GIVE_STOP_TIME}"),
+        ))
+    }
+
     /// The instance's FMU file exists (an error naming the file, line and instance if not).
     pub fn require_fmu(&self, inst: &InstanceSpec) -> Result<()> {
         if inst.fmu.exists() {
@@ -281,5 +376,35 @@ impl System {
             line: None,
         });
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Algorithm;
+
+    #[test]
+    fn algorithm_names_in_any_case_and_one_message_for_the_rest() {
+        for name in ["jacobi", "Jacobi", "JACOBI"] {
+            assert_eq!(name.parse(), Ok(Algorithm::Jacobi));
+        }
+        for name in [
+            "gauss-seidel",
+            "gauss_seidel",
+            "gauss seidel",
+            "gaussseidel",
+            "seidel",
+            "Gauss-Seidel",
+            "GAUSS_SEIDEL",
+            "Seidel",
+        ] {
+            assert_eq!(name.parse(), Ok(Algorithm::GaussSeidel), "{name}");
+        }
+        for name in ["", " jacobi", "gauss--seidel", "gauss", "rk4"] {
+            assert_eq!(
+                name.parse::<Algorithm>().unwrap_err().to_string(),
+                format!("unknown algorithm \"{name}\"; use \"jacobi\" or \"gauss-seidel\"")
+            );
+        }
     }
 }

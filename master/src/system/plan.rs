@@ -72,7 +72,7 @@ pub struct Plan {
     /// Set when the stop time asked for is off the base-step grid: the run then ends at the last
     /// grid point before it (`stop_time` is that point) or with a short last step to it
     /// (`stop_time` is the one asked for and step n_steps is the short one).
-    pub off_grid: Option<crate::run::OffGrid>,
+    pub off_grid: Option<super::OffGrid>,
     pub algorithm: Algorithm,
     pub instances: Vec<PlanInstance>,
     /// Stepping order (Gauss-Seidel: connection order; Jacobi: file order).

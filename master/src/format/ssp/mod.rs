@@ -34,25 +34,6 @@ pub fn is_ssp_path(path: &Path) -> bool {
         .is_some_and(|e| e.eq_ignore_ascii_case("ssp") || e.eq_ignore_ascii_case("ssd"))
 }
 
-/// Was the system read from an SSP archive or an SSD ([`load`])?
-pub fn is_ssp(sys: &System) -> bool {
-    is_ssp_path(&sys.source) || sys.archive.is_some()
-}
-
-/// An SSD may leave out `DefaultExperiment@stopTime`; shipsim needs an end. A system read from
-/// such a file whose stop time was not set since (`shipsim run --stop-time`) is an error naming
-/// the file (as for OSP files, [`super::osp::require_end_time`]). Other systems pass.
-pub fn require_stop_time(sys: &System) -> Result<()> {
-    if is_ssp(sys) && sys.stop_time.is_none() {
-        return Err(Error::system(
-            &sys.source,
-            None,
-            "the file has no <DefaultExperiment stopTime=\"...\">; pass the stop time with --stop-time SECONDS",
-        ));
-    }
-    Ok(())
-}
-
 /// Reads an `.ssp` archive or an `.ssd` file.
 pub fn load(path: &Path) -> Result<System> {
     let is_archive = path

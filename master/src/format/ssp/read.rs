@@ -23,7 +23,7 @@ use super::params::{self, Binding};
 use super::xml::{self, Element};
 use crate::error::{Error, Result};
 use crate::model_description::ModelDescription;
-use crate::system::{Algorithm, InstanceSpec, OutputSpec, System};
+use crate::system::{Algorithm, Format, InstanceSpec, OutputSpec, System};
 use crate::units::Unit;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -170,6 +170,7 @@ impl Reader<'_> {
         super::super::collected(std::mem::take(&mut self.errors))?;
         Ok(System {
             source: self.shown.clone(),
+            format: Format::Ssp,
             start_time: start,
             stop_time: stop,
             step_size,

@@ -39,8 +39,7 @@
 use crate::error::{Error, Result};
 use crate::fmu::UnpackedFmu;
 use crate::model_description::{Causality, ModelDescription, ScalarVariable, VarType};
-use crate::run::LastStep;
-use crate::system::{Algorithm, Plan, PlanConnection, System, TypedValue};
+use crate::system::{Algorithm, LastStep, Plan, PlanConnection, System, TypedValue};
 use crate::units::{self, Unit};
 use std::fmt::Write as _;
 use std::io::Write as _;

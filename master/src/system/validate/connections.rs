@@ -6,7 +6,7 @@
 use super::Checker;
 use crate::error::Error;
 use crate::model_description::{Causality, ModelDescription, ScalarVariable, VarType};
-use crate::system::{ConnectionSpec, PlanConnection};
+use crate::system::{ConnectionSpec, Format, PlanConnection};
 use crate::units::{RadRule, Unit, RAD};
 use std::borrow::Cow;
 use std::collections::{HashMap, HashSet};
@@ -278,7 +278,7 @@ impl<'a> Checker<'a> {
             return true;
         }
         let at = |l: Option<usize>| l.map(|l| format!(" (line {l})")).unwrap_or_default();
-        let hint = if crate::format::osp::is_osp(self.sys) {
+        let hint = if self.sys.format == Format::Osp {
             "; to add them, connect them through a Sum function"
         } else {
             "; to add them, set sum = true on every connection into it"

@@ -17,10 +17,9 @@
 //! Every error names the file, the line when known, the instance and the variable, with
 //! close-name suggestions; all errors are returned together.
 
-use super::{InstanceSpec, Plan, PlanInstance, System, VarRef};
+use super::{InstanceSpec, LastStep, OffGrid, Plan, PlanInstance, System, VarRef};
 use crate::error::{did_you_mean, Error, Result};
 use crate::model_description::ModelDescription;
-use crate::run::{LastStep, OffGrid};
 use std::collections::HashMap;
 
 mod connections;
