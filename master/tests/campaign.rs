@@ -9,7 +9,7 @@ use shipsim::campaign::execute::{self, Observer};
 use shipsim::campaign::kpi::{KpiRecorder, KpiSpec, KpiValue, StatAccumulator};
 use shipsim::campaign::table::{ColumnData, Table};
 use shipsim::campaign::{design, Campaign, CampaignOptions, CampaignSpec, Run};
-use shipsim::run::{run_with, Recorder, RunOptions};
+use shipsim::run::{run_into, Recorder, RunOptions};
 use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -585,7 +585,7 @@ fn forked_runs_equal_cold_runs_that_apply_the_change_by_events_at_the_fork() {
         assert_eq!(cold.events.len(), 2, "direction and roll mode change at T");
         let plan = cold.validate(&mds).unwrap();
         let mut kpis = KpiRecorder::new(&c.spec.kpis);
-        run_with(
+        run_into(
             &plan,
             &fmus,
             Some(&mut kpis as &mut dyn Recorder),

@@ -9,7 +9,7 @@ mod common;
 use common::*;
 use shipsim::fmu::Fmu;
 use shipsim::run::{
-    checkpoint_step, load_fmus, resume_with, run_to_checkpoint, run_with, Checkpoint,
+    checkpoint_step, load_fmus, resume_into, run_into, run_to_checkpoint, Checkpoint,
     CheckpointRequest, MemoryRecorder, RunOptions,
 };
 use shipsim::system::{Algorithm, EventSpec, Plan, System, Value, VarRef};
@@ -65,14 +65,14 @@ fn rows(m: &MemoryRecorder) -> Vec<Vec<u64>> {
 
 fn full_run(plan: &Plan, fmus: &[Arc<Fmu>], opts: &RunOptions) -> Vec<Vec<u64>> {
     let mut m = MemoryRecorder::new();
-    run_with(plan, fmus, Some(&mut m), opts).unwrap();
+    run_into(plan, fmus, Some(&mut m), opts).unwrap();
     rows(&m)
 }
 
 /// The rows of a run continued from `cp` with `plan`.
 fn resumed(plan: &Plan, fmus: &[Arc<Fmu>], cp: &Checkpoint) -> Vec<Vec<u64>> {
     let mut m = MemoryRecorder::new();
-    let s = resume_with(plan, fmus, cp, Some(&mut m), &RunOptions::default()).unwrap();
+    let s = resume_into(plan, fmus, cp, Some(&mut m), &RunOptions::default()).unwrap();
     assert_eq!(s.macro_steps, plan.n_steps - cp.step);
     assert_eq!(s.start_time, cp.time);
     assert_eq!(s.rows as usize, m.time.len());
@@ -180,7 +180,7 @@ fn writing_a_checkpoint_during_a_run_changes_nothing() {
     // A resumed run may write a later checkpoint: resuming from that one gives the same tail.
     let later = d.path().join("later.bin");
     let mut m = MemoryRecorder::new();
-    resume_with(&p, &fmus, &returned, Some(&mut m), &writing(700, &later)).unwrap();
+    resume_into(&p, &fmus, &returned, Some(&mut m), &writing(700, &later)).unwrap();
     assert!(rows(&m) == without[321..]);
     let tail = resumed(&p, &fmus, &Checkpoint::read(&later).unwrap());
     assert!(tail == without[700..]);
@@ -265,7 +265,7 @@ fn a_checkpoint_from_another_system_is_refused() {
     let refused = |sys: &System| -> String {
         let fmus = load_fmus(sys).unwrap();
         let p = plan(sys, &fmus);
-        let e = resume_with(&p, &fmus, &cp, None, &RunOptions::default()).unwrap_err();
+        let e = resume_into(&p, &fmus, &cp, None, &RunOptions::default()).unwrap_err();
         e.to_string()
     };
     let e = refused(&system("rrs.toml", 40.0, Algorithm::Jacobi));

@@ -5,8 +5,9 @@
 //! Isolated runs give the same bytes as runs in process, and their step loop allocates nothing.
 mod common;
 use common::*;
+use shipsim::fmu::Unpack;
 use shipsim::isolate::{IsolateMode, Isolation};
-use shipsim::run::{load_fmus_for, run, Output, RunOptions};
+use shipsim::run::{load_fmus_with, run, Output, RunOptions};
 use shipsim::system::System;
 use std::alloc::{GlobalAlloc, Layout, System as SysAlloc};
 use std::cell::Cell;
@@ -407,7 +408,7 @@ fn isolated_step_loop_allocates_nothing() {
         host: Some(PathBuf::from(SHIPSIM)),
         ..Default::default()
     };
-    let fmus = load_fmus_for(&sys, &iso).unwrap();
+    let fmus = load_fmus_with(&sys, &Unpack::default(), &iso).unwrap();
     assert!(fmus.iter().all(|f| !f.is_loaded()));
     let mds: Vec<_> = fmus.iter().map(|f| &f.model_description).collect();
     let opts = RunOptions {

@@ -3,7 +3,7 @@
 //! algorithms).
 mod common;
 use common::*;
-use shipsim::run::{load_fmus, run, run_with, MemoryRecorder, Output, RunOptions};
+use shipsim::run::{load_fmus, run, run_into, MemoryRecorder, Output, RunOptions};
 use shipsim::system::System;
 use std::alloc::{GlobalAlloc, Layout, System as SysAlloc};
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -78,7 +78,7 @@ value = 2.0
             assert_eq!(s.macro_steps, (stop * 1000.0) as u64);
             let mut memory = MemoryRecorder::new();
             let before = ALLOCS.load(Ordering::SeqCst);
-            let s = run_with(&plan, &fmus, Some(&mut memory), &RunOptions::default()).unwrap();
+            let s = run_into(&plan, &fmus, Some(&mut memory), &RunOptions::default()).unwrap();
             memory_counts.push(ALLOCS.load(Ordering::SeqCst) - before);
             assert_eq!(memory.time.len() as u64, s.rows);
             assert_eq!(s.rows, s.macro_steps + 1);

@@ -6,7 +6,7 @@
 //! Also `--no-output`: no CSV even when the system names one.
 mod common;
 use common::*;
-use shipsim::run::{load_fmus, run_system, run_with, MemoryRecorder, Output, RunOptions, Sampling};
+use shipsim::run::{load_fmus, run_into, run_system, MemoryRecorder, Output, RunOptions, Sampling};
 use shipsim::system::System;
 use std::alloc::{GlobalAlloc, Layout, System as SysAlloc};
 use std::cell::Cell;
@@ -181,7 +181,7 @@ fn profile_counts_are_the_fmus_own_step_counts() {
         profile: Some(Sampling::default()),
         ..Default::default()
     };
-    let s = run_with(&plan, &fmus, Some(&mut memory), &opts).unwrap();
+    let s = run_into(&plan, &fmus, Some(&mut memory), &opts).unwrap();
     let prof = s.profile.unwrap();
     for inst in &prof.instances {
         let steps = memory.column(&format!("{}.steps", inst.name)).unwrap();
@@ -308,7 +308,7 @@ fn profiled_step_loop_allocates_nothing() {
         };
         let mut memory = MemoryRecorder::new();
         let before = allocs();
-        let s = run_with(&plan, &fmus, Some(&mut memory), &opts).unwrap();
+        let s = run_into(&plan, &fmus, Some(&mut memory), &opts).unwrap();
         counts.push(allocs() - before);
         assert!(s.profile.unwrap().sampled_steps >= 16);
     }

@@ -5,7 +5,7 @@ mod common;
 use common::*;
 use shipsim::model_description::VarType;
 use shipsim::run::{
-    prepare, run, run_with, ColumnInfo, MemoryRecorder, Output, Recorder, Row, RunOptions,
+    prepare, run, run_into, ColumnInfo, MemoryRecorder, Output, Recorder, Row, RunOptions,
 };
 use shipsim::system::System;
 
@@ -79,9 +79,9 @@ fn memory_and_statistics_recorders_see_exactly_the_csv_rows() {
         )
         .unwrap();
         let mut mem = MemoryRecorder::new();
-        let s_mem = run_with(&plan, &fmus, Some(&mut mem), &RunOptions::default()).unwrap();
+        let s_mem = run_into(&plan, &fmus, Some(&mut mem), &RunOptions::default()).unwrap();
         let mut stats = Stats::default();
-        run_with(&plan, &fmus, Some(&mut stats), &RunOptions::default()).unwrap();
+        run_into(&plan, &fmus, Some(&mut stats), &RunOptions::default()).unwrap();
 
         let (header, rows) = read_csv(&csv);
         // t = 0, 0.2, ..., 1.0: decimation 2 over 10 steps.
@@ -136,7 +136,7 @@ fmu = "testfmu.fmu"
     );
     let (plan, fmus) = prepare(&System::load(&p).unwrap()).unwrap();
     let mut mem = MemoryRecorder::new();
-    let e = run_with(&plan, &fmus, Some(&mut mem), &RunOptions::default()).unwrap_err();
+    let e = run_into(&plan, &fmus, Some(&mut mem), &RunOptions::default()).unwrap_err();
     let msg = e.to_string();
     assert!(msg.contains("cannot keep 1000000000000001 rows"), "{msg}");
     assert!(msg.contains("rows of 8 columns in memory"), "{msg}");
@@ -155,7 +155,7 @@ fn a_variable_matched_twice_is_recorded_once() {
     let p = write_system(d.path(), "r.toml", &text);
     let (plan, fmus) = prepare(&System::load(&p).unwrap()).unwrap();
     let mut mem = MemoryRecorder::new();
-    run_with(&plan, &fmus, Some(&mut mem), &RunOptions::default()).unwrap();
+    run_into(&plan, &fmus, Some(&mut mem), &RunOptions::default()).unwrap();
     let names: Vec<&str> = mem.columns.iter().map(|c| c.name.as_str()).collect();
     // a.* is y, t_last, grid_error, y2, steps, n_out, enabled_out (the test FMU's outputs, in
     // its model description's order); a.y and b.y keep their first places.

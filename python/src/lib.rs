@@ -604,7 +604,7 @@ impl PySystem {
             |_| Ok(()),
             || {
                 let begin = std::time::Instant::now();
-                run::run_with(&plan, fmus, Some(&mut rec), &opts).map(|mut s| {
+                run::run_into(&plan, fmus, Some(&mut rec), &opts).map(|mut s| {
                     s.total_wall_time = begin.elapsed();
                     s
                 })

@@ -5,7 +5,7 @@
 //! `shipsim run`, byte for byte. Tolerance: none (every value compared by its bits).
 
 use models::controllers::rrs::RollMode;
-use shipsim::run::{prepare, run, run_with, MemoryRecorder, Output, RunOptions};
+use shipsim::run::{prepare, run, run_into, MemoryRecorder, Output, RunOptions};
 use system_tests::model_loop::rrs::{self, RrsParams, COLUMNS};
 use system_tests::study::Env;
 
@@ -23,7 +23,7 @@ fn shipsim_run(sets: &[&str], stop: f64) -> shipsim::system::System {
 fn shipsim_columns(sets: &[&str], stop: f64) -> MemoryRecorder {
     let (plan, fmus) = prepare(&shipsim_run(sets, stop)).unwrap();
     let mut memory = MemoryRecorder::new();
-    run_with(&plan, &fmus, Some(&mut memory), &RunOptions::default()).unwrap();
+    run_into(&plan, &fmus, Some(&mut memory), &RunOptions::default()).unwrap();
     memory
 }
 

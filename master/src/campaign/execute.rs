@@ -337,7 +337,7 @@ impl Context<'_> {
         self.execute(run, |rec| {
             let system = self.campaign.system_for(run)?;
             let plan = system.validate(&self.mds())?;
-            run::run_with(&plan, &self.fmus, Some(rec), &self.run_opts)
+            run::run_into(&plan, &self.fmus, Some(rec), &self.run_opts)
         })
     }
 
@@ -378,7 +378,11 @@ pub fn run(campaign: &Campaign, opts: &CampaignOptions) -> Result<CampaignOutcom
         .map_err(|e| Error::io(format!("cannot create output folder {}", dir.display()), e))?;
     output::check_or_write_provenance(campaign, dir, opts.shard)?;
     let journal = Journal::open(dir)?;
-    let fmus = run::load_fmus_for(&campaign.system, &foreign_isolation())?;
+    let fmus = run::load_fmus_with(
+        &campaign.system,
+        &crate::fmu::Unpack::default(),
+        &foreign_isolation(),
+    )?;
     let (jobs, jobs_note) = jobs_for(&fmus, opts.jobs);
     let mut outcome = CampaignOutcome {
         total: campaign.runs.len(),
@@ -736,7 +740,7 @@ impl Fork {
             }
             let outcome = ctx.execute(r, |rec| {
                 let plan = self.systems(ctx.campaign, r)?.1.validate(&ctx.mds())?;
-                run::resume_with(&plan, &ctx.fmus, &cp, Some(rec), &ctx.run_opts)
+                run::resume_into(&plan, &ctx.fmus, &cp, Some(rec), &ctx.run_opts)
             });
             ctx.finish(r, outcome)
         })

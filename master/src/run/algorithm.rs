@@ -18,7 +18,7 @@
 //!
 //! To add one, implement the trait here, add a variant to [`crate::system::Algorithm`] (and
 //! its name to its `FromStr`, the one parser of the system files, the CLI and Python), and
-//! dispatch to it in [`super::run_with`].
+//! dispatch to it in [`super::run_into`].
 
 use super::exchange::Values;
 use super::profile::{Lap, Probe};

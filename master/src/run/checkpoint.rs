@@ -9,7 +9,7 @@
 //! others still read the outputs it published before.
 //!
 //! The checkpoint is taken after the outputs of t_k are published and before the events of
-//! step k, so a run continued from it ([`super::resume_with`]) applies the events at k and later
+//! step k, so a run continued from it ([`super::resume_into`]) applies the events at k and later
 //! as usual: a warm-up run to t_k followed by runs that change a parameter at t_k (campaign
 //! forks) gives what a cold run with that change as an event at t_k gives.
 //!

@@ -12,7 +12,7 @@
 //!
 //! A run can stop at a communication point and hand back a [`Checkpoint`]
 //! ([`run_to_checkpoint`]), write one on passing a step and go on ([`RunOptions::checkpoint`]),
-//! or start from one in fresh instances ([`resume_with`]); [`checkpoint`] says what it holds.
+//! or start from one in fresh instances ([`resume_into`]); [`checkpoint`] says what it holds.
 //!
 //! Clean termination holds on every path: an instance dropped on an error or an interrupt is
 //! terminated and freed ([`crate::instance`]). The step loop allocates nothing.
@@ -65,13 +65,13 @@ pub struct RunOptions {
     /// Set to true (e.g. by Ctrl-C) to stop the run cleanly.
     pub interrupt: Option<Arc<AtomicBool>>,
     pub log_sink: Option<LogSink>,
-    /// Write a checkpoint on passing a base step and continue ([`run_with`], [`resume_with`]).
+    /// Write a checkpoint on passing a base step and continue ([`run_into`], [`resume_into`]).
     pub checkpoint: Option<CheckpointRequest>,
     /// Time where the step loop goes per instance, on these steps ([`Summary::profile`],
     /// [`profile`]).
     pub profile: Option<Sampling>,
     /// Which instances run in their own processes ([`crate::isolate`]); the FMUs must be
-    /// loaded for it ([`load_fmus_for`]).
+    /// loaded for it ([`load_fmus_with`]).
     pub isolation: Isolation,
     /// Where in-process instances note the call in progress (for a caller's exit hook or
     /// watchdog, [`crate::slave::CallMonitor`]).
@@ -179,11 +179,6 @@ pub fn load_fmus(system: &System) -> Result<Vec<Arc<Fmu>>> {
     )
 }
 
-/// [`load_fmus`] for a run with `isolation` (archives unpacked with the default options).
-pub fn load_fmus_for(system: &System, isolation: &Isolation) -> Result<Vec<Arc<Fmu>>> {
-    load_fmus_with(system, &crate::fmu::Unpack::default(), isolation)
-}
-
 /// [`load_fmus`] with the archives unpacked under `unpack` (limits, directory, interrupt), for
 /// a run with `isolation`: an FMU whose instances all run in their own processes is opened
 /// without loading its binary here ([`Fmu::open_unloaded`]).
@@ -273,10 +268,10 @@ pub enum Output {
 /// Runs a validated plan with loaded FMUs (`fmus[i]` for `plan.instances[i]`), recording into
 /// a CSV file or writer.
 pub fn run(plan: &Plan, fmus: &[Arc<Fmu>], output: Output, opts: &RunOptions) -> Result<Summary> {
-    into_csv(output, |rec| run_with(plan, fmus, rec, opts))
+    into_csv(output, |rec| run_into(plan, fmus, rec, opts))
 }
 
-/// [`resume_with`] recording into a CSV file or writer: the rows from the checkpoint's time on.
+/// [`resume_into`] recording into a CSV file or writer: the rows from the checkpoint's time on.
 pub fn resume(
     plan: &Plan,
     fmus: &[Arc<Fmu>],
@@ -284,7 +279,7 @@ pub fn resume(
     output: Output,
     opts: &RunOptions,
 ) -> Result<Summary> {
-    into_csv(output, |rec| resume_with(plan, fmus, cp, rec, opts))
+    into_csv(output, |rec| resume_into(plan, fmus, cp, rec, opts))
 }
 
 /// Runs `f` with a CSV recorder on `output` (or none); the summary names the file.
@@ -316,7 +311,7 @@ fn create_output_file(p: &std::path::Path) -> Result<Box<dyn Write>> {
 
 /// Runs a validated plan with loaded FMUs, recording into any [`Recorder`] (or none). With
 /// [`RunOptions::checkpoint`] it writes a checkpoint on passing that step and goes on.
-pub fn run_with(
+pub fn run_into(
     plan: &Plan,
     fmus: &[Arc<Fmu>],
     recorder: Option<&mut dyn Recorder>,
@@ -355,7 +350,7 @@ pub fn run_to_checkpoint(
 /// on from step `cp.step` to the end, applying the plan's events at that step and later. The
 /// recorder gets the row at t_`cp.step` first, then the rows a full run records after it. The
 /// plan may differ from the checkpoint's in its start values and events (a fork).
-pub fn resume_with(
+pub fn resume_into(
     plan: &Plan,
     fmus: &[Arc<Fmu>],
     cp: &Checkpoint,

@@ -169,7 +169,7 @@ pub fn run_memory(path: &Path) -> shipsim::run::MemoryRecorder {
     let (plan, fmus) = load_plan(path).unwrap();
     let mut memory = shipsim::run::MemoryRecorder::new();
     let opts = shipsim::run::RunOptions::default();
-    shipsim::run::run_with(&plan, &fmus, Some(&mut memory), &opts).unwrap();
+    shipsim::run::run_into(&plan, &fmus, Some(&mut memory), &opts).unwrap();
     memory
 }
 
