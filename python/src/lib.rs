@@ -726,8 +726,8 @@ struct PyCampaign {
     campaign: Campaign,
 }
 
-/// An error of a campaign: reading a campaign file (or its base system) is a
-/// [`SystemFileError`] unless an FMU is at fault; the rest as [`py_err`].
+/// An error of running or reading the results of a campaign: a mistake the campaign file makes
+/// (a message that starts with "campaign ") is a [`SystemFileError`]; the rest as [`py_err`].
 fn campaign_err(py: Python<'_>, e: Error) -> PyErr {
     match e {
         Error::Other(m) if m.starts_with("campaign ") => SystemFileError::new_err(m),
@@ -735,6 +735,8 @@ fn campaign_err(py: Python<'_>, e: Error) -> PyErr {
     }
 }
 
+/// An error of loading a campaign: reading a campaign file (or its base system) is a
+/// [`SystemFileError`] unless an FMU is at fault; the rest as [`py_err`].
 fn campaign_load_err(py: Python<'_>, e: Error) -> PyErr {
     match e {
         Error::Io { .. } | Error::Other(_) => SystemFileError::new_err(e.to_string()),

@@ -2,7 +2,7 @@
 //!
 //! A campaign file ([`spec`]) names a base system and says what to vary and what to measure.
 //! [`Campaign::load`] reads it, reads the base system and expands the runs ([`design`]).
-//! [`Campaign::run`] ([`execute`]) runs them on a work-stealing pool, each with its own FMU
+//! [`execute::run`] runs them on a work-stealing pool, each with its own FMU
 //! instances (every FMU library loaded once per process), computing the KPIs on the fly
 //! ([`kpi`], [`manoeuvre`]) and appending each finished run durably to the journal
 //! ([`journal`]), from which the run table and the derived table ([`derived`]) are written
