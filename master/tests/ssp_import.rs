@@ -534,12 +534,10 @@ fn a_missing_stop_time_asks_for_one() {
         .replace(" stopTime=\"1\"", "");
     std::fs::write(&p, t).unwrap();
     let mut sys = System::load(&p).unwrap();
-    let e = shipsim::format::osp::require_end_time(&sys)
-        .unwrap_err()
-        .to_string();
+    let e = sys.require_stop_time().unwrap_err().to_string();
     has(&e, &["SystemStructure.ssd", "stopTime", "--stop-time"]);
     sys.stop_time = Some(0.5);
-    shipsim::format::osp::require_end_time(&sys).unwrap();
+    sys.require_stop_time().unwrap();
 }
 
 #[test]

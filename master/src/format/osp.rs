@@ -244,13 +244,6 @@ pub fn parse(path: &Path, text: &str) -> Result<System> {
     })
 }
 
-/// The end-time rule of a run for a system read from an OSP or SSP file: the system's own
-/// [`System::require_stop_time`], which every entry point of a run applies (kept here for
-/// callers of this path).
-pub fn require_end_time(sys: &System) -> Result<()> {
-    sys.require_stop_time()
-}
-
 impl Reader<'_> {
     fn error(&mut self, line: Option<usize>, message: impl Into<String>) {
         self.errors.push(Error::system(self.path, line, message));

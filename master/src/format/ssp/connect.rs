@@ -2,7 +2,7 @@
 //! system connectors, to another component's connector becomes one [`ConnectionSpec`], with the
 //! unit conversions and transformations along it composed.
 
-use super::read::{Connector, Edge, Port, Reader};
+use super::reader::{parse_bool, Connector, Edge, Port, Reader};
 use super::xml::Element;
 use crate::model_description::ModelDescription;
 use crate::system::{ConnectionSpec, ValueMapping, VarRef};
@@ -280,15 +280,6 @@ impl Reader<'_> {
             );
         }
         value
-    }
-}
-
-/// `true`/`false`/`1`/`0` (xs:boolean) as 1/0.
-pub(super) fn parse_bool(s: &str) -> Option<i32> {
-    match s.trim() {
-        "true" | "1" => Some(1),
-        "false" | "0" => Some(0),
-        _ => None,
     }
 }
 

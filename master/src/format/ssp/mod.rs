@@ -19,6 +19,7 @@ use std::path::Path;
 mod connect;
 mod params;
 pub mod read;
+mod reader;
 pub mod write;
 mod xml;
 

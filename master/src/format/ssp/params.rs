@@ -10,8 +10,7 @@
 //! A name that matches no element is an error here (SSP lets tools ignore it), so that a typo
 //! does not go unnoticed; a variable the FMU does not have is reported by the validation.
 
-use super::connect::parse_bool;
-use super::read::{base_unit, Reader, SEP};
+use super::reader::{base_unit, parse_bool, Reader, SEP};
 use super::xml::{self, Element};
 use crate::system::{Value, ValueSpec};
 use crate::units::{RadRule, Unit};
