@@ -2,7 +2,8 @@
 //! validation report.
 //!
 //! Rendering is pure Rust (plotters' bitmap backend with the DejaVu Sans font embedded through
-//! the `dejavu` crate), so no system font or graphics library is needed.
+//! the `dejavu` crate), so no system font or graphics library is needed. The setup, the series
+//! colours and the drawing error are shared with the campaign plots ([`crate::campaign::plot`]).
 
 use crate::error::{Error, Result};
 use plotters::prelude::*;
@@ -267,7 +268,7 @@ pub(crate) fn register_font() {
 }
 
 /// Series colours, in order: matplotlib's "tab10" blue, red, green, orange and purple, then grey.
-pub(crate) const COLORS: [RGBColor; 6] = [
+const COLORS: [RGBColor; 6] = [
     RGBColor(31, 119, 180),
     RGBColor(214, 39, 40),
     RGBColor(44, 160, 44),
@@ -276,9 +277,14 @@ pub(crate) const COLORS: [RGBColor; 6] = [
     RGBColor(90, 90, 90),
 ];
 
-fn draw_err<E: std::fmt::Debug>(path: &Path) -> impl Fn(E) -> Error + '_ {
-    move |e| Error::Other(format!("drawing {}: {e:?}", path.display()))
+/// The error of a failed plotters call, in every PNG plot of the crate; the caller names the
+/// file (`plot PATH: drawing failed: ...`).
+pub(crate) fn drawing_error<E: std::fmt::Debug>(e: E) -> Error {
+    Error::Other(format!("drawing failed: {e:?}"))
 }
+
+/// The drawing area of a PNG plot (in pixels).
+pub(crate) type Area<'a> = DrawingArea<BitMapBackend<'a>, plotters::coord::Shift>;
 
 /// Creates the folder that will hold `path` (and its parents) when it does not exist.
 pub(crate) fn create_parent_dir(path: &Path) -> Result<()> {
@@ -324,11 +330,18 @@ pub fn plot_figure(path: &Path, title: &str, panels: &[Panel], tracks: &[Track])
     }
     register_font();
     create_parent_dir(path)?;
+    draw_figure(path, title, panels, tracks)
+        .map_err(|e| Error::Other(format!("plot {}: {e}", path.display())))
+}
+
+/// The figure of [`plot_figure`], written to `path`.
+fn draw_figure(path: &Path, title: &str, panels: &[Panel], tracks: &[Track]) -> Result<()> {
     let height = 60 + PANEL_HEIGHT * panels.len() as u32 + TRACK_HEIGHT * tracks.len() as u32;
     let root = BitMapBackend::new(path, (1100, height)).into_drawing_area();
-    let err = draw_err(path);
-    root.fill(&WHITE).map_err(&err)?;
-    let root = root.titled(title, ("sans-serif", 22)).map_err(&err)?;
+    root.fill(&WHITE).map_err(drawing_error)?;
+    let root = root
+        .titled(title, ("sans-serif", 22))
+        .map_err(drawing_error)?;
     // The height below the title, shared in proportion (all of it without tracks).
     let (time_px, track_px) = (
         PANEL_HEIGHT * panels.len() as u32,
@@ -346,7 +359,7 @@ pub fn plot_figure(path: &Path, title: &str, panels: &[Panel], tracks: &[Track])
                 .flat_map(|s| &s.t),
         );
         for (panel, area) in panels.iter().zip(areas.iter()) {
-            draw_time_panel(area, panel, (t0, t1), &err)?;
+            draw_time_panel(area, panel, (t0, t1))?;
         }
     }
     if !tracks.is_empty() {
@@ -354,15 +367,12 @@ pub fn plot_figure(path: &Path, title: &str, panels: &[Panel], tracks: &[Track])
             .iter()
             .zip(track_area.split_evenly((tracks.len(), 1)).iter())
         {
-            draw_track(area, track, &err)?;
+            draw_track(area, track)?;
         }
     }
-    root.present().map_err(&err)?;
+    root.present().map_err(drawing_error)?;
     Ok(())
 }
-
-type Area<'a> = DrawingArea<BitMapBackend<'a>, plotters::coord::Shift>;
-type DrawError = DrawingAreaErrorKind<<BitMapBackend<'static> as DrawingBackend>::ErrorType>;
 
 /// The smallest and largest finite value ((0, 1) when there are none or they are equal).
 fn bounds<'v>(values: impl Iterator<Item = &'v f64>) -> (f64, f64) {
@@ -381,17 +391,12 @@ fn bounds<'v>(values: impl Iterator<Item = &'v f64>) -> (f64, f64) {
     }
 }
 
-/// The colour of series `i` of a panel.
-fn color(i: usize) -> RGBColor {
+/// The colour of series `i` of a panel (or of a campaign plot's group), in [`COLORS`] order.
+pub(crate) fn color(i: usize) -> RGBColor {
     COLORS[i % COLORS.len()]
 }
 
-fn draw_time_panel(
-    area: &Area,
-    panel: &Panel,
-    (t0, t1): (f64, f64),
-    err: &impl Fn(DrawError) -> Error,
-) -> Result<()> {
+fn draw_time_panel(area: &Area, panel: &Panel, (t0, t1): (f64, f64)) -> Result<()> {
     let (mut lo, mut hi) = panel
         .series
         .iter()
@@ -405,14 +410,7 @@ fn draw_time_panel(
     }
     let pad = ((hi - lo) * 0.08).max(1e-9);
     let desc = ("time [s]", panel.y_label.as_str());
-    draw_chart(
-        area,
-        (t0, t1),
-        (lo - pad, hi + pad),
-        desc,
-        &panel.series,
-        err,
-    )
+    draw_chart(area, (t0, t1), (lo - pad, hi + pad), desc, &panel.series)
 }
 
 /// One chart: the mesh with the axis descriptions, the series as lines in [`COLORS`] order,
@@ -423,7 +421,6 @@ fn draw_chart(
     (y0, y1): (f64, f64),
     (x_desc, y_desc): (&str, &str),
     series: &[Series],
-    err: &impl Fn(DrawError) -> Error,
 ) -> Result<()> {
     let mut chart = ChartBuilder::on(area)
         .margin(MARGIN)
@@ -431,14 +428,14 @@ fn draw_chart(
         .x_label_area_size(X_LABEL_AREA)
         .y_label_area_size(Y_LABEL_AREA)
         .build_cartesian_2d(x0..x1, y0..y1)
-        .map_err(err)?;
+        .map_err(drawing_error)?;
     chart
         .configure_mesh()
         .x_desc(x_desc)
         .y_desc(y_desc)
         .label_style(("sans-serif", 14))
         .draw()
-        .map_err(err)?;
+        .map_err(drawing_error)?;
     for (i, s) in series.iter().enumerate() {
         let c = color(i);
         chart
@@ -446,7 +443,7 @@ fn draw_chart(
                 s.t.iter().copied().zip(s.y.iter().copied()),
                 c.stroke_width(2),
             ))
-            .map_err(err)?
+            .map_err(drawing_error)?
             .label(s.label.as_str())
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2)));
     }
@@ -456,7 +453,7 @@ fn draw_chart(
         .border_style(BLACK)
         .label_font(("sans-serif", 14))
         .draw()
-        .map_err(err)?;
+        .map_err(drawing_error)?;
     Ok(())
 }
 
@@ -472,7 +469,7 @@ pub fn equal_axes(x: (f64, f64), y: (f64, f64), w: u32, h: u32) -> ((f64, f64), 
     ((cx - hx, cx + hx), (cy - hy, cy + hy))
 }
 
-fn draw_track(area: &Area, track: &Track, err: &impl Fn(DrawError) -> Error) -> Result<()> {
+fn draw_track(area: &Area, track: &Track) -> Result<()> {
     let (w, h) = area.dim_in_pixel();
     let plot_w = w.saturating_sub(MARGIN + RIGHT_MARGIN + Y_LABEL_AREA);
     let plot_h = h.saturating_sub(2 * MARGIN + X_LABEL_AREA);
@@ -480,7 +477,7 @@ fn draw_track(area: &Area, track: &Track, err: &impl Fn(DrawError) -> Error) -> 
     let ys = bounds(track.series.iter().flat_map(|s| &s.y));
     let (x, y) = equal_axes(xs, ys, plot_w, plot_h);
     let desc = (track.x_label.as_str(), track.y_label.as_str());
-    draw_chart(area, x, y, desc, &track.series, err)
+    draw_chart(area, x, y, desc, &track.series)
 }
 
 #[cfg(test)]

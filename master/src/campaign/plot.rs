@@ -15,19 +15,17 @@
 //! row, a path that cannot be written) is an [`Error`] that names it, never a panic.
 //!
 //! Rendering shares the time-series plotter's setup ([`crate::plot`]): plotters' bitmap
-//! backend and DejaVu Sans embedded, so no system font or graphics library is needed.
+//! backend and DejaVu Sans embedded, so no system font or graphics library is needed, its series
+//! colours and its drawing error.
 
 use crate::campaign::table::{ColumnData, Table};
 use crate::error::{suggest, Error, Result};
-use crate::plot::{create_parent_dir, register_font, COLORS};
+use crate::plot::{color, create_parent_dir, drawing_error, register_font, Area};
 use plotters::coord::types::{RangedCoordf64, RangedCoordu32};
-use plotters::coord::Shift;
 use plotters::element::DashedPathElement;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 use std::path::PathBuf;
-
-type Area<'a> = DrawingArea<BitMapBackend<'a>, Shift>;
 
 const FONT: &str = "sans-serif";
 const TEXT: RGBColor = RGBColor(30, 30, 30);
@@ -778,16 +776,8 @@ pub fn viridis(t: f64) -> RGBColor {
     RGBColor(channel(0), channel(1), channel(2))
 }
 
-fn series_color(i: usize) -> RGBColor {
-    COLORS[i % COLORS.len()]
-}
-
 // ---------------------------------------------------------------------------------------------
 // Figure: canvas, title, caption, legend
-
-fn drawing<E: std::fmt::Debug>(e: E) -> Error {
-    Error::Other(format!("drawing failed: {e:?}"))
-}
 
 fn font(size: u32) -> TextStyle<'static> {
     (FONT, size).into_font().color(&TEXT)
@@ -860,15 +850,17 @@ fn render(
     register_font();
     let in_path = |e: Error| Error::Other(format!("plot {}: {e}", path.display()));
     let root = BitMapBackend::new(path, opts.size).into_drawing_area();
-    root.fill(&WHITE).map_err(drawing).map_err(in_path)?;
+    root.fill(&WHITE).map_err(drawing_error).map_err(in_path)?;
     let summary = draw(&root).map_err(in_path)?;
-    root.present().map_err(drawing).map_err(in_path)?;
+    root.present().map_err(drawing_error).map_err(in_path)?;
     Ok(summary)
 }
 
 /// Draws the title and the caption lines and returns the area between them.
 fn figure<'a>(root: &Area<'a>, title: &str, caption: &[String]) -> Result<Area<'a>> {
-    let body = root.titled(&typeset(title), font(22)).map_err(drawing)?;
+    let body = root
+        .titled(&typeset(title), font(22))
+        .map_err(drawing_error)?;
     let (w, h) = body.dim_in_pixel();
     let caption: Vec<String> = caption
         .iter()
@@ -878,7 +870,7 @@ fn figure<'a>(root: &Area<'a>, title: &str, caption: &[String]) -> Result<Area<'
     let (body, foot) = body.split_vertically(h.saturating_sub(foot_h));
     for (i, line) in caption.iter().enumerate() {
         foot.draw(&words(line.as_str(), (12, 2 + 18 * i as i32), font(14)))
-            .map_err(drawing)?;
+            .map_err(drawing_error)?;
     }
     Ok(body)
 }
@@ -941,13 +933,13 @@ fn entries(series: &[SeriesStats], group_label: &str, y_label: &str, band: bool)
                 Some(g) => format!("{group_label} = {g}"),
                 None => format!("mean {y_label}"),
             },
-            color: series_color(i),
+            color: color(i),
             mark: Mark::Series,
         })
         .collect();
     if band {
         let color = if series.len() == 1 {
-            series_color(0)
+            color(0)
         } else {
             RGBColor(120, 120, 120)
         };
@@ -981,7 +973,7 @@ fn draw_legend(area: &Area, entries: &[Entry], notes: &[String]) -> Result<()> {
         [(x0, y0), (x1, y0 + box_h)],
         AXIS.stroke_width(1),
     ))
-    .map_err(drawing)?;
+    .map_err(drawing_error)?;
     for (k, e) in entries.iter().enumerate() {
         let y = y0 + 17 + row * k as i32;
         draw_mark(area, e, (x0 + 8, y))?;
@@ -990,7 +982,7 @@ fn draw_legend(area: &Area, entries: &[Entry], notes: &[String]) -> Result<()> {
             (x0 + 44, y),
             anchored(15, HPos::Left, VPos::Center),
         );
-        area.draw(&label).map_err(drawing)?;
+        area.draw(&label).map_err(drawing_error)?;
     }
     let notes: Vec<String> = notes
         .iter()
@@ -1006,7 +998,7 @@ fn draw_legend(area: &Area, entries: &[Entry], notes: &[String]) -> Result<()> {
             (x0, y),
             anchored(14, HPos::Left, VPos::Center),
         ))
-        .map_err(drawing)?;
+        .map_err(drawing_error)?;
     }
     Ok(())
 }
@@ -1017,28 +1009,28 @@ fn draw_mark(area: &Area, e: &Entry, (x, y): (i32, i32)) -> Result<()> {
     match e.mark {
         Mark::Series => {
             area.draw(&PathElement::new(line, e.color.stroke_width(2)))
-                .map_err(drawing)?;
+                .map_err(drawing_error)?;
             area.draw(&Circle::new((x + 14, y), 4, e.color.filled()))
-                .map_err(drawing)
+                .map_err(drawing_error)
         }
         Mark::Band => {
             let style = e.color.mix(BAND_ALPHA * 1.5).filled();
             area.draw(&Rectangle::new([(x, y - 7), (x + 28, y + 7)], style))
-                .map_err(drawing)
+                .map_err(drawing_error)
         }
         Mark::Bar(alpha) => {
             let corners = [(x + 4, y - 7), (x + 24, y + 7)];
             area.draw(&Rectangle::new(corners, e.color.mix(alpha).filled()))
-                .map_err(drawing)?;
+                .map_err(drawing_error)?;
             area.draw(&Rectangle::new(corners, e.color.stroke_width(1)))
-                .map_err(drawing)
+                .map_err(drawing_error)
         }
         Mark::Line => area
             .draw(&PathElement::new(line, e.color.stroke_width(2)))
-            .map_err(drawing),
+            .map_err(drawing_error),
         Mark::Dashed => area
             .draw(&DashedPathElement::new(line, 6, 5, e.color.stroke_width(2)))
-            .map_err(drawing),
+            .map_err(drawing_error),
     }
 }
 
@@ -1155,7 +1147,7 @@ fn draw_line_chart(
         .x_label_area_size(56)
         .y_label_area_size(78)
         .build_cartesian_2d(xr.0..xr.1, yr.0..yr.1)
-        .map_err(drawing)?;
+        .map_err(drawing_error)?;
     chart
         .configure_mesh()
         .x_desc(typeset(x_label))
@@ -1170,29 +1162,29 @@ fn draw_line_chart(
         .light_line_style(RGBColor(245, 245, 245))
         .axis_style(AXIS)
         .draw()
-        .map_err(drawing)?;
+        .map_err(drawing_error)?;
     for (i, s) in series.iter().enumerate() {
         if spread(s) {
             let upper = s.points.iter().map(|(x, st)| (*x, st.p95));
             let lower = s.points.iter().rev().map(|(x, st)| (*x, st.p05));
-            let style = series_color(i).mix(BAND_ALPHA).filled();
+            let style = color(i).mix(BAND_ALPHA).filled();
             chart
                 .draw_series(std::iter::once(Polygon::new(
                     upper.chain(lower).collect::<Vec<_>>(),
                     style,
                 )))
-                .map_err(drawing)?;
+                .map_err(drawing_error)?;
         }
     }
     for (i, s) in series.iter().enumerate() {
-        let color = series_color(i);
+        let color = color(i);
         let means = s.points.iter().map(|(x, st)| (*x, st.mean));
         chart
             .draw_series(LineSeries::new(means.clone(), color.stroke_width(2)))
-            .map_err(drawing)?;
+            .map_err(drawing_error)?;
         chart
             .draw_series(means.map(|p| Circle::new(p, 4, color.filled())))
-            .map_err(drawing)?;
+            .map_err(drawing_error)?;
     }
     let top_left = chart.backend_coord(&(xr.0, yr.1));
     let bottom_right = chart.backend_coord(&(xr.1, yr.0));
@@ -1344,14 +1336,14 @@ fn draw_cells(area: &Area, g: &Grid, c: Cells, z: (f64, f64), annotate: bool) ->
             let stats = g.cells[j * c.nx + i];
             let fill = stats.map_or(EMPTY_CELL, |s| viridis((s.mean - z.0) / (z.1 - z.0)));
             area.draw(&Rectangle::new([(x0, y0), (x1, y1)], fill.filled()))
-                .map_err(drawing)?;
+                .map_err(drawing_error)?;
             if let Some(s) = stats.filter(|_| annotate) {
                 annotate_cell(area, ((x0, y0), (x1, y1)), s.mean, fill)?;
             }
         }
     }
     let frame = Rectangle::new([(c.left, c.top), (c.right, c.bottom)], AXIS.stroke_width(1));
-    area.draw(&frame).map_err(drawing)
+    area.draw(&frame).map_err(drawing_error)
 }
 
 /// Prints `value` in the middle of a cell, in black or white by the fill's luminance
@@ -1380,7 +1372,7 @@ fn annotate_cell(
         .color(&ink)
         .pos(Pos::new(HPos::Center, VPos::Center));
     area.draw(&words(text, ((x0 + x1) / 2, (y0 + y1) / 2), style))
-        .map_err(drawing)
+        .map_err(drawing_error)
 }
 
 /// Every `k`-th label, so that labels of `size` pixels fit cells of `cell` pixels.
@@ -1410,35 +1402,35 @@ fn draw_cell_axes(
         let (x0, x1) = c.x(i);
         let x = (x0 + x1) / 2;
         let tick = PathElement::new(vec![(x, c.bottom), (x, c.bottom + 5)], AXIS.stroke_width(1));
-        area.draw(&tick).map_err(drawing)?;
+        area.draw(&tick).map_err(drawing_error)?;
         let label = words(
             t.as_str(),
             (x, c.bottom + 9),
             anchored(14, HPos::Center, VPos::Top),
         );
-        area.draw(&label).map_err(drawing)?;
+        area.draw(&label).map_err(drawing_error)?;
     }
     let row_h = (c.bottom - c.top) / c.ny as i32;
     for (j, t) in y_ticks.iter().enumerate().step_by(label_stride(22, row_h)) {
         let (y0, y1) = c.y(j);
         let y = (y0 + y1) / 2;
         let tick = PathElement::new(vec![(c.left - 5, y), (c.left, y)], AXIS.stroke_width(1));
-        area.draw(&tick).map_err(drawing)?;
+        area.draw(&tick).map_err(drawing_error)?;
         let label = words(
             t.as_str(),
             (c.left - 9, y),
             anchored(14, HPos::Right, VPos::Center),
         );
-        area.draw(&label).map_err(drawing)?;
+        area.draw(&label).map_err(drawing_error)?;
     }
     let x_title = words(
         labels[0],
         ((c.left + c.right) / 2, c.bottom + 36),
         anchored(17, HPos::Center, VPos::Top),
     );
-    area.draw(&x_title).map_err(drawing)?;
+    area.draw(&x_title).map_err(drawing_error)?;
     let y_title = words(labels[1], (20, (c.top + c.bottom) / 2), vertical(17));
-    area.draw(&y_title).map_err(drawing)
+    area.draw(&y_title).map_err(drawing_error)
 }
 
 /// Text turned to read upwards, centred on its position.
@@ -1466,25 +1458,25 @@ fn draw_colour_bar(
             [(x0, py), (x1, py + 1)],
             viridis(t).filled(),
         ))
-        .map_err(drawing)?;
+        .map_err(drawing_error)?;
     }
     area.draw(&Rectangle::new(
         [(x0, c.top), (x1, c.bottom)],
         AXIS.stroke_width(1),
     ))
-    .map_err(drawing)?;
+    .map_err(drawing_error)?;
     let mut label_x = x1 + 10;
     for (v, text) in z_ticks {
         let y = c.bottom - ((v - z.0) / (z.1 - z.0) * span as f64).round() as i32;
         let tick = PathElement::new(vec![(x1, y), (x1 + 5, y)], AXIS.stroke_width(1));
-        area.draw(&tick).map_err(drawing)?;
+        area.draw(&tick).map_err(drawing_error)?;
         let style = anchored(14, HPos::Left, VPos::Center);
         area.draw(&words(text.as_str(), (x1 + 8, y), style))
-            .map_err(drawing)?;
+            .map_err(drawing_error)?;
         label_x = label_x.max(x1 + 8 + text_width(area, text, 14) as i32 + 16);
     }
     let title = words(label, (label_x, (c.top + c.bottom) / 2), vertical(17));
-    area.draw(&title).map_err(drawing)
+    area.draw(&title).map_err(drawing_error)
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -1637,7 +1629,7 @@ fn draw_polar(area: &Area, series: &[SeriesStats], opts: &PlotOptions) -> Result
     draw_polar_grid(area, &axes, &labels)?;
     draw_ring_labels(area, &axes, step, label_dir)?;
     for (i, s) in series.iter().enumerate() {
-        draw_polar_series(area, &axes, s, series_color(i))?;
+        draw_polar_series(area, &axes, s, color(i))?;
     }
     let (bx, by) = area.get_base_pixel();
     Ok(Frame::Polar {
@@ -1670,7 +1662,7 @@ fn draw_polar_grid(area: &Area, axes: &PolarAxes, labels: &[String]) -> Result<(
             vec![axes.at(deg, 0.0), axes.at(deg, axes.radius)],
             GRID.stroke_width(1),
         );
-        area.draw(&spoke).map_err(drawing)?;
+        area.draw(&spoke).map_err(drawing_error)?;
         let (x, y) = axes.at(deg, axes.radius + 8.0);
         let (dx, dy) = (x as f64 - axes.centre.0, y as f64 - axes.centre.1);
         let side = |d: f64| {
@@ -1685,7 +1677,7 @@ fn draw_polar_grid(area: &Area, axes: &PolarAxes, labels: &[String]) -> Result<(
         let h = [HPos::Right, HPos::Center, HPos::Left][(side(dx) + 1) as usize];
         let v = [VPos::Bottom, VPos::Center, VPos::Top][(side(dy) + 1) as usize];
         area.draw(&words(label.as_str(), (x, y), anchored(14, h, v)))
-            .map_err(drawing)?;
+            .map_err(drawing_error)?;
     }
     let step = nice_step(axes.r.1 - axes.r.0, 5.0);
     for v in ticks(axes.r.0, axes.r.1, step).into_iter().skip(1) {
@@ -1698,7 +1690,7 @@ fn draw_polar_grid(area: &Area, axes: &PolarAxes, labels: &[String]) -> Result<(
         };
         let centre = axes.at(0.0, 0.0);
         area.draw(&Circle::new(centre, rho.round() as u32, style))
-            .map_err(drawing)?;
+            .map_err(drawing_error)?;
     }
     Ok(())
 }
@@ -1716,12 +1708,13 @@ fn draw_ring_labels(area: &Area, axes: &PolarAxes, step: f64, deg: f64) -> Resul
             [(x - half, y - 9), (x + half, y + 8)],
             WHITE.mix(0.85).filled(),
         );
-        area.draw(&bg).map_err(drawing)?;
+        area.draw(&bg).map_err(drawing_error)?;
         let style = (FONT, 13)
             .into_font()
             .color(&RGBColor(70, 70, 70))
             .pos(Pos::new(HPos::Center, VPos::Center));
-        area.draw(&words(text, (x, y), style)).map_err(drawing)?;
+        area.draw(&words(text, (x, y), style))
+            .map_err(drawing_error)?;
     }
     Ok(())
 }
@@ -1772,14 +1765,14 @@ fn draw_polar_series(
         let mut band = polar_path(axes, &order, |st| st.p95);
         band.extend(polar_path(axes, &order, |st| st.p05).into_iter().rev());
         area.draw(&Polygon::new(band, color.mix(BAND_ALPHA).filled()))
-            .map_err(drawing)?;
+            .map_err(drawing_error)?;
     }
     let mean = polar_path(axes, &order, |st| st.mean);
     area.draw(&PathElement::new(mean, color.stroke_width(2)))
-        .map_err(drawing)?;
+        .map_err(drawing_error)?;
     for (deg, st) in &s.points {
         area.draw(&Circle::new(axes.point(*deg, st.mean), 4, color.filled()))
-            .map_err(drawing)?;
+            .map_err(drawing_error)?;
     }
     Ok(())
 }
@@ -1860,8 +1853,8 @@ fn bins_caption(b: &Bins, n: usize, groups: usize) -> String {
 /// The colour of group `i`'s bars and lines, and the opacity of its bars.
 fn bar_style(i: usize, groups: usize) -> (RGBColor, RGBColor, f64) {
     match groups {
-        1 => (series_color(0), STAT_INK, 1.0),
-        _ => (series_color(i), series_color(i), OVERLAY_ALPHA),
+        1 => (color(0), STAT_INK, 1.0),
+        _ => (color(i), color(i), OVERLAY_ALPHA),
     }
 }
 
@@ -2011,7 +2004,7 @@ fn histogram_chart<'a, 'b>(
         .x_label_area_size(56)
         .y_label_area_size(78)
         .build_cartesian_2d(x.0..x.1, 0..y_top)
-        .map_err(drawing)
+        .map_err(drawing_error)
 }
 
 fn draw_histogram(area: &Area, d: &Distribution, x_label: &str) -> Result<Frame> {
@@ -2066,7 +2059,7 @@ fn draw_histogram(area: &Area, d: &Distribution, x_label: &str) -> Result<Frame>
         .light_line_style(TRANSPARENT)
         .axis_style(AXIS)
         .draw()
-        .map_err(drawing)?;
+        .map_err(drawing_error)?;
     draw_bars(&mut chart, d)?;
     let (bx, by) = area.get_base_pixel();
     let base = chart.backend_coord(&(xr.0, 0)).1 - by;
@@ -2118,13 +2111,13 @@ fn draw_bars(chart: &mut HistogramChart, d: &Distribution) -> Result<()> {
                     color.mix(alpha).filled(),
                 )
             }))
-            .map_err(drawing)?;
+            .map_err(drawing_error)?;
         if many == 1 {
             let between = (1..g.counts.len()).map(|k| {
                 let h = g.counts[k - 1].max(g.counts[k]) as u32;
                 PathElement::new(vec![(e[k], 0), (e[k], h)], WHITE.stroke_width(1))
             });
-            chart.draw_series(between).map_err(drawing)?;
+            chart.draw_series(between).map_err(drawing_error)?;
         } else {
             chart
                 .draw_series(
@@ -2132,7 +2125,7 @@ fn draw_bars(chart: &mut HistogramChart, d: &Distribution) -> Result<()> {
                         .into_iter()
                         .map(|steps| PathElement::new(steps, color.stroke_width(2))),
                 )
-                .map_err(drawing)?;
+                .map_err(drawing_error)?;
         }
     }
     Ok(())
@@ -2180,7 +2173,7 @@ fn draw_tags(
             } else {
                 area.draw(&PathElement::new(line, style))
             }
-            .map_err(drawing)?;
+            .map_err(drawing_error)?;
         }
     }
     for (t, (x, y)) in tags.iter().zip(placed) {
@@ -2189,13 +2182,13 @@ fn draw_tags(
             [(x - half, y + 1), (x + half, y + TAG_ROW - 2)],
             WHITE.mix(0.9).filled(),
         );
-        area.draw(&bg).map_err(drawing)?;
+        area.draw(&bg).map_err(drawing_error)?;
         let style = (FONT, 13)
             .into_font()
             .color(&t.color)
             .pos(Pos::new(HPos::Center, VPos::Center));
         area.draw(&words(&t.text, (*x, y + TAG_ROW / 2), style))
-            .map_err(drawing)?;
+            .map_err(drawing_error)?;
     }
     Ok(())
 }
