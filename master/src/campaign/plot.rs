@@ -6,19 +6,19 @@
 //!   bar;
 //! - [`polar()`]: a KPI against a direction on polar axes (e.g. roll reduction over wave heading);
 //! - [`histogram()`]: the distribution of a KPI over the runs (e.g. a Monte-Carlo robustness
-//!   study), on [`bins`] chosen by the Freedman–Diaconis rule, with its mean and 5 % / 95 %
+//!   study), on [`Bins`] chosen by the Freedman–Diaconis rule, with its mean and 5 % / 95 %
 //!   percentiles, one semi-transparent histogram per value of a group column.
 //!
 //! Every plot reduces the rows that share a design point to their [`Stats`]: the mean, and the
-//! 5 % and 95 % empirical percentiles of [`percentile`]. A row is skipped when one of its
-//! plotted values is not finite (a failed run's KPIs are NaN); [`PlotSummary`] returns the
+//! 5 % and 95 % empirical percentiles (numpy's default definition). A row is skipped when one of
+//! its plotted values is not finite (a failed run's KPIs are NaN); [`PlotSummary`] returns the
 //! count, and the figure's caption prints it. Bad input (a missing or text column, no finite
 //! row, a path that cannot be written) is an [`Error`](crate::Error) that names it, never a
 //! panic.
 //!
-//! One file per concern: `stats` (percentiles, bins, the reduction of the run table's rows),
-//! `figure` (canvas, title, caption, legend, numbers on axes), and one per chart: `line_band`,
-//! `heatmap`, `polar`, `histogram`.
+//! One file per concern: `stats` (percentiles, bins, the reduction of the run table's rows, and
+//! their unit tests), `figure` (canvas, title, caption, legend, numbers on axes), and one per
+//! chart: `line_band`, `heatmap`, `polar`, `histogram`.
 //!
 //! Rendering shares the time-series plotter's setup ([`crate::plot`]): plotters' bitmap
 //! backend and DejaVu Sans embedded, so no system font or graphics library is needed, its series
@@ -36,8 +36,8 @@ pub use histogram::histogram;
 pub use line_band::line_band;
 pub use polar::polar;
 pub use stats::{
-    aggregate, bins, distribution, grid, percentile, Aggregate, BinRule, Bins, Distribution, Grid,
-    GroupCounts, SeriesStats, Stats, MAX_BINS,
+    aggregate, distribution, grid, Aggregate, BinRule, Bins, Distribution, Grid, GroupCounts,
+    SeriesStats, Stats,
 };
 
 use std::path::PathBuf;

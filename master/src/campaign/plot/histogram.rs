@@ -23,10 +23,10 @@ const STAT_INK: RGBColor = RGBColor(20, 20, 20);
 const TAG_ROW: i32 = 19;
 
 /// Draws the distribution of KPI `x` over the rows (e.g. the Monte-Carlo runs of a robustness
-/// study): bars of the runs in each of the [`bins`](super::bins) (Freedman–Diaconis, or Sturges
-/// when the interquartile range is 0), a solid line at the mean and dashed lines at the 5 % and
-/// 95 % percentiles ([`percentile`](super::percentile)), tagged above the bars, with their values
-/// in the legend.
+/// study): bars of the runs in each of the [`Bins`] (Freedman–Diaconis, or Sturges when the
+/// interquartile range is 0), a solid line at the mean and dashed lines at the 5 % and 95 %
+/// percentiles (see [`Stats`](super::Stats)), tagged above the bars, with their values in the
+/// legend.
 ///
 /// With `group`, each value of the group column gets its own semi-transparent histogram
 /// (outlined in its colour) on the bins chosen for all rows, and its own mean and percentile

@@ -13,7 +13,7 @@ use plotters::prelude::*;
 
 /// Draws KPI `y` against factor `x`: for every distinct x (and value of `group`, one colour
 /// each), the mean over the rows as points joined by a line, and the band from the 5 % to the
-/// 95 % percentile ([`percentile`](super::percentile)) shaded where a point has two or more rows.
+/// 95 % percentile (see [`Stats`](super::Stats)) shaded where a point has two or more rows.
 pub fn line_band(
     table: &Table,
     x: &str,

@@ -9,23 +9,13 @@ use crate::error::{suggest, Error, Result};
 /// The percentiles of the band.
 const BAND: (f64, f64) = (5.0, 95.0);
 
-/// The `p`-th percentile (0 ≤ p ≤ 100) of `values`, by linear interpolation between order
-/// statistics: with the values sorted, x₀ ≤ … ≤ xₙ₋₁, and h = (n − 1) p / 100, it is
-/// x⌊h⌋ + (h − ⌊h⌋)(x⌊h⌋₊₁ − x⌊h⌋). This is definition 7 of Hyndman and Fan (*Sample quantiles in
-/// statistical packages*, The American Statistician 50 (1996) 361–365), the default of numpy's
-/// `percentile` (`method="linear"`) and of R's `quantile`; the interpolation is evaluated as
-/// numpy does (from the upper neighbour when the fraction is at least 0.5).
-/// `None` for no values, a NaN among them, or `p` outside 0..=100.
-pub fn percentile(values: &[f64], p: f64) -> Option<f64> {
-    if values.is_empty() || values.iter().any(|v| v.is_nan()) || !(0.0..=100.0).contains(&p) {
-        return None;
-    }
-    let mut sorted = values.to_vec();
-    sorted.sort_by(f64::total_cmp);
-    Some(percentile_sorted(&sorted, p))
-}
-
-/// [`percentile`] of values sorted ascending (not empty, no NaN, `p` in 0..=100).
+/// The `p`-th percentile (0 ≤ p ≤ 100) of values sorted ascending (not empty, no NaN), by
+/// linear interpolation between order statistics: with the values x₀ ≤ … ≤ xₙ₋₁ and
+/// h = (n − 1) p / 100, it is x⌊h⌋ + (h − ⌊h⌋)(x⌊h⌋₊₁ − x⌊h⌋). This is definition 7 of Hyndman and
+/// Fan (*Sample quantiles in statistical packages*, The American Statistician 50 (1996)
+/// 361–365), the default of numpy's `percentile` (`method="linear"`) and of R's `quantile`; the
+/// interpolation is evaluated as numpy does (from the upper neighbour when the fraction is at
+/// least 0.5).
 fn percentile_sorted(sorted: &[f64], p: f64) -> f64 {
     let h = (sorted.len() - 1) as f64 * (p / 100.0);
     let i = (h.floor() as usize).min(sorted.len() - 1);
@@ -40,7 +30,8 @@ fn percentile_sorted(sorted: &[f64], p: f64) -> f64 {
     }
 }
 
-/// The runs of one design point: their number, mean and 5 % / 95 % percentiles.
+/// The runs of one design point: their number, mean and 5 % / 95 % percentiles (linear
+/// interpolation between order statistics, numpy's default: definition 7 of Hyndman and Fan).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Stats {
     pub n: usize,
@@ -51,7 +42,7 @@ pub struct Stats {
 
 impl Stats {
     /// The statistics of finite values; `None` when there are none or one is not finite.
-    pub fn of(values: &[f64]) -> Option<Stats> {
+    fn of(values: &[f64]) -> Option<Stats> {
         if values.is_empty() || values.iter().any(|v| !v.is_finite()) {
             return None;
         }
@@ -181,9 +172,9 @@ pub fn grid(table: &Table, x: &str, y: &str, z: &str) -> Result<Grid> {
 }
 
 /// The most bins [`bins`] makes.
-pub const MAX_BINS: usize = 100;
+pub(super) const MAX_BINS: usize = 100;
 
-/// The rule by which [`bins`] chose the bins.
+/// The rule by which the [`Bins`] were chosen.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum BinRule {
     /// Freedman and Diaconis: width 2 IQR n^(-1/3).
@@ -194,7 +185,8 @@ pub enum BinRule {
     SingleValue,
 }
 
-/// Bins of equal width over the values' range and the values in each.
+/// Bins of equal width over the values' range and the values in each; [`BinRule`] says how
+/// many there are.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Bins {
     /// Ascending, one more than the bins: bin `i` is `edges[i] <= v < edges[i + 1]`, the last
@@ -203,7 +195,7 @@ pub struct Bins {
     /// The values in each bin.
     pub counts: Vec<usize>,
     pub rule: BinRule,
-    /// The rule asked for more than [`MAX_BINS`] bins; there are [`MAX_BINS`].
+    /// The rule asked for more than 100 bins (the most there may be); there are 100.
     pub capped: bool,
 }
 
@@ -226,7 +218,7 @@ impl Bins {
     }
 
     /// The bin holding `v`; `None` outside the edges (or for NaN).
-    pub fn index(&self, v: f64) -> Option<usize> {
+    fn index(&self, v: f64) -> Option<usize> {
         let n = self.len();
         if n == 0 || !(self.edges[0]..=self.edges[n]).contains(&v) {
             return None;
@@ -236,7 +228,7 @@ impl Bins {
 
     /// The number of `values` in each bin (values outside the edges are not counted): a
     /// group's histogram on bins chosen for all runs.
-    pub fn count(&self, values: &[f64]) -> Vec<usize> {
+    fn count(&self, values: &[f64]) -> Vec<usize> {
         let mut counts = vec![0; self.len()];
         for i in values.iter().filter_map(|v| self.index(*v)) {
             counts[i] += 1;
@@ -248,9 +240,9 @@ impl Bins {
 /// Bins for a histogram of `values`: equal widths from the smallest value to the largest, as
 /// many as the rule of Freedman and Diaconis asks for (D. Freedman and P. Diaconis, *On the
 /// histogram as a density estimator: L₂ theory*, Zeitschrift für Wahrscheinlichkeitstheorie
-/// und verwandte Gebiete 57 (1981) 453–476): width 2 IQR n^(-1/3), with the
-/// interquartile range IQR from [`percentile`] (75 % minus 25 %); the count is the range over
-/// that width rounded up, and the width is then the range over the count. This is numpy's
+/// und verwandte Gebiete 57 (1981) 453–476): width 2 IQR n^(-1/3), with the interquartile
+/// range IQR from [`percentile_sorted`] (75 % minus 25 %); the count is the range over that
+/// width rounded up, and the width is then the range over the count. This is numpy's
 /// `histogram_bin_edges(values, "fd")`, edges and all.
 ///
 /// - When the IQR is 0 (most runs share one value), the width would be 0: Sturges' rule gives
@@ -261,7 +253,7 @@ impl Bins {
 ///   ± 0.5).
 ///
 /// `None` for no values, a value that is not finite, or a range too wide for an `f64`.
-pub fn bins(values: &[f64]) -> Option<Bins> {
+fn bins(values: &[f64]) -> Option<Bins> {
     if values.is_empty() || values.iter().any(|v| !v.is_finite()) {
         return None;
     }
@@ -320,7 +312,7 @@ pub struct Distribution {
     pub rows_skipped: usize,
 }
 
-/// The [`bins`] of KPI `x` over the rows with a finite value, and the counts and [`Stats`] of
+/// The [`Bins`] of KPI `x` over the rows with a finite value, and the counts and [`Stats`] of
 /// each value of `group` on them. Rows with a non-finite `x` (or a NaN group value) are
 /// skipped and counted.
 pub fn distribution(table: &Table, x: &str, group: Option<&str>) -> Result<Distribution> {
@@ -492,5 +484,305 @@ fn group_value(col: &ColumnData, v: f64) -> String {
     match col {
         ColumnData::Bool(_) => (v != 0.0).to_string(),
         _ => plain(v),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    //! The statistics against values worked out by hand (the working is in the comments);
+    //! where numpy (2.4.6) was asked too, it agrees.
+
+    use super::*;
+
+    fn close(got: f64, want: f64) -> bool {
+        (got - want).abs() < 1e-12
+    }
+
+    /// A table of the given columns.
+    fn table(columns: Vec<(&str, ColumnData)>) -> Table {
+        let mut t = Table::default();
+        for (name, data) in columns {
+            t.push(name, data);
+        }
+        t
+    }
+
+    #[test]
+    fn percentiles_interpolate_between_order_statistics() {
+        // 1, 2, 3, 4: p5 at h = 3 * 0.05 = 0.15, 1 + 0.15 (2 - 1) = 1.15; p95 at h = 2.85,
+        // 3 + 0.85 (4 - 3) = 3.85 (numpy: 3.8499999999999996, the bits we give too).
+        let v = [1.0, 2.0, 3.0, 4.0];
+        let (p5, p95) = (percentile_sorted(&v, 5.0), percentile_sorted(&v, 95.0));
+        assert!(close(p5, 1.15), "{p5}");
+        assert!(close(p95, 3.85), "{p95}");
+        assert_eq!(p95, 3.8499999999999996);
+        // -2, 0.25, 3.1, 7.5, 9 (n - 1 = 4):
+        // p5: h = 0.2, -2 + 0.2 (0.25 + 2) = -1.55; p95: h = 3.8, 7.5 + 0.8 (9 - 7.5) = 8.7;
+        // p37: h = 1.48, 0.25 + 0.48 (3.1 - 0.25) = 1.618; p50: h = 2, 3.1; p0 and p100 the ends.
+        let v = [-2.0, 0.25, 3.1, 7.5, 9.0];
+        for (p, want) in [
+            (5.0, -1.55),
+            (95.0, 8.7),
+            (37.0, 1.618),
+            (50.0, 3.1),
+            (100.0, 9.0),
+            (0.0, -2.0),
+        ] {
+            let got = percentile_sorted(&v, p);
+            assert!(close(got, want), "p{p}: {got}, want {want}");
+        }
+        // One value is every percentile.
+        assert_eq!(percentile_sorted(&[7.0], 95.0), 7.0);
+        assert_eq!(percentile_sorted(&[7.0], 0.0), 7.0);
+    }
+
+    #[test]
+    fn stats_are_the_mean_and_the_band_of_finite_values() {
+        // 6, 10, 14: mean 10; p5 at h = 2 * 0.05 = 0.1, 6 + 0.1 * 4 = 6.4; p95 at h = 1.9,
+        // 10 + 0.9 * 4 = 13.6. The order of the values does not matter.
+        let s = Stats::of(&[14.0, 6.0, 10.0]).unwrap();
+        assert_eq!(s.n, 3);
+        assert!(
+            close(s.mean, 10.0) && close(s.p05, 6.4) && close(s.p95, 13.6),
+            "{s:?}"
+        );
+        let one = Stats::of(&[-2.5]).unwrap();
+        assert_eq!((one.n, one.mean, one.p05, one.p95), (1, -2.5, -2.5, -2.5));
+        assert_eq!(Stats::of(&[]), None);
+        assert_eq!(Stats::of(&[1.0, f64::NAN]), None);
+        assert_eq!(Stats::of(&[1.0, f64::INFINITY]), None);
+    }
+
+    #[test]
+    fn reduce_pools_the_values_of_each_key() {
+        // Key 1: 1 and 3, mean 2, p5 = 1 + 0.05 * 2 = 1.1, p95 = 1 + 0.95 * 2 = 2.9.
+        // Key 2: 5 and 7, mean 6, p5 5.1, p95 6.9. Key 4: 4 alone.
+        let r = reduce(vec![
+            (2.0, 5.0),
+            (4.0, 4.0),
+            (1.0, 1.0),
+            (2.0, 7.0),
+            (1.0, 3.0),
+        ]);
+        let keys: Vec<f64> = r.iter().map(|p| p.0).collect();
+        assert_eq!(keys, [1.0, 2.0, 4.0]);
+        for ((_, s), (n, mean, p05, p95)) in
+            r.iter()
+                .zip([(2, 2.0, 1.1, 2.9), (2, 6.0, 5.1, 6.9), (1, 4.0, 4.0, 4.0)])
+        {
+            assert_eq!(s.n, n);
+            assert!(
+                close(s.mean, mean) && close(s.p05, p05) && close(s.p95, p95),
+                "{s:?}"
+            );
+        }
+    }
+
+    /// 1 to 7 with the multiplicities 2, 4, 8, 12, 8, 4, 2 (40 values).
+    fn study() -> Vec<f64> {
+        (1..=7)
+            .zip([2, 4, 8, 12, 8, 4, 2])
+            .flat_map(|(v, m)| std::iter::repeat_n(v as f64, m))
+            .collect()
+    }
+
+    #[test]
+    fn bins_follow_freedman_diaconis() {
+        // 0..=99: p25 at h = 99 * 0.25 = 24.75 is 24.75, p75 74.25, IQR 49.5; width
+        // 2 * 49.5 * 100^(-1/3) = 21.33; 99 / 21.33 = 4.64, so 5 bins of 99 / 5 = 19.8 with 20
+        // values each. The edges are i * 19.8 (3 * 19.8 rounds to 59.400000000000006), as
+        // np.histogram_bin_edges(np.arange(100.), "fd") gives them.
+        let v: Vec<f64> = (0..100).map(f64::from).collect();
+        let b = bins(&v).unwrap();
+        assert_eq!(b.edges, [0.0, 19.8, 39.6, 59.400000000000006, 79.2, 99.0]);
+        assert_eq!(b.counts, [20; 5]);
+        assert_eq!(
+            (b.rule, b.capped, b.len(), b.is_empty()),
+            (BinRule::FreedmanDiaconis, false, 5, false)
+        );
+        assert!(close(b.width(), 19.8), "{}", b.width());
+
+        // The study, sorted x0..x39: 1 at 0-1, 2 at 2-5, 3 at 6-13, 4 at 14-25, 5 at 26-33, 6 at
+        // 34-37, 7 at 38-39. p25 at h = 9.75: x9 = x10 = 3; p75 at h = 29.25: x29 = x30 = 5;
+        // IQR 2; width 4 * 40^(-1/3) = 1.17; 6 / 1.17 = 5.13, so 6 bins of 1: [1, 2) 2, [2, 3) 4,
+        // [3, 4) 8, [4, 5) 12, [5, 6) 8, and [6, 7] (closed) 4 + 2.
+        let b = bins(&study()).unwrap();
+        assert_eq!(b.edges, [1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0]);
+        assert_eq!(b.counts, [2, 4, 8, 12, 8, 6]);
+    }
+
+    #[test]
+    fn bins_fall_back_to_sturges_a_cap_and_one_bin() {
+        // 1, 5 (x17), 9, 13: p25 (h = 4.75) and p75 (h = 14.25) are both 5, IQR 0. Sturges:
+        // ceil(log2 20) + 1 = 5 + 1 = 6 bins of 12 / 6 = 2 over [1, 13].
+        let mut v = vec![1.0, 9.0, 13.0];
+        v.extend([5.0; 17]);
+        let b = bins(&v).unwrap();
+        assert_eq!(b.rule, BinRule::Sturges);
+        assert_eq!(b.edges, [1.0, 3.0, 5.0, 7.0, 9.0, 11.0, 13.0]);
+        assert_eq!(b.counts, [1, 0, 17, 0, 1, 1]);
+
+        // 0..=999 and one outlier at 1e6: IQR 750 - 250 = 500, width 1000 * 1001^(-1/3) = 99.97,
+        // 1e6 / 99.97 = 10004 bins; capped at 100 bins of 1e4.
+        let mut v: Vec<f64> = (0..1000).map(f64::from).collect();
+        v.push(1e6);
+        let b = bins(&v).unwrap();
+        assert_eq!((b.len(), b.capped, MAX_BINS), (100, true, 100));
+        assert_eq!((b.edges[0], b.edges[1], b.edges[100]), (0.0, 1e4, 1e6));
+        assert_eq!((b.counts[0], b.counts[99]), (1000, 1));
+        assert_eq!(b.counts[1..99].iter().sum::<usize>(), 0);
+
+        // A single distinct value: one bin centred on it, +- a tenth of it (+- 1 at 0).
+        let b = bins(&[2.5, 2.5, 2.5]).unwrap();
+        assert_eq!(
+            (b.rule, b.edges.clone(), b.counts),
+            (BinRule::SingleValue, vec![2.25, 2.75], vec![3])
+        );
+        assert_eq!(bins(&[0.0]).unwrap().edges, [-1.0, 1.0]);
+        assert_eq!(bins(&[-4.0]).unwrap().edges, [-4.4, -3.6]);
+
+        assert_eq!(bins(&[]), None);
+        assert_eq!(bins(&[1.0, f64::NAN]), None);
+        assert_eq!(bins(&[1.0, f64::INFINITY]), None);
+        assert_eq!(bins(&[-1e308, 1e308]), None, "the range overflows");
+    }
+
+    #[test]
+    fn bins_are_half_open_and_the_last_is_closed() {
+        let b = bins(&study()).unwrap(); // edges 1, 2, ..., 7
+        assert_eq!(b.index(1.0), Some(0));
+        assert_eq!(b.index(1.9999), Some(0));
+        assert_eq!(b.index(2.0), Some(1));
+        assert_eq!(b.index(7.0), Some(5));
+        assert_eq!(
+            (b.index(0.999), b.index(7.001), b.index(f64::NAN)),
+            (None, None, None)
+        );
+        // Values outside the edges are not counted.
+        assert_eq!(b.count(&[0.0, 1.5, 4.0, 4.5, 7.0, 8.0]), [1, 0, 0, 2, 0, 1]);
+        let none = Bins {
+            edges: vec![],
+            counts: vec![],
+            rule: BinRule::SingleValue,
+            capped: false,
+        };
+        assert!(none.is_empty() && none.width().is_nan() && none.index(0.0).is_none());
+    }
+
+    #[test]
+    fn aggregate_groups_text_in_order_of_appearance_and_numbers_ascending() {
+        let x = ColumnData::Float(vec![1.0, 2.0, 1.0, 2.0, 1.0, 2.0, f64::NAN]);
+        let y = ColumnData::Float(vec![10.0, 20.0, 14.0, 24.0, f64::NAN, 30.0, 5.0]);
+        let arm = ColumnData::Text(["b", "b", "a", "a", "b", "a", "a"].map(String::from).into());
+        let hs = ColumnData::Float(vec![3.0, 1.0, 3.0, 1.0, 3.0, f64::NAN, 1.0]);
+        let rrs = ColumnData::Bool(vec![true, false, true, false, true, false, false]);
+        let t = table(vec![
+            ("x", x),
+            ("y", y),
+            ("arm", arm),
+            ("hs", hs),
+            ("rrs", rrs),
+        ]);
+        // Rows 4 (y NaN) and 6 (x NaN) are skipped. "b": x = 1 [10], x = 2 [20]; "a": x = 1
+        // [14], x = 2 [24, 30] (mean 27, p5 24 + 0.05 * 6 = 24.3, p95 24 + 0.95 * 6 = 29.7).
+        let a = aggregate(&t, "x", "y", Some("arm")).unwrap();
+        assert_eq!((a.rows_used, a.rows_skipped), (5, 2));
+        let groups: Vec<_> = a.series.iter().map(|s| s.group.as_deref()).collect();
+        assert_eq!(groups, [Some("b"), Some("a")]);
+        let means = |s: &SeriesStats| s.points.iter().map(|p| (p.0, p.1.mean)).collect::<Vec<_>>();
+        assert_eq!(means(&a.series[0]), [(1.0, 10.0), (2.0, 20.0)]);
+        assert_eq!(means(&a.series[1]), [(1.0, 14.0), (2.0, 27.0)]);
+        let s = a.series[1].points[1].1;
+        assert!(
+            s.n == 2 && close(s.p05, 24.3) && close(s.p95, 29.7),
+            "{s:?}"
+        );
+
+        // A number group: its values ascending, as written in a campaign file; a row whose
+        // group is NaN (row 5) is skipped too. "1": x = 2 [20, 24]; "3": x = 1 [10, 14].
+        let a = aggregate(&t, "x", "y", Some("hs")).unwrap();
+        assert_eq!((a.rows_used, a.rows_skipped), (4, 3));
+        let groups: Vec<_> = a.series.iter().map(|s| s.group.as_deref()).collect();
+        assert_eq!(groups, [Some("1"), Some("3")]);
+        assert_eq!(means(&a.series[0]), [(2.0, 22.0)]);
+        assert_eq!(means(&a.series[1]), [(1.0, 12.0)]);
+
+        // A Bool group reads false, true.
+        let a = aggregate(&t, "x", "y", Some("rrs")).unwrap();
+        let groups: Vec<_> = a.series.iter().map(|s| s.group.as_deref()).collect();
+        assert_eq!(groups, [Some("false"), Some("true")]);
+
+        // Without a group: one series without a name; x = 1 [10, 14], x = 2 [20, 24, 30].
+        let a = aggregate(&t, "x", "y", None).unwrap();
+        assert_eq!(a.series.len(), 1);
+        assert_eq!(a.series[0].group, None);
+        assert_eq!(
+            means(&a.series[0]),
+            [(1.0, 12.0), (2.0, 24.666666666666668)]
+        );
+    }
+
+    #[test]
+    fn grid_reduces_every_cell_and_leaves_empty_ones_empty() {
+        // Cells (x, y): (1, 0.5) [1, 3], (2, 0.5) [2], (1, 1.5) [4]; (2, 1.5) has no run; the
+        // last row's z is NaN.
+        let t = table(vec![
+            ("x", ColumnData::Int(vec![1, 2, 1, 1, 2])),
+            ("y", ColumnData::Float(vec![0.5, 0.5, 1.5, 0.5, 1.5])),
+            ("z", ColumnData::Float(vec![1.0, 2.0, 4.0, 3.0, f64::NAN])),
+        ]);
+        let g = grid(&t, "x", "y", "z").unwrap();
+        assert_eq!(
+            (g.xs.clone(), g.ys.clone()),
+            (vec![1.0, 2.0], vec![0.5, 1.5])
+        );
+        assert_eq!((g.rows_used, g.rows_skipped), (4, 1));
+        let cells: Vec<_> = g.cells.iter().map(|c| c.map(|s| (s.n, s.mean))).collect();
+        assert_eq!(
+            cells,
+            [Some((2, 2.0)), Some((1, 2.0)), Some((1, 4.0)), None]
+        );
+    }
+
+    #[test]
+    fn distribution_counts_each_group_on_shared_bins() {
+        // 0..=9: p25 at h = 2.25 is 2.25, p75 6.75, IQR 4.5; width 9 * 10^(-1/3) = 4.18;
+        // 9 / 4.18 = 2.15, so 3 bins of 3: [0, 3) 3, [3, 6) 3, [6, 9] 4. Group "A" holds 0..=4,
+        // [3, 2, 0], mean 2, p5 at h = 0.2: 0.2, p95 at h = 3.8: 3.8; "B" 5..=9 and a NaN,
+        // [0, 1, 4], mean 7, p5 5.2, p95 8.8; "C" only a NaN: no histogram.
+        let mut kpi: Vec<f64> = (0..10).map(f64::from).collect();
+        kpi.extend([f64::NAN, f64::NAN]);
+        let hull: Vec<String> = "AAAAABBBBBBC".chars().map(String::from).collect();
+        let t = table(vec![
+            ("kpi", ColumnData::Float(kpi)),
+            ("hull", ColumnData::Text(hull)),
+        ]);
+        let d = distribution(&t, "kpi", Some("hull")).unwrap();
+        assert_eq!((d.rows_used, d.rows_skipped), (10, 2));
+        assert_eq!(d.bins.edges, [0.0, 3.0, 6.0, 9.0]);
+        assert_eq!(
+            (d.bins.rule, &d.bins.counts[..]),
+            (BinRule::FreedmanDiaconis, &[3, 3, 4][..])
+        );
+        let [a, b] = &d.groups[..] else {
+            panic!("{:?}", d.groups)
+        };
+        assert_eq!(
+            (a.group.as_deref(), &a.counts[..]),
+            (Some("A"), &[3, 2, 0][..])
+        );
+        assert_eq!(
+            (b.group.as_deref(), &b.counts[..]),
+            (Some("B"), &[0, 1, 4][..])
+        );
+        for (s, (n, mean, p05, p95)) in
+            [(a.stats, (5, 2.0, 0.2, 3.8)), (b.stats, (5, 7.0, 5.2, 8.8))]
+        {
+            assert_eq!(s.n, n);
+            assert!(
+                close(s.mean, mean) && close(s.p05, p05) && close(s.p95, p95),
+                "{s:?}"
+            );
+        }
     }
 }
