@@ -10,7 +10,8 @@
 //!   `OspSystemStructure.xml`) and write out of it (OSP).
 //! - **Master**: [`run`] executes a plan: exchange, recorders, Jacobi and Gauss-Seidel, the
 //!   step loop.
-//! - **Tools**: [`inspect`] (an FMU summary), [`plot`] (PNG plots of recorded CSVs).
+//! - **Tools**: [`inspect`] (an FMU summary), [`results`] (the reader of recorded CSVs),
+//!   [`plot`] (PNG plots of them).
 //!
 //! The library holds no process-wide state (no signal handlers, no global logger): it is
 //! loaded into other processes (Python, Dask workers). The `shipsim` binary (`main.rs`) is the
@@ -35,6 +36,7 @@ pub mod isolate;
 pub mod limits;
 pub mod model_description;
 pub mod plot;
+pub mod results;
 pub mod run;
 pub mod system;
 pub mod units;

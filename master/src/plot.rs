@@ -1,11 +1,12 @@
-//! Time-series plots (PNG) of recorded results, for `shipsim plot`, `cargo xtask demo` and the
-//! validation report.
+//! Time-series plots (PNG) of recorded results ([`ResultsTable`]), for `shipsim plot`,
+//! `cargo xtask demo` and the validation report.
 //!
 //! Rendering is pure Rust (plotters' bitmap backend with the DejaVu Sans font embedded through
 //! the `dejavu` crate), so no system font or graphics library is needed. The setup, the series
 //! colours and the drawing error are shared with the campaign plots ([`crate::campaign::plot`]).
 
 use crate::error::{Error, Result};
+use crate::results::ResultsTable;
 use plotters::prelude::*;
 use std::path::Path;
 use std::sync::Once;
@@ -23,104 +24,6 @@ pub struct Series {
 pub struct Panel {
     pub y_label: String,
     pub series: Vec<Series>,
-}
-
-/// A recorded CSV: header names and columns of numbers.
-#[derive(Clone, Debug)]
-pub struct Table {
-    pub names: Vec<String>,
-    pub columns: Vec<Vec<f64>>,
-    /// Columns of text (recorded String variables), left out of `names` and `columns`.
-    pub text: Vec<String>,
-}
-
-/// A CSV field as a number (`true`/`false` as 1/0).
-fn number(field: &str) -> Option<f64> {
-    match field.trim() {
-        "true" | "True" => Some(1.0),
-        "false" | "False" => Some(0.0),
-        f => f.parse().ok(),
-    }
-}
-
-impl Table {
-    /// Reads a CSV written by the recorder (first column time, header `instance.variable`;
-    /// fields quoted as RFC 4180 says, read by the `csv` crate). Booleans (`true`/`false`) read
-    /// as 1/0. A column whose first value is not a number is text (a recorded String
-    /// variable): it is listed in `text` and left out; a later value that is not a number in
-    /// a number column is an error naming the line and column.
-    pub fn read(path: &Path) -> Result<Table> {
-        let bad = |line: u64, e: String| Error::Other(format!("{}:{line}: {e}", path.display()));
-        let mut reader = csv::ReaderBuilder::new()
-            .has_headers(false)
-            .from_path(path)
-            .map_err(|e| Error::Other(format!("cannot read {}: {e}", path.display())))?;
-        let mut records = reader.records();
-        let header = records
-            .next()
-            .ok_or_else(|| Error::Other(format!("{}: empty CSV file", path.display())))?
-            .map_err(|e| bad(1, e.to_string()))?;
-        let all: Vec<String> = header.iter().map(|s| s.trim().to_string()).collect();
-        let mut numeric: Option<Vec<bool>> = None;
-        let mut columns = vec![Vec::new(); all.len()];
-        for record in records {
-            let record =
-                record.map_err(|e| bad(e.position().map_or(0, |p| p.line()), e.to_string()))?;
-            let line = record.position().map_or(0, |p| p.line());
-            if record.iter().all(|f| f.trim().is_empty()) {
-                continue;
-            }
-            if record.len() != all.len() {
-                let e = format!("{} values, header has {}", record.len(), all.len());
-                return Err(bad(line, e));
-            }
-            let numeric =
-                numeric.get_or_insert_with(|| record.iter().map(|f| number(f).is_some()).collect());
-            for (c, field) in record.iter().enumerate().filter(|(c, _)| numeric[*c]) {
-                let v = number(field).ok_or_else(|| {
-                    let e = format!("column {:?}: {:?} is not a number", all[c], field.trim());
-                    bad(line, e)
-                })?;
-                columns[c].push(v);
-            }
-        }
-        let numeric = numeric.unwrap_or_else(|| vec![true; all.len()]);
-        let (mut names, mut text, mut kept) = (Vec::new(), Vec::new(), Vec::new());
-        for ((name, column), is_number) in all.into_iter().zip(columns).zip(numeric) {
-            match is_number {
-                true => {
-                    names.push(name);
-                    kept.push(column);
-                }
-                false => text.push(name),
-            }
-        }
-        Ok(Table {
-            names,
-            columns: kept,
-            text,
-        })
-    }
-
-    /// The column named `name`; the error lists the available columns.
-    pub fn column(&self, name: &str) -> Result<&[f64]> {
-        self.names
-            .iter()
-            .position(|n| n == name)
-            .map(|i| self.columns[i].as_slice())
-            .ok_or_else(|| match self.text.iter().any(|t| t == name) {
-                true => Error::Other(format!("column {name:?} is text (a String variable)")),
-                false => Error::Other(format!(
-                    "no column {name:?}; columns: {}",
-                    self.names.join(", ")
-                )),
-            })
-    }
-
-    /// The first column (time).
-    pub fn time(&self) -> &[f64] {
-        self.columns.first().map(Vec::as_slice).unwrap_or(&[])
-    }
 }
 
 /// A plotted column as written on the command line: `COL` or `COL*FACTOR` (the factor applies
@@ -167,7 +70,7 @@ pub fn parse_window(spec: &str) -> Result<(f64, f64)> {
 /// labelled `LABEL: column`), time panels and x-y tracks, within a time window.
 pub struct Request<'a> {
     /// Each file's label and table.
-    pub files: &'a [(String, Table)],
+    pub files: &'a [(String, ResultsTable)],
     /// `Y LABEL=COL[*F],COL[*F],...`, one per time panel.
     pub panels: &'a [String],
     /// `XCOL[*F],YCOL[*F]`, one per track panel (equal axes).
@@ -232,7 +135,7 @@ impl Request<'_> {
     /// The times and scaled values of a column within the window.
     fn values(
         &self,
-        table: &Table,
+        table: &ResultsTable,
         name: &str,
         factor: Option<f64>,
     ) -> Result<(Vec<f64>, Vec<f64>)> {
@@ -485,18 +388,11 @@ mod tests {
     use super::*;
 
     #[test]
-    fn reads_a_recorder_csv_and_plots_it() {
+    fn plots_a_recorder_csv() {
         let dir = tempfile::tempdir().unwrap();
         let csv = dir.path().join("r.csv");
         std::fs::write(&csv, "time,g.a,g.flag\n0,1.5,true\n0.1,2.5,false\n").unwrap();
-        let t = Table::read(&csv).unwrap();
-        assert_eq!(t.column("g.a").unwrap(), &[1.5, 2.5]);
-        assert_eq!(t.column("g.flag").unwrap(), &[1.0, 0.0]);
-        assert!(t
-            .column("g.b")
-            .unwrap_err()
-            .to_string()
-            .contains("columns: time, g.a"));
+        let t = ResultsTable::read(&csv).unwrap();
         let png = dir.path().join("out/p.png");
         plot_panels(
             &png,
@@ -513,19 +409,5 @@ mod tests {
         .unwrap();
         let bytes = std::fs::read(&png).unwrap();
         assert_eq!(&bytes[1..4], b"PNG");
-        // a column that starts with text is text (a String variable), left out of the numbers
-        std::fs::write(&csv, "time,x\n0,abc\n").unwrap();
-        let t = Table::read(&csv).unwrap();
-        assert_eq!(
-            (t.names, t.text),
-            (vec!["time".to_string()], vec!["x".to_string()])
-        );
-        // text later in a number column is an error naming the line and column
-        std::fs::write(&csv, "time,x\n0,1\n0.1,abc\n").unwrap();
-        let e = Table::read(&csv).unwrap_err().to_string();
-        assert!(
-            e.contains("r.csv:3: column \"x\": \"abc\" is not a number"),
-            "{e}"
-        );
     }
 }
