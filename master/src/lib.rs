@@ -19,7 +19,8 @@
 //!   step loop, checkpoints.
 //! - **Campaigns**: [`campaign`] runs a system many times over factors, seeds and arms (each
 //!   run through [`run`]), with KPIs, durable journals, run tables and plots.
-//! - **Tools**: [`inspect`] (an FMU summary), [`plot`] (PNG plots of recorded CSVs).
+//! - **Tools**: [`inspect`] (an FMU summary), [`results`] (the reader of recorded CSVs),
+//!   [`plot`] (PNG plots of them).
 //!
 //! Entry functions are named by one rule: `f` is the common form; `f_with` takes the options
 //! `f` leaves at their defaults (`load_with`, `load_fmus_with`, `prepare_with`); `f_into`
@@ -49,6 +50,7 @@ pub mod limits;
 pub mod log;
 pub mod model_description;
 pub mod plot;
+pub mod results;
 pub mod run;
 pub mod slave;
 pub mod system;

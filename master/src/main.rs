@@ -418,7 +418,8 @@ struct PlotArgs {
 /// `shipsim plot`: one time panel per --panel and one x-y panel per --xy, each series once per
 /// CSV file.
 fn plot(a: PlotArgs) -> shipsim::Result<()> {
-    use shipsim::plot::{parse_window, plot_figure, Request, Table};
+    use shipsim::plot::{parse_window, plot_figure, Request};
+    use shipsim::results::ResultsTable;
     let (csvs, output) = (a.csv.as_slice(), a.output.as_path());
     if a.panels.is_empty() && a.xy.is_empty() {
         return Err(Error::Other("nothing to plot: give --panel or --xy".into()));
@@ -440,7 +441,7 @@ fn plot(a: PlotArgs) -> shipsim::Result<()> {
                 .to_string_lossy()
                 .into_owned(),
         };
-        files.push((name, Table::read(csv)?));
+        files.push((name, ResultsTable::read(csv)?));
     }
     let request = Request {
         files: &files,

@@ -1,10 +1,12 @@
-//! Time-series plots (PNG) of recorded results, for `shipsim plot`, `cargo xtask demo` and the
-//! validation report.
+//! Time-series plots (PNG) of recorded results ([`ResultsTable`]), for `shipsim plot`,
+//! `cargo xtask demo` and the validation report.
 //!
 //! Rendering is pure Rust (plotters' bitmap backend with the DejaVu Sans font embedded through
-//! the `dejavu` crate), so no system font or graphics library is needed.
+//! the `dejavu` crate), so no system font or graphics library is needed. The setup, the series
+//! colours and the drawing error are shared with the campaign plots ([`crate::campaign::plot`]).
 
 use crate::error::{Error, Result};
+use crate::results::ResultsTable;
 use plotters::prelude::*;
 use std::path::Path;
 use std::sync::Once;
@@ -22,104 +24,6 @@ pub struct Series {
 pub struct Panel {
     pub y_label: String,
     pub series: Vec<Series>,
-}
-
-/// A recorded CSV: header names and columns of numbers.
-#[derive(Clone, Debug)]
-pub struct Table {
-    pub names: Vec<String>,
-    pub columns: Vec<Vec<f64>>,
-    /// Columns of text (recorded String variables), left out of `names` and `columns`.
-    pub text: Vec<String>,
-}
-
-/// A CSV field as a number (`true`/`false` as 1/0).
-fn number(field: &str) -> Option<f64> {
-    match field.trim() {
-        "true" | "True" => Some(1.0),
-        "false" | "False" => Some(0.0),
-        f => f.parse().ok(),
-    }
-}
-
-impl Table {
-    /// Reads a CSV written by the recorder (first column time, header `instance.variable`;
-    /// fields quoted as RFC 4180 says, read by the `csv` crate). Booleans (`true`/`false`) read
-    /// as 1/0. A column whose first value is not a number is text (a recorded String
-    /// variable): it is listed in `text` and left out; a later value that is not a number in
-    /// a number column is an error naming the line and column.
-    pub fn read(path: &Path) -> Result<Table> {
-        let bad = |line: u64, e: String| Error::Other(format!("{}:{line}: {e}", path.display()));
-        let mut reader = csv::ReaderBuilder::new()
-            .has_headers(false)
-            .from_path(path)
-            .map_err(|e| Error::Other(format!("cannot read {}: {e}", path.display())))?;
-        let mut records = reader.records();
-        let header = records
-            .next()
-            .ok_or_else(|| Error::Other(format!("{}: empty CSV file", path.display())))?
-            .map_err(|e| bad(1, e.to_string()))?;
-        let all: Vec<String> = header.iter().map(|s| s.trim().to_string()).collect();
-        let mut numeric: Option<Vec<bool>> = None;
-        let mut columns = vec![Vec::new(); all.len()];
-        for record in records {
-            let record =
-                record.map_err(|e| bad(e.position().map_or(0, |p| p.line()), e.to_string()))?;
-            let line = record.position().map_or(0, |p| p.line());
-            if record.iter().all(|f| f.trim().is_empty()) {
-                continue;
-            }
-            if record.len() != all.len() {
-                let e = format!("{} values, header has {}", record.len(), all.len());
-                return Err(bad(line, e));
-            }
-            let numeric =
-                numeric.get_or_insert_with(|| record.iter().map(|f| number(f).is_some()).collect());
-            for (c, field) in record.iter().enumerate().filter(|(c, _)| numeric[*c]) {
-                let v = number(field).ok_or_else(|| {
-                    let e = format!("column {:?}: {:?} is not a number", all[c], field.trim());
-                    bad(line, e)
-                })?;
-                columns[c].push(v);
-            }
-        }
-        let numeric = numeric.unwrap_or_else(|| vec![true; all.len()]);
-        let (mut names, mut text, mut kept) = (Vec::new(), Vec::new(), Vec::new());
-        for ((name, column), is_number) in all.into_iter().zip(columns).zip(numeric) {
-            match is_number {
-                true => {
-                    names.push(name);
-                    kept.push(column);
-                }
-                false => text.push(name),
-            }
-        }
-        Ok(Table {
-            names,
-            columns: kept,
-            text,
-        })
-    }
-
-    /// The column named `name`; the error lists the available columns.
-    pub fn column(&self, name: &str) -> Result<&[f64]> {
-        self.names
-            .iter()
-            .position(|n| n == name)
-            .map(|i| self.columns[i].as_slice())
-            .ok_or_else(|| match self.text.iter().any(|t| t == name) {
-                true => Error::Other(format!("column {name:?} is text (a String variable)")),
-                false => Error::Other(format!(
-                    "no column {name:?}; columns: {}",
-                    self.names.join(", ")
-                )),
-            })
-    }
-
-    /// The first column (time).
-    pub fn time(&self) -> &[f64] {
-        self.columns.first().map(Vec::as_slice).unwrap_or(&[])
-    }
 }
 
 /// A plotted column as written on the command line: `COL` or `COL*FACTOR` (the factor applies
@@ -166,7 +70,7 @@ pub fn parse_window(spec: &str) -> Result<(f64, f64)> {
 /// labelled `LABEL: column`), time panels and x-y tracks, within a time window.
 pub struct Request<'a> {
     /// Each file's label and table.
-    pub files: &'a [(String, Table)],
+    pub files: &'a [(String, ResultsTable)],
     /// `Y LABEL=COL[*F],COL[*F],...`, one per time panel.
     pub panels: &'a [String],
     /// `XCOL[*F],YCOL[*F]`, one per track panel (equal axes).
@@ -231,7 +135,7 @@ impl Request<'_> {
     /// The times and scaled values of a column within the window.
     fn values(
         &self,
-        table: &Table,
+        table: &ResultsTable,
         name: &str,
         factor: Option<f64>,
     ) -> Result<(Vec<f64>, Vec<f64>)> {
@@ -267,7 +171,7 @@ pub(crate) fn register_font() {
 }
 
 /// Series colours, in order: matplotlib's "tab10" blue, red, green, orange and purple, then grey.
-pub(crate) const COLORS: [RGBColor; 6] = [
+const COLORS: [RGBColor; 6] = [
     RGBColor(31, 119, 180),
     RGBColor(214, 39, 40),
     RGBColor(44, 160, 44),
@@ -276,9 +180,14 @@ pub(crate) const COLORS: [RGBColor; 6] = [
     RGBColor(90, 90, 90),
 ];
 
-fn draw_err<E: std::fmt::Debug>(path: &Path) -> impl Fn(E) -> Error + '_ {
-    move |e| Error::Other(format!("drawing {}: {e:?}", path.display()))
+/// The error of a failed plotters call, in every PNG plot of the crate; the caller names the
+/// file (`plot PATH: drawing failed: ...`).
+pub(crate) fn drawing_error<E: std::fmt::Debug>(e: E) -> Error {
+    Error::Other(format!("drawing failed: {e:?}"))
 }
+
+/// The drawing area of a PNG plot (in pixels).
+pub(crate) type Area<'a> = DrawingArea<BitMapBackend<'a>, plotters::coord::Shift>;
 
 /// Creates the folder that will hold `path` (and its parents) when it does not exist.
 pub(crate) fn create_parent_dir(path: &Path) -> Result<()> {
@@ -324,11 +233,18 @@ pub fn plot_figure(path: &Path, title: &str, panels: &[Panel], tracks: &[Track])
     }
     register_font();
     create_parent_dir(path)?;
+    draw_figure(path, title, panels, tracks)
+        .map_err(|e| Error::Other(format!("plot {}: {e}", path.display())))
+}
+
+/// The figure of [`plot_figure`], written to `path`.
+fn draw_figure(path: &Path, title: &str, panels: &[Panel], tracks: &[Track]) -> Result<()> {
     let height = 60 + PANEL_HEIGHT * panels.len() as u32 + TRACK_HEIGHT * tracks.len() as u32;
     let root = BitMapBackend::new(path, (1100, height)).into_drawing_area();
-    let err = draw_err(path);
-    root.fill(&WHITE).map_err(&err)?;
-    let root = root.titled(title, ("sans-serif", 22)).map_err(&err)?;
+    root.fill(&WHITE).map_err(drawing_error)?;
+    let root = root
+        .titled(title, ("sans-serif", 22))
+        .map_err(drawing_error)?;
     // The height below the title, shared in proportion (all of it without tracks).
     let (time_px, track_px) = (
         PANEL_HEIGHT * panels.len() as u32,
@@ -346,7 +262,7 @@ pub fn plot_figure(path: &Path, title: &str, panels: &[Panel], tracks: &[Track])
                 .flat_map(|s| &s.t),
         );
         for (panel, area) in panels.iter().zip(areas.iter()) {
-            draw_time_panel(area, panel, (t0, t1), &err)?;
+            draw_time_panel(area, panel, (t0, t1))?;
         }
     }
     if !tracks.is_empty() {
@@ -354,15 +270,12 @@ pub fn plot_figure(path: &Path, title: &str, panels: &[Panel], tracks: &[Track])
             .iter()
             .zip(track_area.split_evenly((tracks.len(), 1)).iter())
         {
-            draw_track(area, track, &err)?;
+            draw_track(area, track)?;
         }
     }
-    root.present().map_err(&err)?;
+    root.present().map_err(drawing_error)?;
     Ok(())
 }
-
-type Area<'a> = DrawingArea<BitMapBackend<'a>, plotters::coord::Shift>;
-type DrawError = DrawingAreaErrorKind<<BitMapBackend<'static> as DrawingBackend>::ErrorType>;
 
 /// The smallest and largest finite value ((0, 1) when there are none or they are equal).
 fn bounds<'v>(values: impl Iterator<Item = &'v f64>) -> (f64, f64) {
@@ -381,17 +294,12 @@ fn bounds<'v>(values: impl Iterator<Item = &'v f64>) -> (f64, f64) {
     }
 }
 
-/// The colour of series `i` of a panel.
-fn color(i: usize) -> RGBColor {
+/// The colour of series `i` of a panel (or of a campaign plot's group), in [`COLORS`] order.
+pub(crate) fn color(i: usize) -> RGBColor {
     COLORS[i % COLORS.len()]
 }
 
-fn draw_time_panel(
-    area: &Area,
-    panel: &Panel,
-    (t0, t1): (f64, f64),
-    err: &impl Fn(DrawError) -> Error,
-) -> Result<()> {
+fn draw_time_panel(area: &Area, panel: &Panel, (t0, t1): (f64, f64)) -> Result<()> {
     let (mut lo, mut hi) = panel
         .series
         .iter()
@@ -405,14 +313,7 @@ fn draw_time_panel(
     }
     let pad = ((hi - lo) * 0.08).max(1e-9);
     let desc = ("time [s]", panel.y_label.as_str());
-    draw_chart(
-        area,
-        (t0, t1),
-        (lo - pad, hi + pad),
-        desc,
-        &panel.series,
-        err,
-    )
+    draw_chart(area, (t0, t1), (lo - pad, hi + pad), desc, &panel.series)
 }
 
 /// One chart: the mesh with the axis descriptions, the series as lines in [`COLORS`] order,
@@ -423,7 +324,6 @@ fn draw_chart(
     (y0, y1): (f64, f64),
     (x_desc, y_desc): (&str, &str),
     series: &[Series],
-    err: &impl Fn(DrawError) -> Error,
 ) -> Result<()> {
     let mut chart = ChartBuilder::on(area)
         .margin(MARGIN)
@@ -431,14 +331,14 @@ fn draw_chart(
         .x_label_area_size(X_LABEL_AREA)
         .y_label_area_size(Y_LABEL_AREA)
         .build_cartesian_2d(x0..x1, y0..y1)
-        .map_err(err)?;
+        .map_err(drawing_error)?;
     chart
         .configure_mesh()
         .x_desc(x_desc)
         .y_desc(y_desc)
         .label_style(("sans-serif", 14))
         .draw()
-        .map_err(err)?;
+        .map_err(drawing_error)?;
     for (i, s) in series.iter().enumerate() {
         let c = color(i);
         chart
@@ -446,7 +346,7 @@ fn draw_chart(
                 s.t.iter().copied().zip(s.y.iter().copied()),
                 c.stroke_width(2),
             ))
-            .map_err(err)?
+            .map_err(drawing_error)?
             .label(s.label.as_str())
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2)));
     }
@@ -456,7 +356,7 @@ fn draw_chart(
         .border_style(BLACK)
         .label_font(("sans-serif", 14))
         .draw()
-        .map_err(err)?;
+        .map_err(drawing_error)?;
     Ok(())
 }
 
@@ -472,7 +372,7 @@ pub fn equal_axes(x: (f64, f64), y: (f64, f64), w: u32, h: u32) -> ((f64, f64), 
     ((cx - hx, cx + hx), (cy - hy, cy + hy))
 }
 
-fn draw_track(area: &Area, track: &Track, err: &impl Fn(DrawError) -> Error) -> Result<()> {
+fn draw_track(area: &Area, track: &Track) -> Result<()> {
     let (w, h) = area.dim_in_pixel();
     let plot_w = w.saturating_sub(MARGIN + RIGHT_MARGIN + Y_LABEL_AREA);
     let plot_h = h.saturating_sub(2 * MARGIN + X_LABEL_AREA);
@@ -480,7 +380,7 @@ fn draw_track(area: &Area, track: &Track, err: &impl Fn(DrawError) -> Error) -> 
     let ys = bounds(track.series.iter().flat_map(|s| &s.y));
     let (x, y) = equal_axes(xs, ys, plot_w, plot_h);
     let desc = (track.x_label.as_str(), track.y_label.as_str());
-    draw_chart(area, x, y, desc, &track.series, err)
+    draw_chart(area, x, y, desc, &track.series)
 }
 
 #[cfg(test)]
@@ -488,18 +388,11 @@ mod tests {
     use super::*;
 
     #[test]
-    fn reads_a_recorder_csv_and_plots_it() {
+    fn plots_a_recorder_csv() {
         let dir = tempfile::tempdir().unwrap();
         let csv = dir.path().join("r.csv");
         std::fs::write(&csv, "time,g.a,g.flag\n0,1.5,true\n0.1,2.5,false\n").unwrap();
-        let t = Table::read(&csv).unwrap();
-        assert_eq!(t.column("g.a").unwrap(), &[1.5, 2.5]);
-        assert_eq!(t.column("g.flag").unwrap(), &[1.0, 0.0]);
-        assert!(t
-            .column("g.b")
-            .unwrap_err()
-            .to_string()
-            .contains("columns: time, g.a"));
+        let t = ResultsTable::read(&csv).unwrap();
         let png = dir.path().join("out/p.png");
         plot_panels(
             &png,
@@ -516,19 +409,5 @@ mod tests {
         .unwrap();
         let bytes = std::fs::read(&png).unwrap();
         assert_eq!(&bytes[1..4], b"PNG");
-        // a column that starts with text is text (a String variable), left out of the numbers
-        std::fs::write(&csv, "time,x\n0,abc\n").unwrap();
-        let t = Table::read(&csv).unwrap();
-        assert_eq!(
-            (t.names, t.text),
-            (vec!["time".to_string()], vec!["x".to_string()])
-        );
-        // text later in a number column is an error naming the line and column
-        std::fs::write(&csv, "time,x\n0,1\n0.1,abc\n").unwrap();
-        let e = Table::read(&csv).unwrap_err().to_string();
-        assert!(
-            e.contains("r.csv:3: column \"x\": \"abc\" is not a number"),
-            "{e}"
-        );
     }
 }

@@ -1,5 +1,6 @@
 //! The campaign plots (`shipsim::campaign::plot`): the statistics they draw, the PNGs they
-//! write (decoded here: size, colours, where the data land), and their errors.
+//! write (decoded here: size, colours, where the data land), and their errors. The statistics'
+//! building blocks (percentiles, bins) have their unit tests in `src/campaign/plot/stats.rs`.
 //!
 //! The run tables are built by hand: a synthetic roll-reduction study,
 //! r = 50 + 30 sin(direction) + 5 (H_s - 3) + e, with three seeds e = -4, 0, +4 per design
@@ -10,8 +11,8 @@
 
 use image::{Rgb, RgbImage};
 use shipsim::campaign::plot::{
-    aggregate, bins, distribution, grid, heatmap, histogram, line_band, percentile, polar, viridis,
-    AngleUnit, BinRule, Cells, Frame, Orientation, PlotOptions, Stats, MAX_BINS,
+    aggregate, distribution, grid, heatmap, histogram, line_band, polar, viridis, AngleUnit,
+    BinRule, Cells, Frame, Orientation, PlotOptions,
 };
 use shipsim::campaign::table::{ColumnData, Table};
 use std::path::PathBuf;
@@ -118,38 +119,6 @@ fn close(a: Rgb<u8>, b: [u8; 3], tol: u8) -> bool {
 }
 
 #[test]
-fn percentile_is_numpys_default() {
-    // np.percentile([1, 2, 3, 4], [5, 95]) == [1.15, 3.8499999999999996] (numpy 2.4.6)
-    let p5 = percentile(&[1.0, 2.0, 3.0, 4.0], 5.0).unwrap();
-    let p95 = percentile(&[4.0, 2.0, 1.0, 3.0], 95.0).unwrap();
-    assert!((p5 - 1.15).abs() < 1e-12, "{p5}");
-    assert!((p95 - 3.85).abs() < 1e-12, "{p95}");
-    assert_eq!(
-        p95, 3.8499999999999996,
-        "numpy evaluates the interpolation this way"
-    );
-    // np.percentile([3.1, -2.0, 7.5, 0.25, 9.0], [5, 95, 37, 50, 100, 0])
-    let a = [3.1, -2.0, 7.5, 0.25, 9.0];
-    let numpy = [
-        (5.0, -1.55),
-        (95.0, 8.7),
-        (37.0, 1.618),
-        (50.0, 3.1),
-        (100.0, 9.0),
-        (0.0, -2.0),
-    ];
-    for (p, want) in numpy {
-        let got = percentile(&a, p).unwrap();
-        assert!((got - want).abs() < 1e-12, "p{p}: {got} vs numpy {want}");
-    }
-    assert_eq!(percentile(&[7.0], 95.0), Some(7.0));
-    assert_eq!(percentile(&[], 50.0), None);
-    assert_eq!(percentile(&[1.0, f64::NAN], 50.0), None);
-    assert_eq!(percentile(&[1.0, 2.0], 100.5), None);
-    assert_eq!(percentile(&[1.0, 2.0], -1.0), None);
-}
-
-#[test]
 fn aggregate_reduces_the_seeds_of_each_design_point() {
     let agg = aggregate(&rrs_table(), "wave_dir", "roll_reduction", Some("H_s")).unwrap();
     assert_eq!((agg.rows_used, agg.rows_skipped), (81, 1));
@@ -181,7 +150,6 @@ fn aggregate_reduces_the_seeds_of_each_design_point() {
     let cell = g.cells[2 * 9 + 4].unwrap(); // 90 deg, H_s = 4
     assert_eq!(cell.n, 3);
     assert!((cell.mean - 85.0).abs() < 1e-12);
-    assert_eq!(Stats::of(&[1.0, f64::NAN]), None);
 }
 
 #[test]
@@ -646,75 +614,6 @@ fn mc_table() -> Table {
     t
 }
 
-#[test]
-fn bins_follow_freedman_diaconis_then_sturges() {
-    // 0..=99: p25 = 24.75, p75 = 74.25, IQR 49.5; width 99 * 100^(-1/3) = 21.33; 99 / 21.33 =
-    // 4.64, so 5 bins of 19.8 with 20 values each. np.histogram_bin_edges(np.arange(100.), "fd")
-    // gives exactly these edges (numpy 2.4.6), 59.400000000000006 included.
-    let v: Vec<f64> = (0..100).map(f64::from).collect();
-    let b = bins(&v).unwrap();
-    assert_eq!(b.edges, [0.0, 19.8, 39.6, 59.400000000000006, 79.2, 99.0]);
-    assert_eq!(b.counts, [20; 5]);
-    assert_eq!(
-        (b.rule, b.capped, b.len()),
-        (BinRule::FreedmanDiaconis, false, 5)
-    );
-    assert!((b.width() - 19.8).abs() < 1e-12, "{}", b.width());
-
-    let study: Vec<f64> = (1..=7)
-        .zip(MULTIPLICITY)
-        .flat_map(|(v, m)| std::iter::repeat_n(v as f64, m))
-        .collect();
-    let b = bins(&study).unwrap();
-    assert_eq!(b.edges, [1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0]);
-    assert_eq!(b.counts, [2, 4, 8, 12, 8, 6]);
-
-    // 1, 5 (x17), 9, 13: p25 (h = 4.75) and p75 (h = 14.25) are both 5, IQR 0. Sturges:
-    // ceil(log2 20) + 1 = 5 + 1 = 6 bins of 12 / 6 = 2 over [1, 13].
-    let mut v = vec![1.0, 9.0, 13.0];
-    v.extend([5.0; 17]);
-    let b = bins(&v).unwrap();
-    assert_eq!(b.rule, BinRule::Sturges);
-    assert_eq!(b.edges, [1.0, 3.0, 5.0, 7.0, 9.0, 11.0, 13.0]);
-    assert_eq!(b.counts, [1, 0, 17, 0, 1, 1]);
-
-    // 0..=999 and one outlier at 1e6: IQR 750 - 250 = 500, width 1000 * 1001^(-1/3) = 99.97,
-    // 1e6 / 99.97 = 10004 bins (numpy makes them); capped at 100 bins of 1e4.
-    let mut v: Vec<f64> = (0..1000).map(f64::from).collect();
-    v.push(1e6);
-    let b = bins(&v).unwrap();
-    assert_eq!((b.len(), b.capped, MAX_BINS), (100, true, 100));
-    assert_eq!((b.edges[0], b.edges[1], b.edges[100]), (0.0, 1e4, 1e6));
-    assert_eq!((b.counts[0], b.counts[99]), (1000, 1));
-    assert_eq!(b.counts[1..99].iter().sum::<usize>(), 0);
-
-    // A single distinct value: one bin centred on it, +- a tenth of it (+- 1 at 0).
-    let b = bins(&[2.5, 2.5, 2.5]).unwrap();
-    assert_eq!(
-        (b.rule, b.edges.clone(), b.counts),
-        (BinRule::SingleValue, vec![2.25, 2.75], vec![3])
-    );
-    assert_eq!(bins(&[0.0]).unwrap().edges, [-1.0, 1.0]);
-    assert_eq!(bins(&[-4.0]).unwrap().edges, [-4.4, -3.6]);
-
-    // Bins are half-open, the last one closed; values outside are not counted.
-    let b = bins(&study).unwrap();
-    assert_eq!(b.index(1.0), Some(0));
-    assert_eq!(b.index(1.9999), Some(0));
-    assert_eq!(b.index(2.0), Some(1));
-    assert_eq!(b.index(7.0), Some(5));
-    assert_eq!(
-        (b.index(0.999), b.index(7.001), b.index(f64::NAN)),
-        (None, None, None)
-    );
-    assert_eq!(b.count(&[0.0, 1.5, 4.0, 4.5, 7.0, 8.0]), [1, 0, 0, 2, 0, 1]);
-
-    assert_eq!(bins(&[]), None);
-    assert_eq!(bins(&[1.0, f64::NAN]), None);
-    assert_eq!(bins(&[1.0, f64::INFINITY]), None);
-    assert_eq!(bins(&[-1e308, 1e308]), None, "the range overflows");
-}
-
 /// The pixel of data (x, count) in a Cartesian frame, computed here.
 fn cart_px(frame: &Frame, xv: f64, yv: f64) -> (i32, i32) {
     let Frame::Cartesian {
@@ -962,8 +861,8 @@ fn histogram_of_a_constant_column_draws_one_bin() {
 #[test]
 fn histogram_odd_inputs_still_plot() {
     let (_keep, dir) = out_dir();
-    // 0..=999 and an outlier at 1e6 (capped at 100 bins, as in `bins_follow_...`); the group
-    // "rrs" is true for the even values; the group "arm" is "broken" for three failed runs.
+    // 0..=999 and an outlier at 1e6 (capped at 100 bins, as in the unit tests of the bins); the
+    // group "rrs" is true for the even values; the group "arm" is "broken" for three failed runs.
     let mut kpi: Vec<f64> = (0..1000).map(f64::from).collect();
     kpi.extend([1e6, f64::NAN, f64::NAN, f64::NAN]);
     let rrs: Vec<bool> = (0..1004).map(|i| i % 2 == 0).collect();

@@ -3,7 +3,8 @@
 //! and their pixels checked.
 
 use image::{Rgb, RgbImage};
-use shipsim::plot::{parse_window, Request, Table};
+use shipsim::plot::{parse_window, Request};
+use shipsim::results::ResultsTable;
 use std::path::Path;
 use std::process::Command;
 
@@ -143,11 +144,11 @@ fn xy_track_has_equal_axes() {
     assert!(x1 - x0 > 850, "{x0}..{x1}");
 }
 
-fn ramp_table() -> Table {
+fn ramp_table() -> ResultsTable {
     let d = tempfile::tempdir().unwrap();
     let csv = d.path().join("r.csv");
     write_csv(&csv, "time,g.s,g.r", (0..=10).map(|t| format!("{t},{t},1")));
-    Table::read(&csv).unwrap()
+    ResultsTable::read(&csv).unwrap()
 }
 
 /// A column's *F applies to that column only; --scale to the others; --window keeps the rows

@@ -11,7 +11,8 @@
 
 use shipsim::campaign::table::Table as CampaignTable;
 use shipsim::campaign::{execute, Campaign, CampaignOptions, CampaignOutcome, CampaignSpec};
-use shipsim::plot::{plot_panels, Panel, Series, Table};
+use shipsim::plot::{plot_panels, Panel, Series};
+use shipsim::results::ResultsTable;
 use shipsim::run::{run_system, Output, RunOptions};
 use shipsim::system::System;
 use std::fmt::Write as _;
@@ -62,7 +63,7 @@ impl Env {
     /// Runs `systems/<file>` with `--set`-style overrides (`instance.variable=value`), writing
     /// `<out_dir>/<csv>`; returns the recorded table. FMU paths of the system file are resolved
     /// by file name in [`Env::fmu_dir`].
-    pub fn run(&self, file: &str, sets: &[String], csv: &str) -> Result<Table, String> {
+    pub fn run(&self, file: &str, sets: &[String], csv: &str) -> Result<ResultsTable, String> {
         self.run_steps(file, sets, csv, None)
     }
 
@@ -73,7 +74,7 @@ impl Env {
         sets: &[String],
         csv: &str,
         steps: Option<u64>,
-    ) -> Result<Table, String> {
+    ) -> Result<ResultsTable, String> {
         let mut system = self.system(file)?;
         system.apply_overrides(sets).map_err(|e| e.to_string())?;
         if let Some(n) = steps {
@@ -83,7 +84,7 @@ impl Env {
         let out = self.out_dir.join(csv);
         run_system(&system, Output::File(out.clone()), &RunOptions::default())
             .map_err(|e| format!("{file}: {e}"))?;
-        Table::read(&out).map_err(|e| e.to_string())
+        ResultsTable::read(&out).map_err(|e| e.to_string())
     }
 
     /// Runs `campaigns/<file>` on `systems/<system>` (FMUs from [`Env::fmu_dir`]) afresh into
@@ -139,7 +140,12 @@ impl Env {
 }
 
 /// A curve from a table column, scaled (e.g. by 180/π for degrees).
-pub fn series(table: &Table, column: &str, label: &str, scale: f64) -> Result<Series, String> {
+pub fn series(
+    table: &ResultsTable,
+    column: &str,
+    label: &str,
+    scale: f64,
+) -> Result<Series, String> {
     Ok(Series {
         label: label.to_string(),
         t: table.time().to_vec(),
@@ -149,7 +155,7 @@ pub fn series(table: &Table, column: &str, label: &str, scale: f64) -> Result<Se
 
 /// A curve restricted to t0 ≤ t ≤ t1 (readable windows of long runs).
 pub fn series_window(
-    table: &Table,
+    table: &ResultsTable,
     column: &str,
     label: &str,
     scale: f64,
@@ -360,12 +366,12 @@ pub fn overrides_text(sets: &[&str]) -> String {
 // ------------------------------------------------------------------------------------------
 
 /// A column of a recorded table.
-pub fn col<'a>(table: &'a Table, column: &str) -> Result<&'a [f64], String> {
+pub fn col<'a>(table: &'a ResultsTable, column: &str) -> Result<&'a [f64], String> {
     table.column(column).map_err(|e| e.to_string())
 }
 
 /// The last value of a column.
-pub fn last(table: &Table, column: &str) -> Result<f64, String> {
+pub fn last(table: &ResultsTable, column: &str) -> Result<f64, String> {
     col(table, column)?
         .last()
         .copied()
@@ -373,7 +379,7 @@ pub fn last(table: &Table, column: &str) -> Result<f64, String> {
 }
 
 /// The part of a column from time `t0` on.
-pub fn after<'a>(table: &'a Table, column: &str, t0: f64) -> Result<&'a [f64], String> {
+pub fn after<'a>(table: &'a ResultsTable, column: &str, t0: f64) -> Result<&'a [f64], String> {
     let t = table.time();
     let start = t.iter().position(|&x| x >= t0).unwrap_or(t.len());
     Ok(&col(table, column)?[start..])

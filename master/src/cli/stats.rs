@@ -6,7 +6,8 @@
 use clap::Args;
 use shipsim::campaign::kpi::{Stat, StatAccumulator};
 use shipsim::error::{Error, Result};
-use shipsim::plot::{parse_window, Table};
+use shipsim::plot::parse_window;
+use shipsim::results::ResultsTable;
 use std::path::PathBuf;
 
 /// The statistics printed, in order, with their column titles.
@@ -50,7 +51,7 @@ pub fn run(args: &StatsArgs) -> Result<()> {
         Some(w) => parse_window(w)?,
         None => (f64::NEG_INFINITY, f64::INFINITY),
     };
-    let table = Table::read(&args.csv)?;
+    let table = ResultsTable::read(&args.csv)?;
     let time = table
         .column("time")
         .map_err(|_| Error::Other(format!("{file}: no column 'time'")))?;
@@ -98,7 +99,7 @@ pub fn run(args: &StatsArgs) -> Result<()> {
 /// The indices of the selected columns, in the order of the pattern list (each column once).
 /// Text columns (recorded String variables) are not selected: a pattern that matches only
 /// text is an error that says so.
-fn select(table: &Table, patterns: Option<&str>, file: &str) -> Result<Vec<usize>> {
+fn select(table: &ResultsTable, patterns: Option<&str>, file: &str) -> Result<Vec<usize>> {
     let names = &table.names;
     let Some(patterns) = patterns else {
         return Ok((0..names.len()).filter(|&c| names[c] != "time").collect());

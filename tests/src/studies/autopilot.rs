@@ -26,7 +26,8 @@ use models::manoeuvre::{
     run as run_manoeuvre, turning_circle, ContainerShipRun, ManoeuvreGenerator, ManoeuvreKind,
     ManoeuvreShip, Sample,
 };
-use shipsim::plot::{Panel, Series, Table};
+use shipsim::plot::{Panel, Series};
+use shipsim::results::ResultsTable;
 
 /// DDG-51 length 466 ft [m] and speed 22 kn [m/s] of the time base t' = tU/L.
 const L: f64 = 142.0368;
@@ -46,7 +47,7 @@ fn max_window_p2p(v: &[f64], n: usize) -> f64 {
 }
 
 /// Commanded (`cmd`) and actual rudder angle [deg].
-fn rudder_panel(t: &Table, cmd: &str) -> Result<Panel, String> {
+fn rudder_panel(t: &ResultsTable, cmd: &str) -> Result<Panel, String> {
     Ok(Panel {
         y_label: "rudder [deg]".into(),
         series: vec![
@@ -57,7 +58,7 @@ fn rudder_panel(t: &Table, cmd: &str) -> Result<Panel, String> {
 }
 
 /// Commanded and actual heading [deg] of the heading autopilot.
-fn heading_panel(t: &Table) -> Result<Panel, String> {
+fn heading_panel(t: &ResultsTable) -> Result<Panel, String> {
     Ok(Panel {
         y_label: "heading [deg]".into(),
         series: vec![
@@ -68,7 +69,7 @@ fn heading_panel(t: &Table) -> Result<Panel, String> {
 }
 
 /// Range (max − min) of the actual rudder over t0 ≤ t < t1 [deg].
-fn rudder_sweep(t: &Table, t0: f64, t1: f64) -> Result<f64, String> {
+fn rudder_sweep(t: &ResultsTable, t0: f64, t1: f64) -> Result<f64, String> {
     let (time, rud) = (t.time(), col(t, "gear.rudder_angle")?);
     let turn: Vec<f64> = (0..time.len())
         .filter(|&k| (t0..t1).contains(&time[k]))
@@ -190,7 +191,11 @@ fn current_rejection(env: &Env, report: &mut Report) -> Result<(), String> {
 }
 
 /// The current-rejection figure: offset, heading (measured and actual), rudder.
-fn current_rejection_figure(env: &Env, t: &Table, report: &mut Report) -> Result<(), String> {
+fn current_rejection_figure(
+    env: &Env,
+    t: &ResultsTable,
+    report: &mut Report,
+) -> Result<(), String> {
     let fig = env.figure(
         "autopilot_current.png",
         "Heading autopilot, 5-kn decaying beam current (AT-6, AT-7)",
@@ -462,7 +467,7 @@ fn track_change_nonlinear(env: &Env, report: &mut Report) -> Result<(), String> 
 /// The track change on the nonlinear plant: heading, offset from dead reckoning, speed, rudder.
 fn track_change_nonlinear_figure(
     env: &Env,
-    t: &Table,
+    t: &ResultsTable,
     xd: &[f64],
     report: &mut Report,
 ) -> Result<(), String> {
@@ -577,7 +582,7 @@ fn track_offset(env: &Env, report: &mut Report) -> Result<(), String> {
 
 /// The steady leg of a track-offset run (t > 900 s): the largest deviation from the track [yd]
 /// and the std of the rudder-equivalent wave yaw disturbance [deg].
-fn steady_leg(t: &Table) -> Result<(f64, f64), String> {
+fn steady_leg(t: &ResultsTable) -> Result<(f64, f64), String> {
     let time = t.time();
     let (y, yr) = (col(t, "ship.y")?, col(t, "ctl.cross_track_reference_used")?);
     let dev: Vec<f64> = (0..time.len())
@@ -591,7 +596,7 @@ fn steady_leg(t: &Table) -> Result<(f64, f64), String> {
 }
 
 /// The lateral offset: track, heading, rudder.
-fn track_offset_figure(env: &Env, t: &Table, report: &mut Report) -> Result<(), String> {
+fn track_offset_figure(env: &Env, t: &ResultsTable, report: &mut Report) -> Result<(), String> {
     let fig = env.figure(
         "autopilot_track_offset.png",
         "Track controller: SS4, 5-kn gust and 2 L offset to port (AT-9)",
@@ -732,7 +737,7 @@ fn identification(env: &Env, report: &mut Report) -> Result<(), String> {
 }
 
 /// The identification run: zig-zag and the estimates.
-fn identification_figure(env: &Env, t: &Table, report: &mut Report) -> Result<(), String> {
+fn identification_figure(env: &Env, t: &ResultsTable, report: &mut Report) -> Result<(), String> {
     let fig = env.figure(
         "identification_zigzag.png",
         "10/10 zig-zag on ContainerShip feeding ParameterEkf (AT-11)",

@@ -83,7 +83,7 @@ impl Agreement {
 }
 
 /// Runs the model loop with the file's parameters and compares every recorded value by its bits.
-fn compare_with_model_loop(table: &shipsim::plot::Table) -> Result<Agreement, String> {
+fn compare_with_model_loop(table: &shipsim::results::ResultsTable) -> Result<Agreement, String> {
     let fmu: Vec<&[f64]> = COLUMNS
         .iter()
         .map(|c| col(table, c))
@@ -116,7 +116,10 @@ fn compare_with_model_loop(table: &shipsim::plot::Table) -> Result<Agreement, St
 
 /// The course is kept about its steady offset, the rudder stays within the servo's 10 deg, and
 /// both disturbances reach the ship (neither sum term is zero).
-fn course_keeping_checks(table: &shipsim::plot::Table, c: &mut Vec<Check>) -> Result<(), String> {
+fn course_keeping_checks(
+    table: &shipsim::results::ResultsTable,
+    c: &mut Vec<Check>,
+) -> Result<(), String> {
     let t = table.time();
     let k0 = t.iter().position(|&x| x >= SETTLED).unwrap_or(0);
     let error: Vec<f64> = col(table, "ship.heading")?[k0..]
@@ -159,7 +162,11 @@ fn course_keeping_checks(table: &shipsim::plot::Table, c: &mut Vec<Check>) -> Re
 }
 
 /// Heading error, rudder, roll and the yaw moments (the two terms and their sum).
-fn figure(env: &Env, table: &shipsim::plot::Table, report: &mut Report) -> Result<(), String> {
+fn figure(
+    env: &Env,
+    table: &shipsim::results::ResultsTable,
+    report: &mut Report,
+) -> Result<(), String> {
     let t = table.time();
     let waves = col(table, "waves.yaw_moment")?;
     let wind = col(table, "wind.yaw_moment")?;

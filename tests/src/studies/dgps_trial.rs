@@ -5,7 +5,8 @@
 
 use crate::study::{col, series, Check, Env, Report};
 use models::hull::DEG;
-use shipsim::plot::{Panel, Series, Table};
+use shipsim::plot::{Panel, Series};
+use shipsim::results::ResultsTable;
 use std::f64::consts::PI;
 
 /// [DERIVED] steady-state velocity lag of the filter per unit acceleration / turn rate [s] for
@@ -43,7 +44,7 @@ fn interp(t: &[f64], y: &[f64], x: f64) -> f64 {
     y[i - 1] + (y[i] - y[i - 1]) * (x - t0) / (t1 - t0)
 }
 
-fn align(tab: &Table) -> Result<Aligned, String> {
+fn align(tab: &ResultsTable) -> Result<Aligned, String> {
     let t = tab.time();
     let psi = col(tab, "ship.heading")?;
     let (u, v) = (
@@ -108,7 +109,7 @@ fn align(tab: &Table) -> Result<Aligned, String> {
 }
 
 /// Filter output `name` of instance `kf` at the aligned instants.
-fn at(tab: &Table, a: &Aligned, name: &str) -> Result<Vec<f64>, String> {
+fn at(tab: &ResultsTable, a: &Aligned, name: &str) -> Result<Vec<f64>, String> {
     let t = tab.time();
     let c = col(tab, name)?;
     Ok(a.t.iter().map(|&x| interp(t, c, x)).collect())
@@ -123,7 +124,7 @@ struct Bias {
     pos_max: f64,
 }
 
-fn bias(tab: &Table, a: &Aligned, kf: &str, from: f64) -> Result<Bias, String> {
+fn bias(tab: &ResultsTable, a: &Aligned, kf: &str, from: f64) -> Result<Bias, String> {
     let (b, s) = (
         at(tab, a, &format!("{kf}.drift_angle"))?,
         at(tab, a, &format!("{kf}.speed_over_ground"))?,
@@ -186,10 +187,10 @@ pub fn run(env: &Env) -> Result<Report, String> {
 /// The runs: noise free (turn, 20/20 zig-zag, coasting stop), with the DGPS noise (turn,
 /// straight); the noise-free ones with the truth aligned to the filter's update instants.
 struct Runs {
-    turn: Table,
-    stop: Table,
-    noisy: Table,
-    straight: Table,
+    turn: ResultsTable,
+    stop: ResultsTable,
+    noisy: ResultsTable,
+    straight: ResultsTable,
     at_turn: Aligned,
     at_stop: Aligned,
     /// The zig-zag's bias at S_p = 0.01.
@@ -376,7 +377,7 @@ fn trade_off_checks(r: &Runs, c: &mut Vec<Check>) -> Result<Vec<Bias>, String> {
 }
 
 /// The velocity noise per S_p on the straight run with the DGPS noise.
-fn velocity_noise_checks(straight: &Table, c: &mut Vec<Check>) -> Result<(), String> {
+fn velocity_noise_checks(straight: &ResultsTable, c: &mut Vec<Check>) -> Result<(), String> {
     let at_st = align(straight)?;
     for i in 0..3 {
         let vn = at(

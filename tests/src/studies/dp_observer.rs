@@ -10,7 +10,8 @@
 use crate::study::{col, last, mean, rms_diff, series, series_window, Check, Env, Report};
 use models::hull::DEG;
 use nalgebra::{Complex, Matrix3, Vector3};
-use shipsim::plot::{Panel, Table};
+use shipsim::plot::Panel;
+use shipsim::results::ResultsTable;
 use std::f64::consts::PI;
 
 /// Samples (1 Hz) of the analysis window at the end of a run.
@@ -146,7 +147,7 @@ fn band_power(x: &[f64]) -> f64 {
 
 /// Wave-band power of η̂ − η over that of y − η (the true LF motion removed from both, so that
 /// a drifting ship leaks no power into the band through the window edges).
-fn wf_ratio(t: &Table, i: usize) -> Result<f64, String> {
+fn wf_ratio(t: &ResultsTable, i: usize) -> Result<f64, String> {
     let tru = col(t, TRUE_ETA[i])?;
     let diff = |name: &str| -> Result<Vec<f64>, String> {
         Ok(col(t, name)?.iter().zip(tru).map(|(a, b)| a - b).collect())
@@ -251,7 +252,7 @@ pub fn run(env: &Env) -> Result<Report, String> {
 }
 
 /// T1: the notch gains the FMU computes.
-fn gain_checks(cl: &Table, c: &mut Vec<Check>) -> Result<(), String> {
+fn gain_checks(cl: &ResultsTable, c: &mut Vec<Check>) -> Result<(), String> {
     let k1 = last(cl, "observer.k1_surge")?;
     let k2 = last(cl, "observer.k2_surge")?;
     c.push(Check::abs(
@@ -272,7 +273,7 @@ fn gain_checks(cl: &Table, c: &mut Vec<Check>) -> Result<(), String> {
 }
 
 /// The DP loop filters the wave-frequency motion out of η̂ (T6).
-fn wave_filtering_checks(cl: &Table, c: &mut Vec<Check>) -> Result<(), String> {
+fn wave_filtering_checks(cl: &ResultsTable, c: &mut Vec<Check>) -> Result<(), String> {
     for i in 0..3 {
         let ratio = wf_ratio(cl, i)?;
         c.push(Check::range(
@@ -296,7 +297,7 @@ fn wave_filtering_checks(cl: &Table, c: &mut Vec<Check>) -> Result<(), String> {
 
 /// The mean bias estimate against the observer's equilibrium under the applied constant bias;
 /// returns (applied, expected).
-fn bias_checks(cl: &Table, c: &mut Vec<Check>) -> Result<([f64; 3], [f64; 3]), String> {
+fn bias_checks(cl: &ResultsTable, c: &mut Vec<Check>) -> Result<([f64; 3], [f64; 3]), String> {
     // the means over the analysis window at the end of the run
     let tail_mean = |name: &str| -> Result<f64, String> {
         let v = col(cl, name)?;
@@ -327,7 +328,7 @@ fn bias_checks(cl: &Table, c: &mut Vec<Check>) -> Result<([f64; 3], [f64; 3]), S
 }
 
 /// The DP loop keeps position and heading.
-fn station_keeping_checks(cl: &Table, c: &mut Vec<Check>) -> Result<(), String> {
+fn station_keeping_checks(cl: &ResultsTable, c: &mut Vec<Check>) -> Result<(), String> {
     let pos_err: Vec<f64> = {
         let (x, y) = (col(cl, "ship.x")?, col(cl, "ship.y")?);
         x.iter()
@@ -382,7 +383,7 @@ fn open_loop_study_sets() -> Vec<(&'static str, f64)> {
 const START: usize = 1000;
 
 /// The open-loop run: wave filtering and position tracking.
-fn tracking_checks(ol: &Table, c: &mut Vec<Check>) -> Result<(), String> {
+fn tracking_checks(ol: &ResultsTable, c: &mut Vec<Check>) -> Result<(), String> {
     for i in 0..3 {
         let ratio = wf_ratio(ol, i)?;
         let est = &col(ol, EST[i])?[START..];
@@ -415,7 +416,7 @@ fn tracking_checks(ol: &Table, c: &mut Vec<Check>) -> Result<(), String> {
 }
 
 /// The open-loop run: the bias estimate follows the Markov bias; returns the raw errors (notes).
-fn bias_estimation_checks(ol: &Table, c: &mut Vec<Check>) -> Result<Vec<String>, String> {
+fn bias_estimation_checks(ol: &ResultsTable, c: &mut Vec<Check>) -> Result<Vec<String>, String> {
     let mut bias_notes = Vec::new();
     for i in 0..3 {
         let lp = moving_average(col(ol, BIAS_EST[i])?, 200);
@@ -444,7 +445,7 @@ fn bias_estimation_checks(ol: &Table, c: &mut Vec<Check>) -> Result<Vec<String>,
 }
 
 /// The open-loop run: RMS(ν̂ − ν) per DOF, as the notes print it.
-fn velocity_errors(ol: &Table) -> Result<Vec<String>, String> {
+fn velocity_errors(ol: &ResultsTable) -> Result<Vec<String>, String> {
     (0..3)
         .map(|i| -> Result<String, String> {
             let e = rms_diff(
@@ -476,7 +477,7 @@ fn t9_checks(env: &Env, c: &mut Vec<Check>) -> Result<(), String> {
         ("observer.initial_heading", 0.05),
     ]);
     let t9 = env.run(FILE, &sets(&nf), "noise_free.csv")?;
-    let err_at = |tab: &Table, est: &str, tru: &str, k: usize| -> Result<f64, String> {
+    let err_at = |tab: &ResultsTable, est: &str, tru: &str, k: usize| -> Result<f64, String> {
         Ok((col(tab, est)?[k] - col(tab, tru)?[k]).abs())
     };
     let last = t9.time().len() - 1;
@@ -512,7 +513,7 @@ fn t9_checks(env: &Env, c: &mut Vec<Check>) -> Result<(), String> {
 }
 
 /// The DP loop: measurement against the LF estimate, and the bias estimates.
-fn closed_loop_figures(env: &Env, cl: &Table, report: &mut Report) -> Result<(), String> {
+fn closed_loop_figures(env: &Env, cl: &ResultsTable, report: &mut Report) -> Result<(), String> {
     let (t0, t1) = (6000.0, 6300.0);
     let mut panels = Vec::new();
     for i in 0..3 {
@@ -562,7 +563,7 @@ fn closed_loop_figures(env: &Env, cl: &Table, report: &mut Report) -> Result<(),
 }
 
 /// The open-loop run, surge, as [Fossen1999, Fig. 9].
-fn open_loop_figure(env: &Env, ol: &Table, report: &mut Report) -> Result<(), String> {
+fn open_loop_figure(env: &Env, ol: &ResultsTable, report: &mut Report) -> Result<(), String> {
     let fig = env.figure(
         "paper_surge.png",
         "Eq. 61 run (open loop), surge: as the paper's Fig. 9",

@@ -2,7 +2,7 @@
 //! [`super::path_estimation`]) share: the report's time step and runs stopped at a prime time.
 
 use crate::study::Env;
-use shipsim::plot::Table;
+use shipsim::results::ResultsTable;
 
 /// Δt′ of the report (one communication step).
 pub const DT: f64 = 0.005;
@@ -14,6 +14,6 @@ pub fn run_until(
     sets: &[String],
     csv: &str,
     stop_prime: f64,
-) -> Result<Table, String> {
+) -> Result<ResultsTable, String> {
     env.run_steps(file, sets, csv, Some((stop_prime / DT).round() as u64))
 }

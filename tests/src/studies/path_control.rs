@@ -21,7 +21,8 @@ use models::controllers::path::{path_gains, PathDesignModel};
 use models::disturbances::current::{design_current_profile, passing_ship};
 use models::hull::tokyo_maru::{TokyoMaruCoefficients, L, T_R, U};
 use models::hull::DEG;
-use shipsim::plot::{Panel, Series, Table};
+use shipsim::plot::{Panel, Series};
+use shipsim::results::ResultsTable;
 
 /// Half beam B/2 [m]: the initial offset of S1/S3.
 const HALF_BEAM: f64 = 23.75;
@@ -110,11 +111,11 @@ struct Run {
     command_deg: Vec<f64>,
     n_hat: Vec<f64>,
     y_hat: Vec<f64>,
-    table: Table,
+    table: ResultsTable,
 }
 
 impl Run {
-    fn new(table: Table, eta_offset: f64) -> Result<Run, String> {
+    fn new(table: ResultsTable, eta_offset: f64) -> Result<Run, String> {
         let scale = |name: &str, s: f64, o: f64| -> Result<Vec<f64>, String> {
             Ok(col(&table, name)?.iter().map(|v| v * s + o).collect())
         };

@@ -11,7 +11,8 @@
 
 use crate::study::{after, mean, series_window, variance, Check, Env, Report};
 use models::hull::DEG;
-use shipsim::plot::{Panel, Table};
+use shipsim::plot::Panel;
+use shipsim::results::ResultsTable;
 const SYSTEM: &str = "rrs.toml";
 /// The robustness system: plant = the 22-knot simulation model (RrsShip model 1,
 /// [Klugt1987, Tables 2.1-2.2])
@@ -40,7 +41,7 @@ pub struct RunStats {
     pub mean_rudder: f64,
 }
 
-fn stats(t: &Table) -> Result<RunStats, String> {
+fn stats(t: &ResultsTable) -> Result<RunStats, String> {
     let deg2 =
         |c: &str| -> Result<f64, String> { Ok(variance(after(t, c, SETTLE)?) / (DEG * DEG)) };
     let sat = after(t, "gear.rate_saturated_time", SETTLE)?;
@@ -72,7 +73,7 @@ fn pair(
     env: &Env,
     tag: &str,
     sets: &[String],
-) -> Result<(RunStats, RunStats, Table, Table), String> {
+) -> Result<(RunStats, RunStats, ResultsTable, ResultsTable), String> {
     pair_of(env, SYSTEM, tag, sets)
 }
 
@@ -82,7 +83,7 @@ fn pair_of(
     system: &str,
     tag: &str,
     sets: &[String],
-) -> Result<(RunStats, RunStats, Table, Table), String> {
+) -> Result<(RunStats, RunStats, ResultsTable, ResultsTable), String> {
     let mut off_sets = sets.to_vec();
     off_sets.push("autopilot.roll_mode=0".into());
     let off = env.run(system, &off_sets, &format!("{tag}_off.csv"))?;
@@ -116,8 +117,8 @@ const TITLE_EXP1: &str =
 
 fn overlay(
     env: &Env,
-    off: &Table,
-    on: &Table,
+    off: &ResultsTable,
+    on: &ResultsTable,
     name: &str,
     title: &str,
 ) -> Result<std::path::PathBuf, String> {

@@ -13,7 +13,8 @@ use models::controllers::path::{Adaptation, Dither, PathControllerParams};
 use models::controllers::wls::{WlsEstimator, WlsSchedule, WlsSettings};
 use models::hull::tokyo_maru::{L, TABLE_2};
 use models::hull::DEG;
-use shipsim::plot::{Panel, Table};
+use shipsim::plot::Panel;
+use shipsim::results::ResultsTable;
 
 pub(super) const WLS: &str = "path_control_wls.toml";
 /// Per-sample σ′ of ψ′, r′, η′ of [Parsons1980, Table 9] (the S11 filter's noise, see the system
@@ -173,7 +174,7 @@ fn noise_free_checks(env: &Env, x_eq: [f64; 5], c: &mut Vec<Check>) -> Result<No
 }
 
 /// The noise-free run holds the line-1145 steady state until the first dither.
-fn equilibrium_checks(nf: &Table, x_eq: [f64; 5], c: &mut Vec<Check>) -> Result<(), String> {
+fn equilibrium_checks(nf: &ResultsTable, x_eq: [f64; 5], c: &mut Vec<Check>) -> Result<(), String> {
     let eta_eq = x_eq[3] * L;
     let tp = col(nf, "ship.time_prime")?;
     let eta = col(nf, "ship.cross_track")?;

@@ -15,7 +15,8 @@ use models::hull::tokyo_maru::{L, TABLE_2, T_R, U};
 use models::observers::path_kalman::PathKalmanFilter;
 use models::observers::path_model::PathDesignModel;
 use models::random::NoiseStream;
-use shipsim::plot::{Panel, Series, Table};
+use shipsim::plot::{Panel, Series};
+use shipsim::results::ResultsTable;
 
 pub(super) const MVE: &str = "path_control_mve.toml";
 /// The S14 dither start (half a step early, see the system file).
@@ -140,7 +141,7 @@ fn table_16_stats(est: &[[f64; 6]], fin: [f64; 6], p: [f64; 6]) -> [[f64; 6]; 5]
 }
 
 /// The statistics of one S14 run through the master.
-fn mve_stats(t: &Table) -> Result<MveStats, String> {
+fn mve_stats(t: &ResultsTable) -> Result<MveStats, String> {
     let tp = col(t, "ship.time_prime")?;
     let eta = col(t, "ship.cross_track")?;
     let cols: Vec<&[f64]> = NAMES
@@ -316,13 +317,13 @@ pub(super) fn s14(env: &Env, report: &mut Report) -> Result<(), String> {
 /// The S14 runs through the master: the statistics of every case and seed, the tables of seed 1.
 struct MveRuns {
     cases: Vec<Vec<MveStats>>,
-    seed1: Vec<Table>,
+    seed1: Vec<ResultsTable>,
 }
 
 impl MveRuns {
     fn run(env: &Env) -> Result<MveRuns, String> {
         let mut cases: Vec<Vec<MveStats>> = Vec::new();
-        let mut seed1: Vec<Table> = Vec::new();
+        let mut seed1: Vec<ResultsTable> = Vec::new();
         for case in &MVE_CASES {
             let mut v = Vec::new();
             for seed in 1..=SEEDS {

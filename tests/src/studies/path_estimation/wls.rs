@@ -4,7 +4,7 @@
 use super::{within_seeds, Spread};
 use crate::study::{col, max_abs, Check};
 use models::hull::tokyo_maru::L;
-use shipsim::plot::Table;
+use shipsim::results::ResultsTable;
 
 const P_NAMES: [&str; 8] = ["f22", "f23", "f25", "f32", "f33", "f35", "N′", "Y′"];
 
@@ -22,7 +22,7 @@ pub(super) struct WlsStats {
 
 /// The fits of a run and its offsets per cycle of `lu`, η measured from the track at
 /// `eta_offset` [m].
-pub(super) fn wls_stats(t: &Table, eta_offset: f64, lu: f64) -> Result<WlsStats, String> {
+pub(super) fn wls_stats(t: &ResultsTable, eta_offset: f64, lu: f64) -> Result<WlsStats, String> {
     let tp = col(t, "ship.time_prime")?;
     let eta = col(t, "ship.cross_track")?;
     let upd = col(t, "est.updates")?;
