@@ -1,7 +1,7 @@
 //! What the four charts share: the canvas and its checks, the title, the caption and the legend
 //! beside the plot, text, and the numbers on axes.
 
-use super::stats::{Aggregate, SeriesStats};
+use super::stats::{plain, widen, Aggregate, SeriesStats};
 use super::{Frame, PlotOptions, PlotSummary};
 use crate::error::{Error, Result};
 use crate::plot::{color, create_parent_dir, drawing_error, register_font, Area};
@@ -81,33 +81,6 @@ pub(super) fn compact(v: f64) -> String {
     } else {
         s
     }
-}
-
-/// `(lo, hi)` widened when empty (a single value) so that it can be mapped onto pixels.
-pub(super) fn widen(lo: f64, hi: f64) -> (f64, f64) {
-    if hi > lo {
-        return (lo, hi);
-    }
-    let d = if (lo.abs() * 0.1).is_normal() {
-        lo.abs() * 0.1
-    } else {
-        1.0
-    };
-    (lo - d, hi + d)
-}
-
-/// A factor value as written in a campaign file: the fewest decimals (up to 6) that give it
-/// back to 1e-9 (so that a linspace's 0.30000000000000004 reads 0.3).
-pub(super) fn plain(v: f64) -> String {
-    for d in 0..=6usize {
-        let s = format!("{v:.d$}");
-        if s.parse::<f64>()
-            .is_ok_and(|p| (p - v).abs() <= 1e-9 * v.abs().max(1.0))
-        {
-            return s;
-        }
-    }
-    format!("{v:.3e}")
 }
 
 /// The data range of `values`, padded by `pad` of its span on both sides.

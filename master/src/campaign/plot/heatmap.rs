@@ -1,10 +1,10 @@
 //! The mean of a KPI over two factors: a heat map of equal cells on the viridis colour map.
 
 use super::figure::{
-    anchored, caption, figure, label_or, nice_step, plain, render, short_value, text_width,
-    tick_label, ticks, widen, words, AXIS, FONT, TEXT,
+    anchored, caption, figure, label_or, nice_step, render, short_value, text_width, tick_label,
+    ticks, words, AXIS, FONT, TEXT,
 };
-use super::stats::{grid, Grid};
+use super::stats::{grid, plain, widen, Grid};
 use super::{Frame, PlotOptions, PlotSummary};
 use crate::campaign::table::Table;
 use crate::error::Result;

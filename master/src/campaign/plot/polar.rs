@@ -1,10 +1,10 @@
 //! A KPI against a direction on polar axes: rings, spokes, and each group's mean and band.
 
 use super::figure::{
-    anchored, label_or, nice_step, series_figure, spread, text_width, tick_label, ticks, widen,
-    words, AXIS, BAND_ALPHA, FONT,
+    anchored, label_or, nice_step, series_figure, spread, text_width, tick_label, ticks, words,
+    AXIS, BAND_ALPHA, FONT,
 };
-use super::stats::{aggregate_by, SeriesStats, Stats};
+use super::stats::{aggregate_by, widen, SeriesStats, Stats};
 use super::{AngleUnit, Frame, Orientation, PlotOptions, PlotSummary};
 use crate::campaign::table::Table;
 use crate::error::Result;

@@ -2,7 +2,6 @@
 //! histogram [`Bins`], and the reduction of a run table's rows to them ([`aggregate`],
 //! [`grid`], [`distribution`]), reading its columns and groups.
 
-use super::figure::{plain, widen};
 use crate::campaign::table::{ColumnData, Table};
 use crate::error::{suggest, Error, Result};
 
@@ -485,6 +484,33 @@ fn group_value(col: &ColumnData, v: f64) -> String {
         ColumnData::Bool(_) => (v != 0.0).to_string(),
         _ => plain(v),
     }
+}
+
+/// `(lo, hi)` widened when empty (a single value) so that it can be mapped onto pixels.
+pub(super) fn widen(lo: f64, hi: f64) -> (f64, f64) {
+    if hi > lo {
+        return (lo, hi);
+    }
+    let d = if (lo.abs() * 0.1).is_normal() {
+        lo.abs() * 0.1
+    } else {
+        1.0
+    };
+    (lo - d, hi + d)
+}
+
+/// A factor value as written in a campaign file: the fewest decimals (up to 6) that give it
+/// back to 1e-9 (so that a linspace's 0.30000000000000004 reads 0.3).
+pub(super) fn plain(v: f64) -> String {
+    for d in 0..=6usize {
+        let s = format!("{v:.d$}");
+        if s.parse::<f64>()
+            .is_ok_and(|p| (p - v).abs() <= 1e-9 * v.abs().max(1.0))
+        {
+            return s;
+        }
+    }
+    format!("{v:.3e}")
 }
 
 #[cfg(test)]
