@@ -343,7 +343,10 @@ fn dispatch(cmd: Command, session: &Session) -> shipsim::Result<()> {
                     .map_err(|e| Error::Other(e.to_string()))?;
             }
             sys.strict_units |= strict_units;
-            if let Some(l) = last_step.as_deref().and_then(shipsim::run::LastStep::parse) {
+            if let Some(l) = last_step
+                .as_deref()
+                .and_then(shipsim::system::LastStep::parse)
+            {
                 sys.last_step = l;
             }
             let flags = RunFlags {

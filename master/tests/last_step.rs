@@ -7,7 +7,8 @@
 //! compared in tests/python/test_last_step_fmpy.py.
 mod common;
 use common::*;
-use shipsim::run::{run_system, LastStep, Output, RunOptions, Summary};
+use shipsim::run::{run_system, Output, RunOptions, Summary};
+use shipsim::system::LastStep;
 use shipsim::system::System;
 use std::path::Path;
 

@@ -9,7 +9,7 @@
 //!
 //! A study is `fn(&Env) -> Result<Report, String>`; register it in [`crate::studies::STUDIES`].
 
-use shipsim::campaign::table::Table as CampaignTable;
+use shipsim::campaign::table::Table;
 use shipsim::campaign::{execute, Campaign, CampaignOptions, CampaignOutcome, CampaignSpec};
 use shipsim::plot::{plot_panels, Panel, Series};
 use shipsim::results::ResultsTable;
@@ -21,8 +21,8 @@ use std::path::{Path, PathBuf};
 /// A campaign run by a study ([`Env::campaign`]).
 pub struct CampaignResult {
     pub outcome: CampaignOutcome,
-    pub runs: CampaignTable,
-    pub derived: CampaignTable,
+    pub runs: Table,
+    pub derived: Table,
 }
 
 /// Where the FMUs, system files and outputs are.
@@ -100,7 +100,7 @@ impl Env {
             ..Default::default()
         };
         let outcome = execute::run(&campaign, &opts).map_err(|e| e.to_string())?;
-        let read = |name: &str| CampaignTable::read(&out.join(name)).map_err(|e| e.to_string());
+        let read = |name: &str| Table::read(&out.join(name)).map_err(|e| e.to_string());
         Ok(CampaignResult {
             outcome,
             runs: read("runs.parquet")?,

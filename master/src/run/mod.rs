@@ -27,7 +27,7 @@ use crate::isolate::{IsolateMode, Isolation};
 use crate::log::LogSink;
 use crate::model_description::ModelDescription;
 use crate::slave::CallMonitor;
-use crate::system::{Algorithm as AlgorithmChoice, Plan, System};
+use crate::system::{Algorithm as AlgorithmChoice, LastStep, OffGrid, Plan, System};
 use std::collections::HashMap;
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -53,7 +53,7 @@ use exchange::Exchange;
 pub use profile::{Profile, Sampling};
 pub use recorder::{write_real, ColumnInfo, CsvRecorder, MemoryRecorder, Recorder, Row, Sample};
 use stepping::{Recording, Stepper};
-pub use time_grid::{LastStep, OffGrid, TimeGrid};
+pub use time_grid::TimeGrid;
 
 /// How to run.
 #[derive(Clone, Default)]

@@ -14,7 +14,7 @@
 //! stop time when the FMU declares canHandleVariableCommunicationStepSize, FMI 2.0, sec. 4.3.1).
 //! Then t_n is the stop time and every other t_k is as above.
 
-pub use crate::system::{LastStep, OffGrid};
+use crate::system::LastStep;
 
 /// The communication points t_k (see the module documentation).
 #[derive(Clone, Copy, Debug, PartialEq)]
