@@ -549,3 +549,45 @@ fn rrs_nan_rudder_command_is_blamed_on_the_autopilot() {
     assert!(blamed, "{err}");
     assert!(!err.contains("fmi2Terminate is not allowed"), "{err}");
 }
+
+/// The FMU-state calls through an isolated instance's host (fmi2GetFMUstate,
+/// fmi2SerializedFMUstateSize, fmi2SerializeFMUstate and fmi2FreeFMUstate for a checkpoint;
+/// fmi2DeSerializeFMUstate, fmi2SetFMUstate and fmi2FreeFMUstate for a resume) give what the
+/// same calls give in process: the checkpoint file of `--isolate` is the in-process one byte
+/// for byte, and a resume of isolated instances from it writes the in-process resume's rows.
+#[test]
+fn isolated_checkpoints_and_resumes_equal_the_in_process_ones() {
+    let d = tempfile::tempdir().unwrap();
+    our_fmu("RrsAutopilot");
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let text = std::fs::read_to_string(root.join("systems/rrs.toml")).unwrap();
+    let dir = format!("{}/", fmu_dir().display());
+    write_system(d.path(), "rrs.toml", &text.replace("../target/fmu/", &dir));
+    let run = |args: &[&str]| {
+        let mut a = vec!["run", "rrs.toml", "-q", "--stop-time", "20"];
+        a.extend(args);
+        let out = shipsim(d.path(), &a);
+        assert!(out.status.success(), "{args:?}: {out:?}");
+    };
+    run(&["-o", "full.csv", "--checkpoint-at", "10", "cp_in.bin"]);
+    run(&[
+        "-o",
+        "full_iso.csv",
+        "--isolate",
+        "--checkpoint-at",
+        "10",
+        "cp_iso.bin",
+    ]);
+    run(&["-o", "tail.csv", "--resume", "cp_in.bin"]);
+    run(&["-o", "tail_iso.csv", "--isolate", "--resume", "cp_iso.bin"]);
+    let read = |n: &str| std::fs::read(d.path().join(n)).unwrap();
+    assert!(
+        read("cp_iso.bin") == read("cp_in.bin"),
+        "checkpoint files differ"
+    );
+    assert!(read("full_iso.csv") == read("full.csv"));
+    let (tail, tail_iso) = (read("tail.csv"), read("tail_iso.csv"));
+    assert_eq!(tail.iter().filter(|&&b| b == b'\n').count(), 1 + 201);
+    assert!(tail_iso == tail, "the isolated resume's rows differ");
+    assert_no_temp_dirs(d.path());
+}

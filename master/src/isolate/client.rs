@@ -560,24 +560,27 @@ impl Slave for Client {
     }
 
     fn get_state(&mut self) -> (fmi2Status, StateHandle) {
-        self.state_call(Op::GetFmuState, 0, 0)
+        self.state_call(Op::GetFmuState, 0)
     }
 
     fn set_state(&mut self, state: StateHandle) -> fmi2Status {
-        self.state_call(Op::SetFmuState, state, 0).0
+        self.state_call(Op::SetFmuState, state).0
     }
 
     fn free_state(&mut self, state: StateHandle) -> (fmi2Status, StateHandle) {
-        self.state_call(Op::FreeFmuState, state, 0)
+        self.state_call(Op::FreeFmuState, state)
     }
 
     fn serialized_size(&mut self, state: StateHandle) -> (fmi2Status, usize) {
-        let (s, n) = self.state_call(Op::SerializedSize, state, 0);
+        let (s, n) = self.state_call(Op::SerializedSize, state);
         (s, n as usize)
     }
 
     fn serialize(&mut self, state: StateHandle, size: usize) -> (fmi2Status, Vec<u8>) {
-        let s = self.state_call(Op::Serialize, state, size as u64).0;
+        let s = self.request(Op::Serialize, |o| {
+            state.put(o);
+            (size as u64).put(o);
+        });
         (s, self.results().bytes().to_vec())
     }
 
@@ -610,16 +613,13 @@ impl Client {
         })
     }
 
-    /// A call on an FMU state handle (or none) with a u64 argument that returns a handle or a
-    /// size as u64 (the serialized bytes of [`Op::Serialize`] are in the results).
-    fn state_call(&mut self, op: Op, handle: StateHandle, arg: u64) -> (fmi2Status, u64) {
+    /// A call on an FMU state handle (or none) that returns a handle or a size as u64 (the
+    /// request's second u64, the size of [`Op::Serialize`], is 0).
+    fn state_call(&mut self, op: Op, handle: StateHandle) -> (fmi2Status, u64) {
         let s = self.request(op, |o| {
             handle.put(o);
-            arg.put(o);
+            0u64.put(o);
         });
-        if op == Op::Serialize {
-            return (s, 0);
-        }
         (s, self.results().u64())
     }
 }
