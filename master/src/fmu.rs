@@ -224,6 +224,21 @@ impl UnpackedFmu {
         Ok(cs)
     }
 
+    /// The platforms the archive has binaries for: the folders of `binaries/`, sorted (FMI 2.0,
+    /// sec. 2.4: linux64, win64, darwin64, ...). This master loads [`PLATFORM`]'s.
+    pub fn platforms(&self) -> Vec<String> {
+        let mut found: Vec<String> = std::fs::read_dir(self.dir.path().join("binaries"))
+            .map(|rd| {
+                rd.flatten()
+                    .filter(|e| e.file_type().is_ok_and(|t| t.is_dir()))
+                    .map(|e| e.file_name().to_string_lossy().into_owned())
+                    .collect()
+            })
+            .unwrap_or_default();
+        found.sort();
+        found
+    }
+
     /// `binaries/<platform>/<modelIdentifier>.<ext>`: a regular file inside the unpacked
     /// directory (the identifier is checked to be a file name, and the resolved path to lie
     /// inside the directory).
@@ -238,12 +253,7 @@ impl UnpackedFmu {
             .join(format!("{}.{}", cs.model_identifier, LIB_EXT));
         let regular = std::fs::symlink_metadata(&p).is_ok_and(|m| m.file_type().is_file());
         if !regular {
-            let mut found = Vec::new();
-            if let Ok(rd) = std::fs::read_dir(self.dir.path().join("binaries")) {
-                for e in rd.flatten() {
-                    found.push(e.file_name().to_string_lossy().into_owned());
-                }
-            }
+            let found = self.platforms();
             return Err(Error::fmu(
                 &self.path,
                 format!(

@@ -51,6 +51,16 @@ pub fn inspect(path: &Path, unpack: &Unpack) -> Result<String> {
             Err(e) => format!("MISSING: {e}"),
         }
     );
+    let platforms = u.platforms();
+    let _ = writeln!(
+        s,
+        "platforms      {}",
+        if platforms.is_empty() {
+            "none".to_string()
+        } else {
+            platforms.join(", ")
+        }
+    );
     let _ = writeln!(s, "capabilities (CoSimulation):");
     for (name, v) in [
         ("needsExecutionTool", cs.needs_execution_tool),

@@ -134,6 +134,33 @@ fn missing_binary() {
     );
 }
 
+/// An FMU built for other platforms only (a Windows-only FMU, say) is refused with the platforms
+/// it has, and `inspect` lists them.
+#[test]
+fn other_platforms_only() {
+    let d = tempfile::tempdir().unwrap();
+    let p = d.path().join("winonly.fmu");
+    common::zip_files(
+        &p,
+        &[
+            ("modelDescription.xml", common::model_description(common::GUID, "2.0").into_bytes()),
+            ("binaries/win64/testfmu.dll", b"MZ".to_vec()),
+            ("binaries/darwin64/testfmu.dylib", b"\xcf\xfa".to_vec()),
+        ],
+    );
+    let e = load_err(&p);
+    assert!(
+        e.contains("winonly.fmu")
+            && e.contains(
+                "missing binary binaries/linux64/testfmu.so (platforms in the archive: \
+                 darwin64, win64)"
+            ),
+        "{e}"
+    );
+    let text = shipsim::inspect::inspect(&p, &Default::default()).unwrap();
+    assert!(text.contains("platforms      darwin64, win64\n"), "{text}");
+}
+
 #[test]
 fn missing_fmi2_symbol() {
     let d = tempfile::tempdir().unwrap();

@@ -6,7 +6,11 @@
 //! is loaded once to obtain the generated `modelDescription.xml` and `documentation/index.html`
 //! (this also proves the library loads), its exported symbols and dynamic dependencies are
 //! checked, and `target/fmu/X.fmu` is written with fixed timestamps (reproducible archives).
+//!
+//! Every archive carries `binaries/linux64/X.so` and, where a toolchain for it is installed
+//! (win64.rs), `binaries/win64/X.dll`, built from the same sources in a second cargo build.
 
+use crate::win64::{self, Toolchain};
 use crate::{cargo, run};
 use anyhow::{bail, Context, Result};
 use object::read::elf::{Dyn, ElfFile64, FileHeader};
@@ -175,8 +179,15 @@ fn check_binary(path: &Path) -> Result<()> {
     Ok(())
 }
 
-/// Writes one `.fmu` archive.
-fn write_fmu(out: &Path, id: &str, xml: &str, so: &Path, html: &str) -> Result<()> {
+/// Writes one `.fmu` archive (with a win64 binary when `dll` is given).
+fn write_fmu(
+    out: &Path,
+    id: &str,
+    xml: &str,
+    so: &Path,
+    dll: Option<&Path>,
+    html: &str,
+) -> Result<()> {
     use zip::write::SimpleFileOptions;
     let file = std::fs::File::create(out).with_context(|| format!("creating {}", out.display()))?;
     let mut zip = zip::ZipWriter::new(file);
@@ -190,15 +201,69 @@ fn write_fmu(out: &Path, id: &str, xml: &str, so: &Path, html: &str) -> Result<(
         opts.unix_permissions(0o755),
     )?;
     zip.write_all(&std::fs::read(so)?)?;
+    if let Some(dll) = dll {
+        zip.start_file(
+            format!("binaries/win64/{id}.dll"),
+            opts.unix_permissions(0o755),
+        )?;
+        zip.write_all(&std::fs::read(dll)?)?;
+    }
     zip.start_file("documentation/index.html", opts)?;
     zip.write_all(html.as_bytes())?;
     zip.finish()?;
     Ok(())
 }
 
-/// Builds and packages every FMU; returns the output folder `target/fmu` (example FMUs go to
-/// `target/fmu-examples`).
+/// Whether `build-fmus` writes win64 binaries.
+#[derive(Clone, Copy, PartialEq, Debug)]
+pub enum Win64 {
+    /// linux64 only (`--platforms linux64`).
+    Skip,
+    /// Where a toolchain is installed; otherwise say so once, with the install line.
+    IfAvailable,
+    /// A missing toolchain is an error (`CI=true`, `--platforms linux64,win64`).
+    Required,
+}
+
+impl Win64 {
+    /// `Required` under `CI=true`, else `IfAvailable`.
+    pub fn from_env() -> Win64 {
+        if crate::ci() {
+            Win64::Required
+        } else {
+            Win64::IfAvailable
+        }
+    }
+
+    /// `--platforms LIST`: `linux64` or `linux64,win64` (any order).
+    pub fn parse_platforms(list: &str) -> Result<Win64> {
+        let mut names: Vec<&str> = list.split(',').map(str::trim).collect();
+        names.sort_unstable();
+        match names.as_slice() {
+            ["linux64"] => Ok(Win64::Skip),
+            ["linux64", "win64"] => Ok(Win64::Required),
+            _ => bail!("--platforms {list:?}: expected linux64 or linux64,win64"),
+        }
+    }
+}
+
+/// `cargo xtask build-fmus [--platforms linux64[,win64]]`.
+pub fn build_fmus_task(root: &Path, args: &[String]) -> Result<()> {
+    let win64 = match args {
+        [] => Win64::from_env(),
+        [flag, list] if flag == "--platforms" => Win64::parse_platforms(list)?,
+        _ => bail!("usage: cargo xtask build-fmus [--platforms linux64|linux64,win64]"),
+    };
+    build_fmus_for(root, win64).map(|_| ())
+}
+
+/// Builds and packages every FMU, with win64 binaries as [`Win64::from_env`] says; returns the
+/// output folder `target/fmu` (example FMUs go to `target/fmu-examples`).
 pub fn build_fmus(root: &Path) -> Result<PathBuf> {
+    build_fmus_for(root, Win64::from_env())
+}
+
+fn build_fmus_for(root: &Path, win64: Win64) -> Result<PathBuf> {
     let crates = fmu_crates(root)?;
     if crates.is_empty() {
         bail!("no FMU crates found (packages with [package.metadata.fmu])");
@@ -209,14 +274,45 @@ pub fn build_fmus(root: &Path) -> Result<PathBuf> {
         cmd.args(["-p", &c.package]);
     }
     run(&mut cmd)?;
+    let windows = build_win64(root, &crates, win64)?;
     let out_dir = root.join("target/fmu");
     package(
         &crates,
         &root.join("target/release"),
+        windows.as_deref(),
         &out_dir,
         &root.join("target/fmu-examples"),
     )?;
     Ok(out_dir)
+}
+
+/// Builds the win64 binaries in `target/win64`; returns the folder that holds the DLLs, or
+/// `None` when they are not built.
+fn build_win64(root: &Path, crates: &[FmuCrate], win64: Win64) -> Result<Option<PathBuf>> {
+    if win64 == Win64::Skip {
+        return Ok(None);
+    }
+    let toolchain = match Toolchain::find() {
+        Ok(t) => t,
+        Err(why) if win64 == Win64::Required => bail!(
+            "the win64 FMU binaries cannot be built: {why}; install {}",
+            win64::INSTALL
+        ),
+        Err(why) => {
+            eprintln!(
+                "xtask: FMUs with linux64 binaries only ({why}); for win64 binaries install {}",
+                win64::INSTALL
+            );
+            return Ok(None);
+        }
+    };
+    eprintln!("xtask: win64 binaries with {}", toolchain.describe());
+    let target = root.join("target/win64");
+    let packages: Vec<&str> = crates.iter().map(|c| c.package.as_str()).collect();
+    run(toolchain
+        .build_command(&target, &packages)?
+        .current_dir(root))?;
+    Ok(Some(target.join(win64::TARGET).join("release")))
 }
 
 /// A variant of some FMUs for a measurement: the FMUs whose model identifiers are `only`, built
@@ -245,13 +341,19 @@ pub fn build_fmu_variant(root: &Path, cfg: &str, only: &[&str]) -> Result<PathBu
     }
     run(&mut cmd)?;
     let out_dir = target.join("fmu");
-    package(&crates, &target.join("release"), &out_dir, &out_dir)?;
+    package(&crates, &target.join("release"), None, &out_dir, &out_dir)?;
     Ok(out_dir)
 }
 
-/// Packages built FMU libraries (in `release`) as `.fmu` archives: into `out_dir`, or
-/// `examples_dir` for example FMUs.
-fn package(crates: &[FmuCrate], release: &Path, out_dir: &Path, examples_dir: &Path) -> Result<()> {
+/// Packages built FMU libraries (in `release`, and the win64 DLLs in `windows` if given) as
+/// `.fmu` archives: into `out_dir`, or `examples_dir` for example FMUs.
+fn package(
+    crates: &[FmuCrate],
+    release: &Path,
+    windows: Option<&Path>,
+    out_dir: &Path,
+    examples_dir: &Path,
+) -> Result<()> {
     std::fs::create_dir_all(out_dir)?;
     std::fs::create_dir_all(examples_dir)?;
     for c in crates {
@@ -262,9 +364,13 @@ fn package(crates: &[FmuCrate], release: &Path, out_dir: &Path, examples_dir: &P
             .with_context(|| format!("loading {}", so.display()))?;
         let xml = generated_text(&lib, b"shipfmu_model_description")?;
         let html = generated_text(&lib, b"shipfmu_documentation_html")?;
+        let dll = windows.map(|w| w.join(format!("{}.dll", c.lib_name)));
+        if let Some(dll) = &dll {
+            win64::check_dll(dll)?;
+        }
         let dir = if c.example { examples_dir } else { out_dir };
         let fmu = dir.join(format!("{}.fmu", c.model_identifier));
-        write_fmu(&fmu, &c.model_identifier, &xml, &so, &html)?;
+        write_fmu(&fmu, &c.model_identifier, &xml, &so, dll.as_deref(), &html)?;
         eprintln!("xtask: wrote {}", fmu.display());
     }
     Ok(())

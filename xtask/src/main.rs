@@ -19,6 +19,7 @@ mod artifacts;
 mod fmu;
 mod fuzz;
 mod layers;
+mod win64;
 
 use anyhow::{bail, Context, Result};
 use std::path::{Path, PathBuf};
@@ -27,7 +28,7 @@ use std::process::Command;
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let result = match args.first().map(String::as_str) {
-        Some("build-fmus") => fmu::build_fmus(&workspace_root()).map(|_| ()),
+        Some("build-fmus") => fmu::build_fmus_task(&workspace_root(), &args[1..]),
         Some("test") => test(&args[1..]),
         Some("demo") => demo(),
         Some("bench") => bench(&args[1..]),
@@ -42,7 +43,7 @@ fn main() {
             eprintln!(
                 "usage: cargo xtask <task>\n\n\
                  tasks:\n  \
-                 build-fmus   build every FMU into target/fmu/<ModelIdentifier>.fmu\n  \
+                 build-fmus [--platforms linux64[,win64]]  build every FMU into target/fmu/<ModelIdentifier>.fmu\n  \
                  test         run every test: Rust, FMU packaging, FMPy and libcosim checks\n  \
                  demo         run the default coupled system\n  \
                  wheel        build the shipsim Python package (python/) as a wheel in target/wheels\n  \
@@ -81,6 +82,11 @@ pub fn run(cmd: &mut Command) -> Result<()> {
         bail!("{cmd:?} failed with {status}");
     }
     Ok(())
+}
+
+/// `CI=true` (or 1): what a test needs and lacks is a failure, not a skipped check.
+pub fn ci() -> bool {
+    std::env::var("CI").is_ok_and(|v| v.eq_ignore_ascii_case("true") || v == "1")
 }
 
 pub fn cargo() -> Command {

@@ -398,8 +398,13 @@ pub unsafe fn exit_initialization_mode<M: FmuModel>(c: fmi2Component) -> fmi2Sta
                 inst.work_limit = 0.0;
                 if let Some(vr) = inst.fast.non_finite_output(&inst.model) {
                     inst.core.state = LifeState::Error;
-                    let at = format_args!("at t = {}", inst.core.start_time);
-                    return non_finite_output(inst, "fmi2ExitInitializationMode", at, vr);
+                    let t = inst.core.start_time;
+                    return non_finite_output(
+                        inst,
+                        "fmi2ExitInitializationMode",
+                        format_args!("at t = {t}"),
+                        vr,
+                    );
                 }
                 inst.core.state = LifeState::StepComplete;
                 inst.log_fmt(
@@ -675,8 +680,8 @@ fn non_finite_value<M: FmuModel, T: Handed>(
         return fmi2OK;
     };
     inst.core.state = LifeState::Error;
-    let at = format_args!("at t = {}", inst.core.time);
-    non_finite_output(inst, "fmi2GetReal", at, vrs[k])
+    let t = inst.core.time;
+    non_finite_output(inst, "fmi2GetReal", format_args!("at t = {t}"), vrs[k])
 }
 
 /// # Safety
@@ -1484,6 +1489,19 @@ fn work<M: FmuModel>(m: &M, t: f64, h: f64) -> Result<(), String> {
     }
 }
 
+/// The next double above a finite `x` (`f64::next_up`, which needs rustc 1.86: the win64 FMUs
+/// are built with Debian bookworm's rustc 1.85 where rustup cannot add the target).
+fn next_up(x: f64) -> f64 {
+    let bits = x.to_bits();
+    if x == 0.0 {
+        f64::from_bits(1)
+    } else if x > 0.0 {
+        f64::from_bits(bits + 1)
+    } else {
+        f64::from_bits(bits - 1)
+    }
+}
+
 #[cold]
 #[inline(never)]
 fn work_message<M: FmuModel>(m: &M, t: f64, h: f64) -> String {
@@ -1515,7 +1533,7 @@ fn work_message<M: FmuModel>(m: &M, t: f64, h: f64) -> String {
         return format!(
             "internal step {name} = {length:?} s is lost in rounding at t + h = {end:e} s \
              (the doubles there are {:e} s apart): the time is too large for this step",
-            end.next_up() - end
+            next_up(end) - end
         );
     }
     if h == 0.0 {

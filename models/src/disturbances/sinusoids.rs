@@ -108,9 +108,13 @@ impl Sinusoids {
 
 /// [`sum_blocks`] with 256-bit AVX2 vectors: one block per iteration, the same IEEE operations in
 /// the same order lane by lane (no fused multiply-add), hence the same bits.
+///
+/// # Safety
+/// The CPU must support AVX2. (An `unsafe fn`, not a safe `#[target_feature]` function: those
+/// need rustc 1.86, and the win64 FMUs are built with Debian bookworm's rustc 1.85.)
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-fn sum_avx(blocks: &[Block], tau: f64, x: f64) -> f64 {
+unsafe fn sum_avx(blocks: &[Block], tau: f64, x: f64) -> f64 {
     use std::arch::x86_64::*;
     let load = |a: &[f64; LANES]| {
         // SAFETY: `a` is a valid, readable [f64; 4], the 32 bytes an unaligned load reads.
