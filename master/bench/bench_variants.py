@@ -10,6 +10,9 @@ Variants:
 - shipsim_no_output_check: without the finiteness check of the values fmi2GetReal hands out
   (fmus/export/src/api.rs, OUTPUT_CHECK), so the row is what the check costs (issue 19: at most
   1 %).
+- shipsim_platform_libm: the models' transcendental functions from the platform's C library
+  (glibc) instead of the pure-Rust libm crate (models/src/math.rs), so the row is what identical
+  bits on linux64 and win64 cost (issue 30).
 
 The two builds run in pairs, back to back, pinned to one core (as bench_systems.py does); each run
 is systems/rrs.toml extended to --stop-time (24,000 s by default: 480,000 macro steps) without
@@ -41,6 +44,7 @@ from bench_systems import ROOT, pinning, run_system
 WHAT = {
     "shipsim_no_call_log": "per-call logging, off (`logCalls` not enabled)",
     "shipsim_no_output_check": "finiteness of every Real handed out (fmi2GetReal)",
+    "shipsim_platform_libm": "one pure-Rust libm on every platform (models::math), against glibc's",
 }
 
 # The shorter run of the instruction count (s); the longer runs to twice this.

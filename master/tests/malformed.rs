@@ -143,7 +143,10 @@ fn other_platforms_only() {
     common::zip_files(
         &p,
         &[
-            ("modelDescription.xml", common::model_description(common::GUID, "2.0").into_bytes()),
+            (
+                "modelDescription.xml",
+                common::model_description(common::GUID, "2.0").into_bytes(),
+            ),
             ("binaries/win64/testfmu.dll", b"MZ".to_vec()),
             ("binaries/darwin64/testfmu.dylib", b"\xcf\xfa".to_vec()),
         ],

@@ -7,6 +7,7 @@ pub mod error;
 pub mod hull;
 pub mod integrate;
 pub mod manoeuvre;
+pub mod math;
 pub mod memo;
 pub mod observers;
 pub mod random;

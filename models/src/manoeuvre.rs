@@ -462,6 +462,7 @@ pub fn run<S: ManoeuvreShip>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::math::{asin, atan2, cos, sin};
     use std::f64::consts::PI;
 
     /// A steady circle at speed `u` [m/s] and rate `w` [rad/s] from t = 0, sampled every 0.1 s
@@ -474,8 +475,8 @@ mod tests {
                 let psi = w * t;
                 Sample {
                     t,
-                    x: r * psi.sin(),
-                    y: r * (1.0 - psi.cos()),
+                    x: r * sin(psi),
+                    y: r * (1.0 - cos(psi)),
                     psi,
                     r: w,
                     speed: u,
@@ -492,8 +493,8 @@ mod tests {
                 let t = i as f64 * 0.05;
                 Sample {
                     t,
-                    psi: a * (w * t).sin(),
-                    r: a * w * (w * t).cos(),
+                    psi: a * sin(w * t),
+                    r: a * w * cos(w * t),
                     ..Default::default()
                 }
             })
@@ -524,7 +525,7 @@ mod tests {
         let (a, w, b) = (15.0 * DEG, 0.05, 10.0 * DEG);
         let s = sine_zigzag_run(a, w);
         let m = zigzag(&s, 0.0, 1.0, b).unwrap();
-        assert!((m.second_execute - (b / a).asin() / w).abs() < 1e-3);
+        assert!((m.second_execute - asin(b / a) / w).abs() < 1e-3);
         assert!((m.first_overshoot - (a - b)).abs() < 1e-6);
         assert!((m.first_overshoot_time - PI / 2.0 / w).abs() < 0.05);
         assert!((m.second_overshoot - (a - b)).abs() < 1e-6);
@@ -681,7 +682,7 @@ mod tests {
                     r: x[2],
                     speed: sp,
                     roll: x[7],
-                    drift: x[1].atan2(x[0]),
+                    drift: atan2(x[1], x[0]),
                     rudder: x[8],
                     rudder_command: 0.0,
                 });

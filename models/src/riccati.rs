@@ -16,6 +16,7 @@
 //! Matrices are `nalgebra::DMatrix<f64>`; these are design-time computations (at initialization
 //! or on a slow adaptation clock), never in a model's per-step path.
 
+use crate::math::powf;
 use nalgebra::{DMatrix, Schur};
 
 /// Iteration limit of the nalgebra QR-type iterations (SVD, Schur). They converge in a few
@@ -119,7 +120,7 @@ fn sign_function(h: &M) -> Result<M, RiccatiError> {
         ))?;
         let det = z.determinant().abs();
         let c = if det.is_finite() && det > 0.0 {
-            det.powf(-1.0 / n2)
+            powf(det, -1.0 / n2)
         } else {
             1.0
         };

@@ -38,6 +38,7 @@
 //! most [`SteeringGearParams::max_substep`].
 
 use crate::error::{check_positive, ParamError};
+use crate::math::exp;
 use crate::memo::{bits, Bits, Memo};
 use serde::{Deserialize, Serialize};
 
@@ -254,7 +255,7 @@ impl SteeringGear {
         if remaining > 0.0 {
             let decay = *self
                 .decay
-                .get(bits([remaining, tau]), || (-remaining / tau).exp());
+                .get(bits([remaining, tau]), || exp(-remaining / tau));
             angle = c - (c - angle) * decay;
         }
         let p = &self.params;
@@ -302,6 +303,7 @@ impl SteeringGear {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::math::{asin, atan2, cos, ln, sin};
     use std::f64::consts::PI;
 
     fn gear(params: SteeringGearParams) -> SteeringGear {
@@ -314,14 +316,14 @@ mod tests {
         let a = 2.0 / n
             * t.iter()
                 .zip(y)
-                .map(|(t, y)| y * (omega * t).cos())
+                .map(|(t, y)| y * cos(omega * t))
                 .sum::<f64>();
         let b = 2.0 / n
             * t.iter()
                 .zip(y)
-                .map(|(t, y)| y * (omega * t).sin())
+                .map(|(t, y)| y * sin(omega * t))
                 .sum::<f64>();
-        ((a * a + b * b).sqrt(), a.atan2(b)) // amplitude, phase relative to sin(omega t)
+        ((a * a + b * b).sqrt(), atan2(a, b)) // amplitude, phase relative to sin(omega t)
     }
 
     #[test]
@@ -361,7 +363,7 @@ mod tests {
             let mut max_dev: f64 = 0.0;
             for k in 0..4000 {
                 let t = k as f64 * h;
-                let cmd = u * (omega * t).sin();
+                let cmd = u * sin(omega * t);
                 g.step(cmd, h);
                 let t1 = t + h;
                 // ideal limiter output at t1 (input held over the step, so compare with cmd at t)
@@ -386,7 +388,7 @@ mod tests {
                 // first harmonic of a sine clipped at half its amplitude:
                 // (2/π)(asin(r) + r√(1−r²)) with r = 1/2  →  0.6090·u
                 let r: f64 = 0.5;
-                let expected = u * 2.0 / PI * (r.asin() + r * (1.0 - r * r).sqrt());
+                let expected = u * 2.0 / PI * (asin(r) + r * (1.0 - r * r).sqrt());
                 assert!(
                     (amp - expected).abs() / expected < 1e-3,
                     "{amp} vs {expected}"
@@ -425,7 +427,7 @@ mod tests {
             let mut sum = 0.0;
             for k in 0..per {
                 let t = (p * per + k) as f64 * h;
-                g.step(a * (b * t).sin(), h);
+                g.step(a * sin(b * t), h);
                 sum += g.angle();
                 assert!(g.rate().abs() <= rate * (1.0 + 1e-12));
                 if p >= 10 {
@@ -445,7 +447,7 @@ mod tests {
         assert!(means[11].abs() < 0.02 * a, "last mean {}", means[11] / a);
         let (amp, phase) = first_harmonic(&ts, &ys, b);
         let lag = -phase;
-        let expected_lag = PI / 2.0 - (PI / 6.0).asin();
+        let expected_lag = PI / 2.0 - asin(PI / 6.0);
         assert!(
             (lag - expected_lag).abs() < 0.5 * DEG,
             "lag {} deg",
@@ -482,7 +484,7 @@ mod tests {
             t = k as f64 * h;
             assert!(t < 60.0);
         }
-        let expected = (70.0 * DEG - rate * tau) / rate + tau * (rate * tau / eps).ln();
+        let expected = (70.0 * DEG - rate * tau) / rate + tau * ln(rate * tau / eps);
         assert!((t - expected).abs() <= h, "{t} vs {expected}");
         assert!(t < 30.0);
         assert!((g.rate_saturated_time() - (70.0 * DEG - rate * tau) / rate).abs() < 1e-9);
@@ -500,7 +502,7 @@ mod tests {
         for k in 1..=2000 {
             g.step(40.0 * DEG, 0.01);
             let t = k as f64 * 0.01;
-            let expected = 30.0 * DEG * (1.0 - (-t / tau).exp());
+            let expected = 30.0 * DEG * (1.0 - exp(-t / tau));
             assert!((g.angle() - expected).abs() < 1e-12, "t={t}");
         }
     }
@@ -516,7 +518,7 @@ mod tests {
             for _ in 0..n {
                 g.step(0.1, h);
             }
-            let expected = 0.1 * (1.0 - (-1.0f64).exp());
+            let expected = 0.1 * (1.0 - exp(-1.0f64));
             assert!((g.angle() - expected).abs() < 1e-14, "h={h}: {}", g.angle());
         }
     }
@@ -552,7 +554,7 @@ mod tests {
             g.step(step_amp, 0.01);
             let t = k as f64 * 0.01;
             let w = 7.5 * t;
-            let expected = step_amp * (1.0 - (1.0 + w) * (-w).exp());
+            let expected = step_amp * (1.0 - (1.0 + w) * exp(-w));
             assert!((g.angle() - expected).abs() < 1e-10, "t={t}");
         }
         // frequency response at B = 0.6436 ω0: gain 1/√2 (small amplitude, steady state)
@@ -563,7 +565,7 @@ mod tests {
         let (mut ts, mut ys) = (vec![], vec![]);
         for k in 0..10_000 {
             let t = k as f64 * h;
-            g.step(0.01 * (bw * (t + 0.5 * h)).sin(), h);
+            g.step(0.01 * sin(bw * (t + 0.5 * h)), h);
             if k >= 5000 {
                 ts.push(t + h);
                 ys.push(g.angle());

@@ -200,7 +200,7 @@ fn test(extra: &[String]) -> Result<()> {
     let bin = root.join("target/release");
     run(Command::new(&python)
         .current_dir(&root)
-        .args(["-m", "pytest", "-q", "tests/python"])
+        .args(["-m", "pytest", "-q", "-rs", "tests/python"])
         .env("SHIPSIM_FMU_DIR", &fmu_dir)
         .env("SHIPSIM_BIN", bin.join("shipsim"))
         .env("SHIPSIM_REFERENCE_BIN", bin.join("model-reference")))?;
@@ -231,6 +231,21 @@ fn lint(root: &Path) -> Result<()> {
         .current_dir(root)
         .args(["fmt", "--all", "--", "--check"]))
     .context("code is not formatted: run `cargo fmt --all`")?;
+    eprintln!("xtask: clippy disallowed_methods on models/ and the FMU crates (one libm: models/src/math.rs)");
+    let mut clippy = cargo();
+    clippy
+        .current_dir(root)
+        .args(["clippy", "--release", "--lib", "-p", "ship-models"]);
+    for c in fmu::fmu_crates(root)? {
+        clippy.args(["-p", &c.package]);
+    }
+    run(clippy.args([
+        "--",
+        "-A",
+        "clippy::all",
+        "-D",
+        "clippy::disallowed_methods",
+    ]))?;
     eprintln!("xtask: clippy too_many_lines (100) on master/src");
     run(cargo().current_dir(root).args([
         "clippy",
@@ -392,6 +407,7 @@ fn bench(extra: &[String]) -> Result<()> {
     ];
     let no_call_log = fmu::build_fmu_variant(&root, "shipsim_no_call_log", &rrs)?;
     let no_output_check = fmu::build_fmu_variant(&root, "shipsim_no_output_check", &rrs)?;
+    let platform_libm = fmu::build_fmu_variant(&root, "shipsim_platform_libm", &rrs)?;
     let python = ensure_venv(&root)?;
     install_python_package(&root, &python)?;
     let script = |name: &str, args: &[String]| -> Result<String> {
@@ -419,6 +435,7 @@ fn bench(extra: &[String]) -> Result<()> {
             &[
                 format!("shipsim_no_call_log={}", no_call_log.display()),
                 format!("shipsim_no_output_check={}", no_output_check.display()),
+                format!("shipsim_platform_libm={}", platform_libm.display()),
             ],
         )
     };

@@ -34,7 +34,11 @@ pub enum Toolchain {
     /// rustup's target beside the running toolchain.
     Rustup,
     /// Debian's rustc and cargo with the standard library's source (`sysroot` = `/usr`).
-    Debian { rustc: PathBuf, cargo: PathBuf, library: PathBuf },
+    Debian {
+        rustc: PathBuf,
+        cargo: PathBuf,
+        library: PathBuf,
+    },
 }
 
 impl Toolchain {
@@ -46,7 +50,10 @@ impl Toolchain {
         if target_installed(Path::new("rustc")) {
             return Ok(Toolchain::Rustup);
         }
-        let (rustc, cargo) = (PathBuf::from("/usr/bin/rustc"), PathBuf::from("/usr/bin/cargo"));
+        let (rustc, cargo) = (
+            PathBuf::from("/usr/bin/rustc"),
+            PathBuf::from("/usr/bin/cargo"),
+        );
         if let Some(sysroot) = sysroot(&rustc) {
             let library = sysroot.join("lib/rustlib/src/rust/library");
             if cargo.exists() && library.join("Cargo.lock").exists() {
@@ -111,11 +118,15 @@ impl Toolchain {
 }
 
 fn on_path(program: &str) -> bool {
-    std::env::var_os("PATH").is_some_and(|p| std::env::split_paths(&p).any(|d| d.join(program).is_file()))
+    std::env::var_os("PATH")
+        .is_some_and(|p| std::env::split_paths(&p).any(|d| d.join(program).is_file()))
 }
 
 fn sysroot(rustc: &Path) -> Option<PathBuf> {
-    let out = Command::new(rustc).args(["--print", "sysroot"]).output().ok()?;
+    let out = Command::new(rustc)
+        .args(["--print", "sysroot"])
+        .output()
+        .ok()?;
     out.status
         .success()
         .then(|| PathBuf::from(String::from_utf8_lossy(&out.stdout).trim()))

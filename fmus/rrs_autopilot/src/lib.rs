@@ -187,6 +187,7 @@ impl FmuModel for RrsAutopilotFmu {
 mod tests {
     use super::*;
     use fmi2_export::testing::real_of as output;
+    use models::math::{cos, sin};
 
     /// The four outputs read from the kept outputs equal `RrsAutopilot::outputs` for the
     /// current inputs bit for bit: before the first sample (where they follow the inputs, kept
@@ -232,9 +233,9 @@ mod tests {
         let mut commands = Vec::new();
         for k in 0..300 {
             let t = 0.1 * k as f64;
-            m.inputs.roll = 0.1 * (0.63 * t).sin();
-            m.inputs.roll_rate = 0.063 * (0.63 * t).cos();
-            m.inputs.heading_error = 0.02 * (0.05 * t).sin();
+            m.inputs.roll = 0.1 * sin(0.63 * t);
+            m.inputs.roll_rate = 0.063 * cos(0.63 * t);
+            m.inputs.heading_error = 0.02 * sin(0.05 * t);
             m.calculate_outputs();
             check(&m, &format!("step {k}, inputs set"));
             m.do_step(t, 0.1).unwrap();

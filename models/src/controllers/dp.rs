@@ -33,6 +33,7 @@
 use super::ControlError;
 use crate::error::{check_finite, check_non_negative, check_positive};
 use crate::hull::wrap_pi;
+use crate::math::{sin, sin_cos};
 use serde::{Deserialize, Serialize};
 
 /// Parameters (per DOF: surge, sway, yaw).
@@ -133,7 +134,7 @@ pub struct DpController {
 
 /// Body-frame error Jᵀ(ψ̂)(η̂ − η_d), heading error wrapped.
 pub fn body_error(eta: [f64; 3], setpoint: [f64; 3]) -> [f64; 3] {
-    let (s, c) = eta[2].sin_cos();
+    let (s, c) = sin_cos(eta[2]);
     let (dn, de) = (eta[0] - setpoint[0], eta[1] - setpoint[1]);
     [
         c * dn + s * de,
@@ -191,7 +192,7 @@ impl DpController {
         let e = body_error(u.eta, u.setpoint);
         std::array::from_fn(|i| {
             -self.kp[i] * e[i] - self.kd[i] * u.nu[i] - self.ki[i] * self.integral[i]
-                + self.params.test_amplitude[i] * (self.params.test_frequency[i] * self.time).sin()
+                + self.params.test_amplitude[i] * sin(self.params.test_frequency[i] * self.time)
         })
     }
 
@@ -283,7 +284,7 @@ mod tests {
             setpoint,
         };
         let tau = c.tau(&u);
-        let (s, co) = 0.1f64.sin_cos();
+        let (s, co) = sin_cos(0.1f64);
         let jtb = [
             co * bias[0] + s * bias[1],
             -s * bias[0] + co * bias[1],
@@ -308,7 +309,7 @@ mod tests {
             c.step(&u, 1.0);
         }
         let tau = c.tau(&u);
-        assert_eq!(tau[0], 1000.0 * (0.05f64 * 37.0).sin());
-        assert_eq!(tau[2], 1000.0 * (0.07f64 * 37.0).sin());
+        assert_eq!(tau[0], 1000.0 * sin(0.05f64 * 37.0));
+        assert_eq!(tau[2], 1000.0 * sin(0.07f64 * 37.0));
     }
 }

@@ -32,6 +32,7 @@ pub mod presets;
 
 use super::ControlError;
 use crate::error::{check_finite, check_positive, check_positive_or_infinite};
+use crate::math::{cos, ln, log10, powf, sin_cos};
 use crate::memo::{bits, Bits, Memo};
 use nalgebra::{Complex, DMatrix, SMatrix, SVector};
 use serde::{Deserialize, Serialize};
@@ -120,7 +121,7 @@ fn bisect(f: impl Fn(f64) -> f64, mut lo: f64, mut hi: f64) -> f64 {
 pub fn margins(l: &TransferFunction, w_lo: f64, w_hi: f64) -> Option<Margins> {
     let n = 4000;
     let ws: Vec<f64> = (0..=n)
-        .map(|i| w_lo * (w_hi / w_lo).powf(i as f64 / n as f64))
+        .map(|i| w_lo * powf(w_hi / w_lo, i as f64 / n as f64))
         .collect();
     // unwrapped phase along the scan
     let mut phase = Vec::with_capacity(ws.len());
@@ -142,7 +143,7 @@ pub fn margins(l: &TransferFunction, w_lo: f64, w_hi: f64) -> Option<Margins> {
         let k = ((near - p) / (2.0 * std::f64::consts::PI)).round();
         p + k * 2.0 * std::f64::consts::PI
     };
-    let mag = |w: f64| l.freq(w).norm().ln();
+    let mag = |w: f64| ln(l.freq(w).norm());
     let mut gc = None;
     let mut pc = None;
     for i in 0..n {
@@ -161,7 +162,7 @@ pub fn margins(l: &TransferFunction, w_lo: f64, w_hi: f64) -> Option<Margins> {
         phase[i]
     };
     Some(Margins {
-        gain_margin_db: -20.0 * l.freq(pc).norm().log10(),
+        gain_margin_db: -20.0 * log10(l.freq(pc).norm()),
         phase_crossover: pc,
         phase_margin_deg: 180.0 + unwrap_at(gc, near_gc).to_degrees(),
         gain_crossover: gc,
@@ -285,7 +286,8 @@ impl<const N: usize> TustinController<N> {
 
     /// Discrete frequency response at ω (z = e^{jωT}).
     pub fn freq(&self, w: f64, step: f64) -> Complex<f64> {
-        let z = Complex::new(0.0, w * step).exp();
+        let (sin_wt, cos_wt) = sin_cos(w * step);
+        let z = Complex::new(cos_wt, sin_wt);
         let ad = DMatrix::from_fn(N, N, |i, j| Complex::new(self.ad[(i, j)], 0.0));
         let mut zi = DMatrix::from_fn(N, N, |i, j| if i == j { z } else { Complex::new(0.0, 0.0) });
         zi -= ad;
@@ -503,7 +505,7 @@ impl LateralOffset {
             self.offset
         } else {
             let x = (t - self.start) / self.duration;
-            self.offset * 0.5 * (1.0 - (std::f64::consts::PI * x).cos())
+            self.offset * 0.5 * (1.0 - cos(std::f64::consts::PI * x))
         }
     }
 }
@@ -844,6 +846,7 @@ impl TrackController {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::math::{exp, sin};
 
     /// Closed-loop unit step of the (heading or track) loop with the Nomoto plant + gear, in t′:
     /// continuous controller (RK4 on the joint state, dt′ = 1e-3) or the sampled Tustin controller
@@ -977,7 +980,7 @@ mod tests {
     #[test]
     fn at5_low_frequency_gain() {
         let l = HeadingDesign::default().open_loop().unwrap();
-        let db = |w: f64| 20.0 * l.freq(w).norm().log10();
+        let db = |w: f64| 20.0 * log10(l.freq(w).norm());
         eprintln!("AT-5: |L(j0.01)| = {:.5} dB", db(0.01));
         assert!(db(0.01) >= 39.99 && db(0.01) < 40.0);
         for w in [1e-4, 1e-3, 0.005, 0.0099] {
@@ -985,7 +988,7 @@ mod tests {
         }
         // track loop: 72.3 dB
         let ly = TrackDesign::default().open_loop().unwrap();
-        assert!((20.0 * ly.freq(0.01).norm().log10() - 72.3).abs() < 0.05);
+        assert!((20.0 * log10(ly.freq(0.01).norm()) - 72.3).abs() < 0.05);
     }
 
     /// Heading step overshoot 4.81 % (printed "5 %", criterion ≤ 5 % [Taylor2000, sec. 5.2.2]),
@@ -1148,7 +1151,7 @@ mod tests {
                 let n = ((h / 0.005f64).ceil() as usize).max(1);
                 for _ in 0..n {
                     delta +=
-                        (controller.command() - delta) * (1.0 - (-(h / n as f64) / gear_tau).exp());
+                        (controller.command() - delta) * (1.0 - exp(-(h / n as f64) / gear_tau));
                     ship.step(
                         &NomotoInputs {
                             rudder: delta,
@@ -1189,7 +1192,7 @@ mod tests {
         let mut track = TrackController::new(TrackDesign::default()).unwrap();
         let mut track_rebuilt = track.clone();
         for (k, &h) in steps.iter().enumerate() {
-            let y = (k as f64 * 0.01).sin();
+            let y = sin(k as f64 * 0.01);
             rebuilt.set_design(rebuilt.design).unwrap();
             track_rebuilt.set_design(track_rebuilt.design).unwrap();
             kept.step(y, 0.3, h);
@@ -1213,7 +1216,7 @@ mod tests {
         let mut b: TrackController =
             bincode::deserialize(&bincode::serialize(&a).unwrap()).unwrap();
         for k in 0..100 {
-            let y = (k as f64 * 0.1).sin();
+            let y = sin(k as f64 * 0.1);
             a.step(y, 0.0, 0.5);
             b.step(y, 0.0, 0.5);
             assert_eq!(a.command().to_bits(), b.command().to_bits());

@@ -35,6 +35,7 @@
 use super::ControlError;
 use crate::error::{check_non_negative, check_positive, require};
 use crate::hull::rrs_ship::{RrsHullCoefficients, RrsSpeedLaws};
+use crate::math::exp;
 use crate::memo::{bits, Bits, Memo};
 use crate::riccati;
 use nalgebra::{DMatrix, SMatrix, SVector};
@@ -254,7 +255,7 @@ impl Agc {
     /// The memory's forgetting factor e^(−dt/T_m) over `dt` (0 without memory).
     pub fn forget(&self, dt: f64) -> f64 {
         if self.memory_time > 0.0 {
-            (-dt / self.memory_time).exp()
+            exp(-dt / self.memory_time)
         } else {
             0.0
         }
@@ -763,7 +764,7 @@ impl RrsAutopilot {
         let f = *self
             .variance_decay
             .get(bits([h, a.roll_variance_time]), || {
-                (-h / a.roll_variance_time).exp()
+                exp(-h / a.roll_variance_time)
             });
         self.roll_variance = f * self.roll_variance + (1.0 - f) * i.roll * i.roll;
         if a.enabled {
@@ -797,6 +798,7 @@ impl RrsAutopilot {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::math::{atan2, cos, sin};
     use crate::steering_gear::{SteeringGear, SteeringGearParams};
 
     fn close<const N: usize>(name: &str, got: &SVector<f64, N>, want: &[f64], tol: f64) {
@@ -1006,7 +1008,7 @@ mod tests {
         let mut hist = Vec::with_capacity(n);
         for k in 0..n {
             let t = k as f64 * dt;
-            let u = amp(t) * (omega * t).sin();
+            let u = amp(t) * sin(omega * t);
             let (g, a) = if with_agc {
                 let o = agc.step(u, dt);
                 (o.setpoint, o.attenuation)
@@ -1025,12 +1027,12 @@ mod tests {
                 cnt += 1;
             }
             // projection of u and δ_w on sin/cos at ω (phase)
-            ss += u * (omega * t).sin();
-            sc += u * (omega * t).cos();
-            ws += w * (omega * t).sin();
-            wc += w * (omega * t).cos();
+            ss += u * sin(omega * t);
+            sc += u * cos(omega * t);
+            ws += w * sin(omega * t);
+            wc += w * cos(omega * t);
         }
-        let lag = sc.atan2(ss) - wc.atan2(ws);
+        let lag = atan2(sc, ss) - atan2(wc, ws);
         (max_rate, lag, sum / cnt as f64, hist)
     }
 
@@ -1110,8 +1112,8 @@ mod tests {
         for k in 0..3000 {
             let t = k as f64 * dt;
             let i = RrsInputs {
-                roll: 0.002 * t * (0.63 * t).sin(),
-                roll_rate: 0.002 * t * 0.63 * (0.63 * t).cos(),
+                roll: 0.002 * t * sin(0.63 * t),
+                roll_rate: 0.002 * t * 0.63 * cos(0.63 * t),
                 heading_error: if (k / 400) % 2 == 0 { 0.05 } else { -0.05 },
                 speed: 11.0,
                 ..Default::default()
@@ -1196,8 +1198,8 @@ mod tests {
         // roll of 2 deg amplitude (variance above the 1 deg² target), moderate rudder: q_φ grows
         // to the operator limit
         let roll = |amp: f64, t: f64| RrsInputs {
-            roll: amp * (0.63 * t).sin(),
-            roll_rate: 0.63 * amp * (0.63 * t).cos(),
+            roll: amp * sin(0.63 * t),
+            roll_rate: 0.63 * amp * cos(0.63 * t),
             speed: 11.0,
             ..Default::default()
         };
@@ -1233,8 +1235,8 @@ mod tests {
     fn snapshot_continues_identically() {
         let mut a = RrsAutopilot::new(RrsAutopilotParams::default()).unwrap();
         let i = |t: f64| RrsInputs {
-            roll: 0.1 * (0.6 * t).sin(),
-            roll_rate: 0.06 * (0.6 * t).cos(),
+            roll: 0.1 * sin(0.6 * t),
+            roll_rate: 0.06 * cos(0.6 * t),
             speed: 10.0,
             heading_error: 0.02,
             ..Default::default()

@@ -44,6 +44,7 @@
 
 use super::shaping::{quantise_time, FirstOrderProcess, Start, WhiteSequence};
 use crate::error::{check_non_negative, check_positive};
+use crate::math::{exp, sin_cos};
 use crate::random::{channel, NoiseStream};
 use serde::{Deserialize, Serialize};
 
@@ -53,7 +54,7 @@ pub const KNOT: f64 = 1852.0 / 3600.0;
 /// Ricker ("Mexican hat") pulse `(1 − 2x²) e^(−x²)`, x = τ/w.
 pub fn ricker(tau: f64, w: f64) -> f64 {
     let x2 = (tau / w).powi(2);
-    (1.0 - 2.0 * x2) * (-x2).exp()
+    (1.0 - 2.0 * x2) * exp(-x2)
 }
 
 /// Passing-ship surrogate (for [Parsons1980, Fig. 3]) at τ = t′ − t′_p for magnitude factor f: (N′, Y′).
@@ -365,14 +366,14 @@ impl Current {
     /// Earth-fixed current velocity (north, east) [m/s].
     pub fn current_velocity(&self) -> [f64; 2] {
         let v = self.current_speed();
-        let (s, c) = self.params.direction.sin_cos();
+        let (s, c) = sin_cos(self.params.direction);
         [v * c, v * s]
     }
 
     /// Current velocity in the body frame (u_c, v_c) [m/s].
     pub fn current_body(&self) -> [f64; 2] {
         let v = self.current_speed();
-        let (s, c) = (self.params.direction - self.heading).sin_cos();
+        let (s, c) = sin_cos(self.params.direction - self.heading);
         [v * c, v * s]
     }
 
@@ -442,7 +443,7 @@ impl Current {
 
     /// [`Current::bias_body`] of a [`Current::bias`] `b`.
     pub fn body(&self, b: [f64; 3]) -> [f64; 3] {
-        let (s, c) = self.heading.sin_cos();
+        let (s, c) = sin_cos(self.heading);
         [c * b[0] + s * b[1], -s * b[0] + c * b[1], b[2]]
     }
 }
@@ -539,8 +540,8 @@ mod tests {
         let mut c = Current::new(p, 0.0).unwrap();
         c.advance_to(1000.0);
         let b = c.bias();
-        assert!((b[0] - 1.0e4 * (-1.0f64).exp()).abs() < 1e-8);
-        assert!((b[2] - 5.0e5 * (-1.0f64).exp()).abs() < 1e-6);
+        assert!((b[0] - 1.0e4 * exp(-1.0f64)).abs() < 1e-8);
+        assert!((b[2] - 5.0e5 * exp(-1.0f64)).abs() < 1e-6);
         // body frame at heading 90 deg: x_body = b_y... J^T b
         c.set_heading(std::f64::consts::FRAC_PI_2);
         let bb = c.bias_body();
@@ -564,7 +565,7 @@ mod tests {
         let (_, v) = mean_variance(&x[1000..]);
         assert!((v / 5.0e4 - 1.0).abs() < 0.03, "{v}");
         let r = correlation(&x[..n - 100], &x[100..]);
-        assert!((r - (-1.0f64).exp()).abs() < 0.02, "lag 1000 s: {r}");
+        assert!((r - exp(-1.0f64)).abs() < 0.02, "lag 1000 s: {r}");
         assert!(correlation(&x, &y).abs() < 0.05);
     }
 

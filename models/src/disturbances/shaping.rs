@@ -18,6 +18,7 @@
 //! frequency): the new Φ and Q_d apply from the next grid interval that is drawn.
 
 use crate::integrate::due_passes;
+use crate::math::{exp, exp_m1};
 use crate::random::NoiseStream;
 
 /// Time quantum of the disturbance models [s]: every time handed to `advance_to` is rounded to
@@ -266,11 +267,11 @@ impl FirstOrderProcess {
             self.phi = 1.0;
             self.step_std = self.gain.abs() * dt.sqrt();
         } else {
-            let phi = (-dt / self.time_constant).exp();
+            let phi = exp(-dt / self.time_constant);
             let v = self.gain * self.gain * self.time_constant / 2.0;
             self.phi = phi;
             // 1 − φ² without cancellation: −expm1(−2 dt/T)
-            self.step_std = (v * -(-2.0 * dt / self.time_constant).exp_m1()).sqrt();
+            self.step_std = (v * -exp_m1(-2.0 * dt / self.time_constant)).sqrt();
         }
     }
 
@@ -403,7 +404,7 @@ mod tests {
         assert!((v / va - 1.0).abs() < 0.03, "{v} vs {va}");
         // lag-100 (1000 s) autocorrelation = e^-1
         let r = correlation(&x[..n - 100], &x[100..]);
-        assert!((r - (-1.0f64).exp()).abs() < 0.02, "{r}");
+        assert!((r - exp(-1.0f64)).abs() < 0.02, "{r}");
     }
 
     #[test]

@@ -1,6 +1,7 @@
 //! Spectral estimation for checking realisations: radix-2 FFT, Welch's averaged periodogram and
 //! spectral moments. Used by the tests (and by users who want to look at a recorded signal).
 
+use crate::math::{cos, sin_cos};
 use std::f64::consts::PI;
 
 /// In-place radix-2 complex FFT (forward, no scaling). `re.len()` must be a power of two.
@@ -25,7 +26,7 @@ pub fn fft(re: &mut [f64], im: &mut [f64]) {
         let ang = -2.0 * PI / len as f64;
         for start in (0..n).step_by(len) {
             for k in 0..len / 2 {
-                let (s, c) = (ang * k as f64).sin_cos();
+                let (s, c) = sin_cos(ang * k as f64);
                 let (a, b) = (start + k, start + k + len / 2);
                 let tr = re[b] * c - im[b] * s;
                 let ti = re[b] * s + im[b] * c;
@@ -45,7 +46,7 @@ pub fn fft(re: &mut [f64], im: &mut [f64]) {
 pub fn welch(x: &[f64], dt: f64, nseg: usize) -> (Vec<f64>, Vec<f64>) {
     assert!(nseg.is_power_of_two() && x.len() >= nseg);
     let w: Vec<f64> = (0..nseg)
-        .map(|i| 0.5 - 0.5 * (2.0 * PI * i as f64 / nseg as f64).cos())
+        .map(|i| 0.5 - 0.5 * cos(2.0 * PI * i as f64 / nseg as f64))
         .collect();
     let wss: f64 = w.iter().map(|v| v * v).sum();
     let nf = nseg / 2 + 1;
@@ -115,7 +116,7 @@ mod tests {
     fn fft_of_a_cosine() {
         let n = 64;
         let mut re: Vec<f64> = (0..n)
-            .map(|i| (2.0 * PI * 5.0 * i as f64 / n as f64).cos())
+            .map(|i| cos(2.0 * PI * 5.0 * i as f64 / n as f64))
             .collect();
         let mut im = vec![0.0; n];
         fft(&mut re, &mut im);

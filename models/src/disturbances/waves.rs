@@ -64,6 +64,7 @@
 use super::shaping::{quantise_time, SecondOrderProcess, Start};
 use super::sinusoids::Sinusoids;
 use crate::error::{check_non_negative, check_positive, require};
+use crate::math::{cos, exp, ln, powf, sin};
 use crate::random::{channel, NoiseStream};
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
@@ -113,7 +114,7 @@ impl SeaState {
     }
     /// Fully developed PM sea for a given H_s: `ω_p = (16 α/5)^¼ √(g/H_s)`, α = 0.0081.
     pub fn fully_developed_pm(hs: f64) -> Self {
-        let wp = (16.0 * 0.0081 / 5.0f64).powf(0.25) * (GRAVITY / hs).sqrt();
+        let wp = powf(16.0 * 0.0081 / 5.0f64, 0.25) * (GRAVITY / hs).sqrt();
         Self::pierson_moskowitz(hs, 2.0 * PI / wp)
     }
     pub fn jonswap(hs: f64, peak_period: f64, gamma: f64) -> Self {
@@ -160,7 +161,7 @@ impl Spectrum {
         let (b, omega_peak) = match sea.spectrum {
             SpectrumKind::Bretschneider => {
                 let b = 691.0 / sea.period.powi(4);
-                (b, (0.8 * b).powf(0.25))
+                (b, powf(0.8 * b, 0.25))
             }
             _ => {
                 let wp = 2.0 * PI / sea.period;
@@ -187,13 +188,13 @@ impl Spectrum {
         if w <= 0.0 {
             return 0.0;
         }
-        let base = self.a * w.powi(-5) * (-self.b * w.powi(-4)).exp();
+        let base = self.a * w.powi(-5) * exp(-self.b * w.powi(-4));
         match self.sea.spectrum {
             SpectrumKind::Jonswap => {
                 let wp = self.omega_peak;
                 let sigma = if w <= wp { 0.07 } else { 0.09 };
-                let r = (-(w - wp).powi(2) / (2.0 * sigma * sigma * wp * wp)).exp();
-                self.norm * base * self.sea.gamma.powf(r)
+                let r = exp(-(w - wp).powi(2) / (2.0 * sigma * sigma * wp * wp));
+                self.norm * base * powf(self.sea.gamma, r)
             }
             _ => base,
         }
@@ -206,14 +207,11 @@ impl Spectrum {
 
     /// `mₙ = ∫ ωⁿ S dω`, Simpson in ln ω over [0.05, 200]·ω_p (the tails beyond are < 1e-7 m0).
     pub fn moment(&self, n: i32) -> f64 {
-        let (lo, hi) = (
-            (0.05 * self.omega_peak).ln(),
-            (200.0 * self.omega_peak).ln(),
-        );
+        let (lo, hi) = (ln(0.05 * self.omega_peak), ln(200.0 * self.omega_peak));
         let m = 20_000;
         let h = (hi - lo) / m as f64;
         let f = |u: f64| {
-            let w = u.exp();
+            let w = exp(u);
             w.powi(n + 1) * self.density(w)
         };
         let mut sum = f(lo) + f(hi);
@@ -251,7 +249,7 @@ impl Spectrum {
     /// `ω = (B / −ln p)^¼`. JONSWAP: bisection on the cumulative energy (Simpson in ln ω).
     pub fn energy_band(&self, lo: f64, hi: f64) -> (f64, f64) {
         if self.sea.spectrum != SpectrumKind::Jonswap {
-            let quantile = |p: f64| (self.b / -p.ln()).powf(0.25);
+            let quantile = |p: f64| powf(self.b / -ln(p), 0.25);
             return (quantile(lo), quantile(hi));
         }
         self.energy_band_numeric(lo, hi)
@@ -262,15 +260,15 @@ impl Spectrum {
     fn energy_band_numeric(&self, lo: f64, hi: f64) -> (f64, f64) {
         let m0 = self.moment(0);
         let cdf = |w: f64| {
-            let l = (0.05 * self.omega_peak).ln();
-            let u = w.ln();
+            let l = ln(0.05 * self.omega_peak);
+            let u = ln(w);
             if u <= l {
                 return 0.0;
             }
             let m = 2000;
             let h = (u - l) / m as f64;
             let f = |x: f64| {
-                let w = x.exp();
+                let w = exp(x);
                 w * self.density(w)
             };
             let mut sum = f(l) + f(u);
@@ -298,7 +296,7 @@ impl Spectrum {
 /// Encounter frequency, [Klugt1987, eq. (2.22)]: `ω_e = ω0 − ω0² U cos γ / g`.
 #[inline]
 pub fn encounter_frequency(omega0: f64, speed: f64, gamma: f64, g: f64) -> f64 {
-    omega0 - omega0 * omega0 * speed * gamma.cos() / g
+    omega0 - omega0 * omega0 * speed * cos(gamma) / g
 }
 
 /// Encounter angle γ = wave_direction − heading wrapped to (−π, π] (0 following, π head seas).
@@ -534,9 +532,9 @@ impl Waves {
         self.t_ref = self.time;
         self.speed = speed;
         self.gamma = gamma;
-        self.speed_along = speed * gamma.cos();
-        self.sin_gamma = gamma.sin();
-        self.sin_2gamma = (2.0 * gamma).sin();
+        self.speed_along = speed * cos(gamma);
+        self.sin_gamma = sin(gamma);
+        self.sin_2gamma = sin(2.0 * gamma);
         if self.params.realisation == Realisation::ShapingFilter {
             let w0 = if self.params.shaping_frequency > 0.0 {
                 self.params.shaping_frequency
@@ -691,7 +689,7 @@ mod tests {
         let js = Spectrum::new(&SeaState::jonswap(3.0, 10.0, 3.3)).unwrap();
         assert!((4.0 * js.moment(0).sqrt() / 3.0 - 1.0).abs() < 1e-6);
         // normalisation close to DNV's 1 − 0.287 ln γ
-        assert!((js.norm / (1.0 - 0.287 * 3.3f64.ln()) - 1.0).abs() < 0.03);
+        assert!((js.norm / (1.0 - 0.287 * ln(3.3f64)) - 1.0).abs() < 0.03);
         // peak of JONSWAP at ωp
         let wp = js.peak_frequency();
         assert!(js.density(wp) > js.density(wp * 0.98) && js.density(wp) > js.density(wp * 1.02));
@@ -888,7 +886,7 @@ mod tests {
             for k in 0..100 {
                 let t = k as f64 * 0.77;
                 w.advance_to(t);
-                assert!((w.elevation() - a * (theta0 + we * t).cos()).abs() < 1e-12);
+                assert!((w.elevation() - a * cos(theta0 + we * t)).abs() < 1e-12);
             }
             if gamma == 0.0 && u == 15.0 {
                 assert!(
@@ -909,8 +907,8 @@ mod tests {
             w.set_inputs(5.0, gamma);
             w.advance_to(w.time() + 1.3);
             let z = w.elevation();
-            assert!((w.roll_moment() - 2.0e6 * gamma.sin() * z).abs() < 1e-6);
-            assert!((w.yaw_moment() - 5.0e5 * (2.0 * gamma).sin() * z).abs() < 1e-6);
+            assert!((w.roll_moment() - 2.0e6 * sin(gamma) * z).abs() < 1e-6);
+            assert!((w.yaw_moment() - 5.0e5 * sin(2.0 * gamma) * z).abs() < 1e-6);
         }
     }
 

@@ -27,6 +27,7 @@
 
 use super::shaping::{quantise_time, FirstOrderProcess, Start};
 use crate::error::{check_non_negative, check_positive};
+use crate::math::{atan2, sin, sin_cos};
 use crate::random::{channel, NoiseStream};
 use serde::{Deserialize, Serialize};
 
@@ -94,9 +95,9 @@ pub fn relative_wind(
     heading: f64,
 ) -> (f64, f64) {
     // body frame: x forward, y starboard; earth direction β → body angle β − ψ
-    let (s, c) = (wind_direction - heading).sin_cos();
+    let (s, c) = sin_cos(wind_direction - heading);
     let (x, y) = (wind_speed * c - ship_speed, wind_speed * s);
-    ((x * x + y * y).sqrt(), y.atan2(x))
+    ((x * x + y * y).sqrt(), atan2(y, x))
 }
 
 /// The wind model (see the module documentation).
@@ -208,7 +209,7 @@ impl Wind {
 
     /// [`Wind::roll_moment`] for the relative wind `(V_w, γ)` of [`Wind::relative`].
     pub fn roll_moment_at(&self, (v, g): (f64, f64)) -> f64 {
-        self.params.roll_coefficient * v * v * g.sin()
+        self.params.roll_coefficient * v * v * sin(g)
     }
 
     /// [Klugt1987, eq. (2.20)]: c_wR V_w² sin 2γ [N·m].
@@ -218,13 +219,14 @@ impl Wind {
 
     /// [`Wind::yaw_moment`] for the relative wind `(V_w, γ)` of [`Wind::relative`].
     pub fn yaw_moment_at(&self, (v, g): (f64, f64)) -> f64 {
-        self.params.yaw_coefficient * v * v * (2.0 * g).sin()
+        self.params.yaw_coefficient * v * v * sin(2.0 * g)
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::math::exp;
     use crate::random::{correlation, mean_variance};
     use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, PI};
 
@@ -252,7 +254,7 @@ mod tests {
         let mut w = Wind::new(p, 0.0).unwrap();
         w.set_inputs(0.0, 0.0);
         w.advance_to(1.0);
-        assert!((w.roll_moment() - 2.0e3 * 100.0 * FRAC_PI_4.sin()).abs() < 1e-9);
+        assert!((w.roll_moment() - 2.0e3 * 100.0 * sin(FRAC_PI_4)).abs() < 1e-9);
         assert!((w.yaw_moment() - 5.0e3 * 100.0).abs() < 1e-9); // sin 2γ = 1 at 45°
                                                                 // beam wind: no yaw moment, full roll moment
         w.set_inputs(0.0, -FRAC_PI_4);
@@ -284,7 +286,7 @@ mod tests {
         let (_, vd) = mean_variance(&d);
         assert!((vd.sqrt() / 5f64.to_radians() - 1.0).abs() < 0.03);
         let r = correlation(&v[..n - 20], &v[20..]);
-        assert!((r - (-1.0f64).exp()).abs() < 0.02, "lag T_g: {r}");
+        assert!((r - exp(-1.0f64)).abs() < 0.02, "lag T_g: {r}");
         assert!(correlation(&v, &d).abs() < 0.05);
         // another seed: uncorrelated
         let mut w2 = Wind::new(

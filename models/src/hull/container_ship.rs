@@ -37,6 +37,7 @@
 use super::{mss_rudder_rate, wrap_pi, DEG};
 use crate::error::{check_finite, check_positive, require, ParamError};
 use crate::integrate::rk4_advance;
+use crate::math::{atan, atan2, cos, sin, sin_cos};
 use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
@@ -358,7 +359,7 @@ impl ContainerShip {
             rudder: s[8],
             shaft_rpm: s[9],
             speed: u_tot,
-            drift_angle: s[1].atan2(s[0]),
+            drift_angle: atan2(s[1], s[0]),
             v_prime: s[1] / ur,
             r_prime: s[2] * L / ur,
             p_prime: s[6] * L / ur,
@@ -381,14 +382,14 @@ impl ContainerShip {
         let wake = (1.0 - WP) + TAU * ((vp + XP * rp).powi(2) + CPV * vp + CPR * rp);
         let u_p = match params.propeller_inflow {
             PropellerInflow::Current => up * wake,
-            PropellerInflow::Pre2022Cos => vp.cos() * wake,
+            PropellerInflow::Pre2022Cos => cos(vp) * wake,
         };
         let j = u_p * speed / (n_s * PROP_DIAMETER);
         let kt = KT0 - KT1 * j;
         let u_r = u_p * EPS * (1.0 + 8.0 * KAPPA * kt / (PI * j * j)).sqrt();
-        let alpha_r = delta + (v_r / u_r).atan();
+        let alpha_r = delta + atan(v_r / u_r);
         let slope = 6.13 * RUDDER_ASPECT / (RUDDER_ASPECT + 2.25);
-        let f_n = -slope * (RUDDER_AREA / (L * L)) * (u_r * u_r + v_r * v_r) * alpha_r.sin();
+        let f_n = -slope * (RUDDER_AREA / (L * L)) * (u_r * u_r + v_r * v_r) * sin(alpha_r);
         let thrust = 2.0 * PROP_DIAMETER.powi(4) * kt * n_s * n_s.abs() / (L * L * speed * speed);
         let w = 2.0 * G * DISPLACEMENT_VOLUME / (L * L * speed * speed);
         let gm = params.gm / L;
@@ -399,7 +400,7 @@ impl ContainerShip {
             + XVV * vp * vp
             + XRR * rp * rp
             + XPP * phi * phi
-            + CRX * f_n * delta.sin()
+            + CRX * f_n * sin(delta)
             + (M + MY) * vp * rp;
 
         let terms = [
@@ -426,10 +427,10 @@ impl ContainerShip {
         }
         let q2 = 0.5 * RHO * L * L * speed * speed;
         let q3 = q2 * L;
-        let y = hy + (1.0 + AH) * f_n * delta.cos() - (M + MX) * up * rp + inp.sway_force_ext / q2;
-        let k = hk - (1.0 + AH) * ZR * f_n * delta.cos() + MX * LX * up * rp - w * gm * phi
+        let y = hy + (1.0 + AH) * f_n * cos(delta) - (M + MX) * up * rp + inp.sway_force_ext / q2;
+        let k = hk - (1.0 + AH) * ZR * f_n * cos(delta) + MX * LX * up * rp - w * gm * phi
             + inp.roll_moment_ext / q3;
-        let n = hn + (XR + AH * XH) * f_n * delta.cos() + inp.yaw_moment_ext / q3;
+        let n = hn + (XR + AH * XH) * f_n * cos(delta) + inp.yaw_moment_ext / q3;
         ContainerForces {
             speed,
             x,
@@ -473,8 +474,8 @@ impl ContainerShip {
         let a_p = (-M32 * M44 * f.y + (M22 * M44 - M42 * M42) * f.k + M32 * M42 * f.n) / det;
         let a_r = (-M42 * M33 * f.y + M32 * M42 * f.k + (M22 * M33 - M32 * M32) * f.n) / det;
 
-        let (spsi, cpsi) = psi.sin_cos();
-        let cphi = phi.cos();
+        let (spsi, cpsi) = sin_cos(psi);
+        let cphi = cos(phi);
         [
             f.x * sp * sp / L / M11,
             a_v * sp * sp / L,
@@ -650,8 +651,8 @@ impl LinearContainerShip {
         let eta = Vector3::new(s[4], psi, phi);
         let rhs = b * delta - n * nu - g * eta;
         let acc = m.lu().solve(&rhs).unwrap_or_else(Vector3::zeros);
-        let (spsi, cpsi) = psi.sin_cos();
-        let cphi = phi.cos();
+        let (spsi, cpsi) = sin_cos(psi);
+        let cphi = cos(phi);
         [
             0.0,
             acc[0],
@@ -700,7 +701,7 @@ impl LinearContainerShip {
             rudder: s[8],
             shaft_rpm: 0.0,
             speed: sp,
-            drift_angle: s[1].atan2(u0),
+            drift_angle: atan2(s[1], u0),
             v_prime: s[1] / sp,
             r_prime: s[2] * L / sp,
             p_prime: s[6] * L / sp,

@@ -25,6 +25,7 @@
 use super::{mss_rudder_rate, wrap_pi, DEG};
 use crate::error::{check_finite, check_positive, require, ParamError};
 use crate::integrate::rk4_advance;
+use crate::math::{atan2, sin_cos};
 use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 
@@ -281,7 +282,7 @@ impl Mariner {
         let (x, y, n, sp) = Self::forces(params.u0, s);
         let (du, v, r, psi, d) = (s[0], s[1], s[2], s[5], s[6]);
         let det = M22 * M33 - M23 * M32;
-        let (spsi, cpsi) = psi.sin_cos();
+        let (spsi, cpsi) = sin_cos(psi);
         [
             x * sp * sp / L / M11,
             (M33 * y - M23 * n) / det * sp * sp / L,
@@ -327,7 +328,7 @@ impl Mariner {
             rudder: -s[6],
             rudder_state: s[6],
             speed: sp,
-            drift_angle: s[1].atan2(u),
+            drift_angle: atan2(s[1], u),
             u_prime: s[0] / sp,
             v_prime: s[1] / sp,
             r_prime: s[2] * L / sp,

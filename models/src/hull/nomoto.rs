@@ -56,6 +56,7 @@
 use super::{wrap_pi, KNOT};
 use crate::error::{check_finite, check_mass_matrix_2x2, check_positive, ParamError};
 use crate::integrate::rk4_advance;
+use crate::math::sin_cos;
 use nalgebra::{Matrix2, Vector2};
 use serde::{Deserialize, Serialize};
 
@@ -259,7 +260,7 @@ impl NomotoShip {
     pub fn step(&mut self, inputs: &NomotoInputs, h: f64) {
         let (l, u) = (self.length, self.speed);
         let s_scale = u / l; // dt′/dt
-        let (cs, cc) = inputs.current_direction.sin_cos();
+        let (cs, cc) = sin_cos(inputs.current_direction);
         let (cn, ce) = (inputs.current_speed * cc, inputs.current_speed * cs);
         let delta = inputs.rudder + inputs.yaw_disturbance;
         let me = &*self;
@@ -267,7 +268,7 @@ impl NomotoShip {
         rk4_advance(&mut st, h, self.max_substep, |s| {
             let (dv, dr) = me.derivative_prime(s[0], s[1], delta);
             let v = s[0] * u;
-            let (sp, cp) = s[2].sin_cos();
+            let (sp, cp) = sin_cos(s[2]);
             [
                 dv * s_scale,
                 dr * s_scale,
@@ -330,6 +331,7 @@ pub fn esso_osaka_assumed_m_b() -> ([[f64; 2]; 2], [f64; 2]) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::math::{cos, exp, sin};
 
     /// [DERIVED] from [Taylor2000, eqs. (5.25)-(5.26)]: DDG-51 at 22 kn has L/U = 12.55 s,
     /// T = 24.2 s, K = 0.1626 1/s.
@@ -350,8 +352,8 @@ mod tests {
         for proto in [NomotoShip::ddg51(), NomotoShip::esso_osaka()] {
             let (mut a, mut b, mut c) = (proto.clone(), proto.clone(), proto.clone());
             for k in 0..200 {
-                let d = 0.05 * (0.01 * k as f64).sin();
-                let w = 0.03 * (0.07 * k as f64).cos();
+                let d = 0.05 * sin(0.01 * k as f64);
+                let w = 0.03 * cos(0.07 * k as f64);
                 a.step(
                     &NomotoInputs {
                         rudder: d,
@@ -403,8 +405,8 @@ mod tests {
             let o = s.outputs();
             let tp = 100.0 / lu;
             let (tt, kk) = (1.9287, 2.04);
-            let r_exp = kk * d * (1.0 - (-tp / tt).exp()) / lu;
-            let psi_exp = kk * d * (tp - tt * (1.0 - (-tp / tt).exp()));
+            let r_exp = kk * d * (1.0 - exp(-tp / tt)) / lu;
+            let psi_exp = kk * d * (tp - tt * (1.0 - exp(-tp / tt)));
             assert!(
                 (o.yaw_rate - r_exp).abs() < 1e-9 * r_exp,
                 "h {h}: {} vs {r_exp}",

@@ -48,6 +48,7 @@
 use super::{wrap_pi, KNOT};
 use crate::error::{check_finite, check_positive, ParamError};
 use crate::integrate::rk4_advance;
+use crate::math::sin_cos;
 use crate::memo::{bits, Bits, Memo};
 use nalgebra::{SMatrix, SVector};
 use serde::{Deserialize, Serialize};
@@ -488,7 +489,7 @@ impl RrsShip {
             let dx = a * x + bu;
             let mut d = [0.0; NX + 2];
             d[..NX].copy_from_slice(dx.as_slice());
-            let (sp, cp) = s[4].sin_cos();
+            let (sp, cp) = sin_cos(s[4]);
             d[NX] = speed * cp;
             d[NX + 1] = speed * sp;
             d
@@ -590,6 +591,7 @@ fn filter(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::math::{cos, sin};
     use nalgebra::Complex;
 
     /// Amplitude of the steady-state response of output `out` to a unit sinusoid of frequency
@@ -612,7 +614,7 @@ mod tests {
         for k in 0..(n_settle + n_meas) {
             // mid-point value of the sinusoid, held over the step
             let t = (k as f64 + 0.5) * h;
-            let val = (w * t).sin();
+            let val = sin(w * t);
             let mut inp = RrsShipInputs {
                 speed,
                 ..Default::default()
@@ -626,8 +628,8 @@ mod tests {
             if k >= n_settle {
                 let t1 = (k + 1) as f64 * h;
                 let y = s.state()[out];
-                cs += y * (w * t1).cos();
-                sn += y * (w * t1).sin();
+                cs += y * cos(w * t1);
+                sn += y * sin(w * t1);
             }
         }
         let n = n_meas as f64;

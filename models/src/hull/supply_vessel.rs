@@ -25,6 +25,7 @@
 use super::wrap_pi;
 use crate::error::{check_finite, check_positive, require, ParamError};
 use crate::integrate::rk4_advance;
+use crate::math::sin_cos;
 use crate::memo::{bits, Bits, Memo};
 use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
@@ -153,7 +154,7 @@ impl SupplyVessel {
         let tau = Vector3::from(inputs.tau);
         let b = Vector3::from(inputs.bias);
         rk4_advance(&mut self.state, h, self.max_substep, |s| {
-            let (sp, cp) = s[2].sin_cos();
+            let (sp, cp) = sin_cos(s[2]);
             let nu = Vector3::new(s[3], s[4], s[5]);
             // Jᵀ(ψ) b
             let bb = Vector3::new(cp * b[0] + sp * b[1], -sp * b[0] + cp * b[1], b[2]);
@@ -190,6 +191,7 @@ impl SupplyVessel {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::math::exp;
 
     /// [DERIVED] from [Fossen1999, eqs. (56)-(57)]: eig(M⁻¹D) = 0.11907, 0.025655, 0.0094579 1/s (relative 1e-4).
     #[test]
@@ -222,7 +224,7 @@ mod tests {
         let (d11, d22, d23, d32, d33, m11) =
             (5.0242e4, 2.7229e5, -4.3933e6, -4.3933e6, 4.1894e8, 5.3122e6);
         s.step(&inp, 20.0);
-        let u20 = x / d11 * (1.0 - (-20.0 * d11 / m11).exp());
+        let u20 = x / d11 * (1.0 - exp(-20.0 * d11 / m11));
         assert!((s.outputs().nu[0] - u20).abs() < 1e-9 * u20);
         for _ in 0..2980 {
             s.step(&inp, 1.0);

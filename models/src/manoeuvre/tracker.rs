@@ -15,6 +15,7 @@
 //! [`turning_circle`]: super::turning_circle
 //! [`zigzag`]: super::zigzag
 
+use crate::math::{cos, sin};
 use serde::{Deserialize, Serialize};
 
 use super::{
@@ -127,8 +128,8 @@ impl TurningCircleTracker {
             if is_executed(p.t, self.t_execute) {
                 let e = Execute {
                     sample: *p,
-                    cos: p.psi.cos(),
-                    sin: p.psi.sin(),
+                    cos: cos(p.psi),
+                    sin: sin(p.psi),
                 };
                 self.execute = Some(e);
                 self.peak_heel_time = p.t;
@@ -438,7 +439,7 @@ mod tests {
             .position(|p| p.t >= t_e - 1e-9)
             .ok_or(MetricError::NoExecute)?;
         let e = s[ke];
-        let (c0, s0) = (e.psi.cos(), e.psi.sin());
+        let (c0, s0) = (cos(e.psi), sin(e.psi));
         let along = |p: &Sample| (p.x - e.x) * c0 + (p.y - e.y) * s0;
         let perp = |p: &Sample| -(p.x - e.x) * s0 + (p.y - e.y) * c0;
         let last = s[s.len() - 1];

@@ -25,6 +25,7 @@
 
 use crate::error::{check_non_negative, check_positive};
 use crate::hull::wrap_pi;
+use crate::math::{atan2, hypot, sin_cos};
 use nalgebra::{Matrix2, SMatrix, SVector};
 use serde::{Deserialize, Serialize};
 
@@ -193,12 +194,12 @@ impl DgpsKalman {
 
     /// Speed over ground v_xy [Artyszuk2003, eq. (6)] [m/s].
     pub fn speed_over_ground(&self) -> f64 {
-        self.x[0].hypot(self.x[1])
+        hypot(self.x[0], self.x[1])
     }
 
     /// Course over ground atan2(v_EW, v_NS) [rad].
     pub fn course_over_ground(&self) -> f64 {
-        self.x[1].atan2(self.x[0])
+        atan2(self.x[1], self.x[0])
     }
 
     /// Drift angle β_A = ψ − χ [Artyszuk2003, eq. (7)], wrapped to (−π, π].
@@ -234,13 +235,13 @@ impl DgpsKalman {
         current_direction: f64,
     ) -> f64 {
         let w = self.body_velocity_through_water(heading, current_speed, current_direction);
-        (-w[1]).atan2(w[0])
+        atan2(-w[1], w[0])
     }
 }
 
 /// Dᵀ(ψ)[a_N, a_E] = [cos ψ a_N + sin ψ a_E, −sin ψ a_N + cos ψ a_E] [Artyszuk2003, sec. 1].
 pub fn rotate_to_body(heading: f64, north: f64, east: f64) -> [f64; 2] {
-    let (s, c) = heading.sin_cos();
+    let (s, c) = sin_cos(heading);
     [c * north + s * east, -s * north + c * east]
 }
 
@@ -252,19 +253,20 @@ pub fn water_velocity(
     current_speed: f64,
     current_direction: f64,
 ) -> [f64; 2] {
-    let (s, c) = current_direction.sin_cos();
+    let (s, c) = sin_cos(current_direction);
     let cb = rotate_to_body(heading, current_speed * c, current_speed * s);
     [ground[0] - cb[0], ground[1] - cb[1]]
 }
 
 /// [Artyszuk2003, eq. (7)]: β_A = ψ − atan2(v_EW, v_NS), wrapped.
 pub fn drift_angle(heading: f64, v_ns: f64, v_ew: f64) -> f64 {
-    wrap_pi(heading - v_ew.atan2(v_ns))
+    wrap_pi(heading - atan2(v_ew, v_ns))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::math::{cos, sin};
 
     /// Steady-state gains ([DERIVED] from [Artyszuk2003, eqs. (3)-(5)]): K∞ = (k_v, k_p) per axis: S_p 0.001 → (0.014466, 0.162914); 0.01 →
     /// (0.042688, 0.271106); 0.1 → (0.11936, 0.430124); a-priori P∞ (P_vv, P_vp, P_pp) and the
@@ -370,7 +372,7 @@ mod tests {
     fn steady_turn_course_lag() {
         let (u, r) = (7.0, 0.03);
         let mut f = DgpsKalman::new(DgpsKalmanParams::default(), [u, 0.0, 0.0, 0.0]).unwrap();
-        let pos = |t: f64| (u / r * (r * t).sin(), u / r * (1.0 - (r * t).cos()));
+        let pos = |t: f64| (u / r * sin(r * t), u / r * (1.0 - cos(r * t)));
         let mut t = 0.0;
         for _ in 0..300 {
             t += 1.0;
@@ -393,10 +395,7 @@ mod tests {
     /// Worked example of [Artyszuk2003, eq. (7)]: ψ = 30°, 5 m/s at course 20° ⇒ β_A = +10.00°.
     #[test]
     fn drift_angle_example() {
-        let (vn, ve) = (
-            5.0 * 20f64.to_radians().cos(),
-            5.0 * 20f64.to_radians().sin(),
-        );
+        let (vn, ve) = (5.0 * cos(20f64.to_radians()), 5.0 * sin(20f64.to_radians()));
         assert!((vn - 4.6985).abs() < 1e-4 && (ve - 1.7101).abs() < 1e-4);
         assert!((drift_angle(30f64.to_radians(), vn, ve).to_degrees() - 10.0).abs() < 1e-9);
     }

@@ -493,6 +493,7 @@ mod tests {
         run, turning_circle, ManoeuvreGenerator, ManoeuvreKind, ManoeuvreShip, Sample,
         TurningCircleMetrics,
     };
+    use crate::math::{atan2, sin};
     use crate::random::NoiseStream;
 
     /// The Esso Osaka truth of [Taylor2000, Table 2.3].
@@ -552,7 +553,7 @@ mod tests {
                 r: o.yaw_rate,
                 speed: o.speed_over_ground,
                 roll: 0.0,
-                drift: o.sway_velocity.atan2(self.ship.speed),
+                drift: atan2(o.sway_velocity, self.ship.speed),
                 rudder: self.rudder,
                 rudder_command: 0.0,
             }
@@ -977,7 +978,7 @@ mod tests {
         let mut hist: Vec<[f64; 4]> = Vec::new();
         for k in 0..200 {
             let t = k as f64;
-            let s = (0.05 * t).sin();
+            let s = sin(0.05 * t);
             g.step(t, 1.0, [u, 0.02 * s * u, 0.2 * s * u / l, 1.0], 0.1 * s);
             hist.push(g.sums.last().copied().unwrap());
             let n = hist.len();

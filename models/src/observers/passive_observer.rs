@@ -29,6 +29,7 @@
 use crate::error::{check_finite, check_non_negative, check_positive, require, ParamError};
 use crate::hull::wrap_pi;
 use crate::integrate::rk4_advance;
+use crate::math::sin_cos;
 use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 
@@ -141,7 +142,7 @@ pub struct PassiveObserver {
 }
 
 fn rot(psi: f64) -> Matrix3<f64> {
-    let (s, c) = psi.sin_cos();
+    let (s, c) = sin_cos(psi);
     Matrix3::new(c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0)
 }
 
@@ -296,6 +297,7 @@ mod tests {
     use super::*;
     use crate::disturbances::waves::{WaveParams, Waves};
     use crate::hull::supply_vessel::{SupplyVessel, SupplyVesselInputs};
+    use crate::math::sin;
 
     /// [Fossen1999, eq. (59)]: K₁ = [−2.2059; 1.6157], K₂ = 1.1 to 4 decimals; exact −2.2058824.
     /// T2/T3: the tuning rule holds for the paper's set and fails for λ/κ ≥ ω₀ or ω_c ≤ ω₀.
@@ -333,11 +335,7 @@ mod tests {
                 .unwrap();
         for k in 0..30_000 {
             let t = k as f64 * 0.1;
-            let tau = [
-                1e5 * (0.05 * t).sin(),
-                1e5 * (0.1 * t).sin(),
-                1e7 * (0.07 * t).sin(),
-            ];
+            let tau = [1e5 * sin(0.05 * t), 1e5 * sin(0.1 * t), 1e7 * sin(0.07 * t)];
             let y = ship.outputs().measured;
             obs.step(y, tau, 0.1);
             ship.step(
@@ -444,7 +442,7 @@ mod tests {
                 }
                 let (mut re, mut im) = (0.0, 0.0);
                 for (q, v) in x.iter().enumerate() {
-                    let (sn, cs) = (wk * q as f64).sin_cos();
+                    let (sn, cs) = sin_cos(wk * q as f64);
                     re += (v[i] - mean) * cs;
                     im -= (v[i] - mean) * sn;
                 }

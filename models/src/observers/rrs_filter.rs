@@ -686,6 +686,7 @@ impl RrsFilter {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::math::sin;
     use crate::random::NoiseStream;
 
     fn close(a: f64, b: f64, tol: f64) -> bool {
@@ -758,10 +759,10 @@ mod tests {
         let mut worst: f64 = 0.0;
         for k in 0..40_000 {
             let time = k as f64 * t;
-            let phi = 0.05 * (0.63 * time).sin();
+            let phi = 0.05 * sin(0.63 * time);
             f.sample(phi + 0.1, 0.0, t);
             if time > 1500.0 {
-                let phi_next = 0.05 * (0.63 * (time + t)).sin();
+                let phi_next = 0.05 * sin(0.63 * (time + t));
                 worst = worst.max((f.state()[0] - phi_next).abs());
             }
         }
