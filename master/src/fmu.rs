@@ -86,6 +86,21 @@ impl std::fmt::Debug for Fmu {
 
 /// Unpacks a zip archive (an FMU, or an SSP for the SSP reader) into a new temporary directory.
 pub fn unpack_archive(path: &Path, unpack: &Unpack) -> Result<tempfile::TempDir> {
+    unpack_into_temp(path, unpack, None)
+}
+
+/// [`unpack_archive`] for an FMU: the binaries of other platforms than [`PLATFORM`] are checked
+/// like every entry but not written (an FMU with linux64 and win64 binaries unpacks its `.so`
+/// only); their folders are, so that [`UnpackedFmu::platforms`] lists them.
+fn unpack_fmu_archive(path: &Path, unpack: &Unpack) -> Result<tempfile::TempDir> {
+    unpack_into_temp(path, unpack, Some(PLATFORM))
+}
+
+fn unpack_into_temp(
+    path: &Path,
+    unpack: &Unpack,
+    only_platform: Option<&str>,
+) -> Result<tempfile::TempDir> {
     let file =
         std::fs::File::open(path).map_err(|e| Error::fmu(path, format!("cannot open: {e}")))?;
     if file.metadata().is_ok_and(|m| m.is_dir()) {
@@ -133,6 +148,7 @@ pub fn unpack_archive(path: &Path, unpack: &Unpack) -> Result<tempfile::TempDir>
         fmu: path,
         dir: dir.path(),
         unpack,
+        only_platform,
         total: 0,
     }
     .all(&mut zip)?;
@@ -149,7 +165,8 @@ pub struct UnpackedFmu {
 /// How an FMU archive is unpacked ([`UnpackedFmu::open_with`], [`Fmu::load_with`]).
 ///
 /// Every FMU gets its own directory `shipsim-fmu-*` (mode 0700) in `parent`; files are written
-/// 0600 (0700 under `binaries/`), whatever modes the archive stores; directories 0700.
+/// 0600 (0700 under `binaries/`), whatever modes the archive stores; directories 0700. Binaries
+/// of other platforms than [`PLATFORM`] are checked but not written.
 /// Symbolic links, absolute paths and `..` are refused, and so is an archive beyond
 /// [`Limits`]. The directory is removed when the last user of the FMU drops it (also on an
 /// error and while a panic unwinds); a process that wants to remove it on a signal too puts
@@ -172,7 +189,7 @@ impl UnpackedFmu {
 
     /// Unpacks the archive (see [`Unpack`]) and parses its `modelDescription.xml`.
     pub fn open_with(path: &Path, unpack: &Unpack) -> Result<UnpackedFmu> {
-        let dir = unpack_archive(path, unpack)?;
+        let dir = unpack_fmu_archive(path, unpack)?;
         let model_description = read_model_description(path, dir.path())?;
         Ok(UnpackedFmu {
             path: path.to_path_buf(),
@@ -349,6 +366,8 @@ struct Extraction<'a> {
     fmu: &'a Path,
     dir: &'a Path,
     unpack: &'a Unpack,
+    /// `Some(platform)`: files under `binaries/<other platform>/` are not written.
+    only_platform: Option<&'a str>,
     /// Bytes written so far.
     total: u64,
 }
@@ -399,6 +418,9 @@ impl Extraction<'_> {
         if let Some(parent) = out.parent() {
             self.create_dirs(parent)?;
         }
+        if self.other_platform(&rel) {
+            return Ok(());
+        }
         let limit = self.entry_limit(&name, entry.size(), entry.compressed_size())?;
         let mode = if rel.starts_with("binaries") {
             0o700
@@ -436,6 +458,17 @@ impl Extraction<'_> {
             }
             file.write_all(&buf[..n])
                 .map_err(|e| self.err(format!("cannot unpack '{name}': {e}")))?;
+        }
+    }
+
+    /// A file under `binaries/<platform>/` of another platform than the one unpacked for.
+    fn other_platform(&self, rel: &Path) -> bool {
+        let mut parts = rel.components();
+        match (self.only_platform, parts.next(), parts.next(), parts.next()) {
+            (Some(ours), Some(b), Some(p), Some(_)) => {
+                b.as_os_str() == "binaries" && p.as_os_str() != ours
+            }
+            _ => false,
         }
     }
 

@@ -164,6 +164,32 @@ fn other_platforms_only() {
     assert!(text.contains("platforms      darwin64, win64\n"), "{text}");
 }
 
+/// An FMU with binaries for several platforms unpacks this platform's only (the others are checked
+/// like every entry, and their folders kept so that `platforms` lists them), and runs.
+#[test]
+fn other_platforms_are_not_unpacked() {
+    let d = tempfile::tempdir().unwrap();
+    let so = compile(d.path(), "multi", &c_source("testfmu.c"), &[]);
+    let p = d.path().join("multi.fmu");
+    zip_files(
+        &p,
+        &[
+            (
+                "modelDescription.xml",
+                model_description(GUID, "2.0").into_bytes(),
+            ),
+            ("binaries/linux64/testfmu.so", std::fs::read(so).unwrap()),
+            ("binaries/win64/testfmu.dll", vec![b'M'; 1 << 20]),
+        ],
+    );
+    let u = shipsim::fmu::UnpackedFmu::open(&p).unwrap();
+    assert_eq!(u.platforms(), ["linux64", "win64"]);
+    assert!(u.dir.path().join("binaries/linux64/testfmu.so").is_file());
+    assert!(u.dir.path().join("binaries/win64").is_dir());
+    assert!(!u.dir.path().join("binaries/win64/testfmu.dll").exists());
+    assert!(Fmu::load(&p).is_ok());
+}
+
 #[test]
 fn missing_fmi2_symbol() {
     let d = tempfile::tempdir().unwrap();
