@@ -6,11 +6,12 @@
 //!   (`x86_64-w64-mingw32-gcc`). This is the set-up of a normal developer machine.
 //! * **Debian**: where rustup cannot reach its servers (this project's CI), Debian bookworm's
 //!   own Rust (`apt-get install rustc-web cargo-web rust-web-src gcc-mingw-w64-x86-64`, rustc
-//!   1.85) builds the standard library for the target from its source (`-Zbuild-std`, allowed
-//!   on a stable compiler by `RUSTC_BOOTSTRAP=1`). The two startup objects a windows-gnu link
+//!   1.85, or 1.96 from bookworm-security) builds the standard library for the target from its
+//!   source (`-Zbuild-std`, allowed on a stable compiler by `RUSTC_BOOTSTRAP=1`). The two startup objects a windows-gnu link
 //!   needs (`rsbegin.o`, `rsend.o`, normally shipped with the target's standard library) are
 //!   compiled here from the same source. The FMU crates and their dependencies therefore build
-//!   with rustc 1.85 (the workspace's `rust-version` is for the master and is ignored here).
+//!   with that rustc, 1.85 at the oldest (the workspace's `rust-version` is for the master and is
+//!   ignored here).
 //!
 //! Either way the build has a target directory of its own (`target/win64`): two compilers
 //! sharing `target/` would rebuild each other's crates. The DLLs are stripped of symbols
@@ -91,7 +92,11 @@ impl Toolchain {
                 cargo,
                 library,
             } => {
-                let objects = startup_objects(rustc, library, &target_dir.join("rtstartup"))?;
+                // one folder per compiler: an upgraded rustc compiles its own startup objects
+                let release = version(rustc).unwrap_or_default();
+                let release = release.split_whitespace().nth(1).unwrap_or("unknown");
+                let objects =
+                    startup_objects(rustc, library, &target_dir.join("rtstartup").join(release))?;
                 flags.extend(["-L".to_string(), format!("native={}", objects.display())]);
                 let mut cmd = Command::new(cargo);
                 cmd.env("RUSTC", rustc)
