@@ -49,6 +49,7 @@ pub mod isolate;
 pub mod limits;
 pub mod log;
 pub mod model_description;
+pub mod output_path;
 pub mod plot;
 pub mod results;
 pub mod run;

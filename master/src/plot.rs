@@ -232,6 +232,7 @@ pub fn plot_figure(path: &Path, title: &str, panels: &[Panel], tracks: &[Track])
         return Err(Error::Other("nothing to plot".into()));
     }
     register_font();
+    let path = &crate::output_path::writable(path)?;
     create_parent_dir(path)?;
     draw_figure(path, title, panels, tracks)
         .map_err(|e| Error::Other(format!("plot {}: {e}", path.display())))

@@ -315,7 +315,9 @@ impl Context<'_> {
     fn recorders(&self, run: &Run) -> Result<RunRecorders<'_>> {
         let series = match &self.campaign.spec.series {
             Some(s) if s.runs.contains(&(run.index as u64)) => {
-                let path = self.series_dir.join(super::output::series_name(run.index));
+                let path = crate::output_path::writable(
+                    &self.series_dir.join(super::output::series_name(run.index)),
+                )?;
                 std::fs::create_dir_all(&self.series_dir).map_err(|e| {
                     Error::io(format!("cannot create {}", self.series_dir.display()), e)
                 })?;

@@ -100,7 +100,7 @@ impl Journal {
     /// Opens (or creates) `dir/runs.jsonl`, reading the runs already done and dropping a
     /// partial last line.
     pub fn open(dir: &Path) -> Result<Journal> {
-        let path = dir.join("runs.jsonl");
+        let path = crate::output_path::writable(&dir.join("runs.jsonl"))?;
         let io = |what: &str, e| Error::io(format!("{what} {}", path.display()), e);
         let mut file = OpenOptions::new()
             .read(true)

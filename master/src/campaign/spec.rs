@@ -156,7 +156,7 @@ pub struct SeriesSpec {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct Raw {
-    name: Option<String>,
+    name: Option<Spanned<String>>,
     description: Option<String>,
     system: String,
     stop_time: Option<f64>,
@@ -317,12 +317,17 @@ impl Reader<'_> {
 
     fn spec(&mut self, raw: Raw) -> CampaignSpec {
         let dir = self.path.parent().unwrap_or(Path::new("."));
-        let name = raw.name.clone().unwrap_or_else(|| {
-            self.path
-                .file_stem()
-                .map(|s| s.to_string_lossy().into_owned())
-                .unwrap_or_else(|| "campaign".into())
-        });
+        let name = match &raw.name {
+            Some(n) => {
+                let line = self.line(n.span());
+                self.folder_name(n.get_ref(), line, "name")
+            }
+            None => {
+                let stem = self.path.file_stem().map(|s| s.to_string_lossy());
+                let stem = stem.unwrap_or_else(|| "campaign".into()).into_owned();
+                self.folder_name(&stem, None, "the file's name (the default name)")
+            }
+        };
         for (what, t) in [("stop_time", raw.stop_time), ("fork_at", raw.fork_at)] {
             if t.is_some_and(|t| !t.is_finite()) {
                 self.error(None, format!("{what} = {} must be finite", t.unwrap()));
@@ -370,6 +375,34 @@ impl Reader<'_> {
         };
         self.names(&spec);
         spec
+    }
+
+    /// The campaign's name, which is also its output folder `results/<name>`: one folder name,
+    /// never a path (no `/` or `\\`, not `.` or `..`, not empty, no control characters), so that
+    /// a campaign file cannot make `campaign run` write outside `results/`.
+    fn folder_name(&mut self, name: &str, line: Option<usize>, what: &str) -> String {
+        let why = if name.trim().is_empty() {
+            Some("is empty")
+        } else if name == "." || name == ".." {
+            Some("is a relative folder, not a name")
+        } else if name.contains(['/', '\\']) {
+            Some("contains a path separator")
+        } else if name.chars().any(char::is_control) {
+            Some("contains a control character")
+        } else {
+            None
+        };
+        if let Some(why) = why {
+            self.error(
+                line,
+                format!(
+                    "campaign {what} {name:?} {why}: the name is the output folder \
+                     results/<name>, so it must be one folder name (give `name = \"...\"`, or \
+                     `--output DIR` to choose the folder)"
+                ),
+            );
+        }
+        name.to_string()
     }
 
     /// `{ "inst.var" = value, ... }` as (variable, value) pairs.

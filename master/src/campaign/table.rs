@@ -170,6 +170,7 @@ fn tmp_path(path: &Path) -> PathBuf {
 /// to disk and renamed over `path` (a rename within a directory is atomic on POSIX file
 /// systems). On any error the temporary file is removed and `path` is left as it was.
 pub(crate) fn write_atomic(path: &Path, write: impl FnOnce(File) -> Result<File>) -> Result<()> {
+    let path = &crate::output_path::writable(path)?;
     let tmp = tmp_path(path);
     let result = File::create(&tmp)
         .map_err(|e| Error::io(format!("creating {}", tmp.display()), e))

@@ -408,8 +408,10 @@ pub fn write(sys: &System, out: &Path) -> Result<Vec<String>> {
         std::fs::create_dir_all(dir)
             .map_err(|e| Error::io(format!("creating {}", dir.display()), e))?;
     }
+    let out = &crate::output_path::writable(out)?;
     std::fs::write(out, x).map_err(|e| Error::io(format!("writing {}", out.display()), e))?;
     if !plan.events.is_empty() {
+        let scenario_path = crate::output_path::writable(&scenario_path)?;
         std::fs::write(&scenario_path, scenario_json(sys, &plan))
             .map_err(|e| Error::io(format!("writing {}", scenario_path.display()), e))?;
     }

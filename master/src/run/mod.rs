@@ -300,6 +300,7 @@ fn into_csv(
 
 /// The output file, with its folder created; buffered.
 fn create_output_file(p: &std::path::Path) -> Result<Box<dyn Write>> {
+    let p = &crate::output_path::writable(p)?;
     if let Some(dir) = p.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir)
             .map_err(|e| Error::io(format!("cannot create output folder {}", dir.display()), e))?;

@@ -180,6 +180,7 @@ pub(super) fn render(
             path.display()
         )));
     }
+    let path = &crate::output_path::writable(path)?;
     create_parent_dir(path)?;
     std::fs::File::create(path)
         .map_err(|e| Error::io(format!("plot: cannot write {}", path.display()), e))?;

@@ -394,6 +394,7 @@ impl Archive {
 
     /// Zips the archive into `out` (through a temporary file beside it, renamed at the end).
     fn write_zip(&self, out: &Path) -> Result<()> {
+        let out = &crate::output_path::writable(out)?;
         if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
             std::fs::create_dir_all(dir)
                 .map_err(|e| Error::io(format!("creating {}", dir.display()), e))?;

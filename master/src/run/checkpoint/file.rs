@@ -150,6 +150,7 @@ impl Checkpoint {
     /// Writes the checkpoint to `path`, creating its folder (through `<path>.part`, renamed
     /// into place, so that a reader never sees half a file).
     pub fn write(&self, path: &Path) -> Result<()> {
+        let path = &crate::output_path::writable(path)?;
         let bytes = self.encode()?;
         let ctx = |what: &str| format!("writing checkpoint file {} ({what})", path.display());
         if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
