@@ -378,8 +378,10 @@ pub fn run(campaign: &Campaign, opts: &CampaignOptions) -> Result<CampaignOutcom
     let dir = &opts.output;
     std::fs::create_dir_all(dir)
         .map_err(|e| Error::io(format!("cannot create output folder {}", dir.display()), e))?;
-    output::check_or_write_provenance(campaign, dir, opts.shard)?;
+    // The folder's lock first (the journal holds it): a second process on the folder is refused
+    // before it writes anything, campaign.json included.
     let journal = Journal::open(dir)?;
+    output::check_or_write_provenance(campaign, dir, opts.shard)?;
     let fmus = run::load_fmus_with(
         &campaign.system,
         &crate::fmu::Unpack::default(),

@@ -105,8 +105,9 @@ pub fn merge(inputs: &[PathBuf], out: &Path) -> Result<MergeReport> {
     let mut merged_prov = newest.clone();
     merged_prov.shard = None;
     let text = serde_json::to_string_pretty(&merged_prov).expect("serializable");
-    write_atomic(&out.join("campaign.json"), text.as_bytes())?;
+    // the output folder's lock before anything is written into it
     let mut journal = Journal::open(out)?;
+    write_atomic(&out.join("campaign.json"), text.as_bytes())?;
     let mut found = 0;
     let mut missing = Vec::new();
     for run in &runs {

@@ -55,6 +55,19 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use toml::Spanned;
 
+/// The columns the run and derived tables have of their own (docs/campaigns.md, "Output
+/// folder"); no factor, seed or KPI may take one of these names.
+pub const TABLE_COLUMNS: [&str; 8] = [
+    "run",
+    "point",
+    "replication",
+    "arm",
+    "status",
+    "message",
+    "wall_time",
+    "key",
+];
+
 /// The most runs (and design points) a campaign file may expand to: every run is held in
 /// memory with the values it sets (about a kilobyte each).
 pub const MAX_RUNS: usize = 1_000_000;
@@ -343,7 +356,9 @@ impl Reader<'_> {
             .derived
             .into_iter()
             .map(|d| {
+                let line = self.line(d.span());
                 let d = d.into_inner();
+                self.not_reserved("derived kpi", &d.name, line);
                 Derived {
                     name: d.name,
                     expr: d.expr,
@@ -433,6 +448,7 @@ impl Reader<'_> {
         let line = self.line(f.span());
         let f = f.into_inner();
         let name = f.name.clone().unwrap_or_else(|| f.variable.clone());
+        self.not_reserved("factor", &name, line);
         let what = format!("factor '{name}'");
         if crate::system::VarRef::parse(&f.variable).is_none() {
             self.error(
@@ -614,6 +630,7 @@ impl Reader<'_> {
             );
         }
         for s in &r.seeds {
+            self.not_reserved("seed", s, None);
             if crate::system::VarRef::parse(s).is_none() {
                 self.error(
                     None,
@@ -646,11 +663,32 @@ impl Reader<'_> {
             None => stat_kpi(&k),
         };
         match kpi {
-            Ok(kpi) => Some(kpi),
+            Ok(kpi) => {
+                for c in kpi.columns() {
+                    self.not_reserved("kpi", &c, line);
+                }
+                Some(kpi)
+            }
             Err(m) => {
                 self.error(line, format!("kpi '{}': {m}", k.name));
                 None
             }
+        }
+    }
+
+    /// A factor, seed, KPI or derived KPI is a column of the run or derived table, beside the
+    /// table's own columns ([`TABLE_COLUMNS`]): a name equal to one of those would give the table
+    /// two columns of that name (Parquet readers then refuse the file).
+    fn not_reserved(&mut self, what: &str, name: &str, line: Option<usize>) {
+        if TABLE_COLUMNS.contains(&name) {
+            self.error(
+                line,
+                format!(
+                    "{what} name '{name}' is a column of the run tables ({}); choose another \
+                     name (`name = \"...\"`)",
+                    TABLE_COLUMNS.join(", ")
+                ),
+            );
         }
     }
 
@@ -690,6 +728,30 @@ impl Reader<'_> {
             spec.factors.iter().map(|f| &f.name).collect();
         if factor_names.len() != spec.factors.len() {
             self.error(None, "two factors have the same name".into());
+        }
+        // factors, seeds, KPIs and derived KPIs share the tables' header
+        let mut columns: std::collections::HashMap<String, &str> = Default::default();
+        let factors = spec.factors.iter().map(|f| ("factor", f.name.clone()));
+        let seeds = spec.replications.seeds.iter().map(|s| ("seed", s.clone()));
+        let kpis = spec
+            .kpis
+            .iter()
+            .flat_map(|k| k.columns())
+            .map(|c| ("kpi", c));
+        let derived = spec.derived.iter().map(|d| ("derived kpi", d.name.clone()));
+        for (what, name) in factors.chain(seeds).chain(kpis).chain(derived) {
+            match columns.get(&name) {
+                Some(first) if *first != what => self.error(
+                    None,
+                    format!(
+                        "{what} '{name}' has the name of a {first}: the run tables would have \
+                         two columns '{name}'; rename one (`name = \"...\"`)"
+                    ),
+                ),
+                _ => {
+                    columns.insert(name, what);
+                }
+            }
         }
     }
 }

@@ -1,0 +1,119 @@
+//! A campaign file or folder cannot be turned against its user (issue 38): names that would
+//! clash in the run tables, a second process on a running folder, journal lines that do not
+//! match the campaign, and absurd job counts are refused with clear errors.
+mod common;
+
+use shipsim::campaign::CampaignSpec;
+use std::path::Path;
+
+fn load_err(dir: &Path, text: &str) -> String {
+    let p = dir.join("c.toml");
+    std::fs::write(&p, text).unwrap();
+    match CampaignSpec::load(&p) {
+        Ok(_) => panic!("loaded:\n{text}"),
+        Err(e) => e.to_string(),
+    }
+}
+
+#[test]
+fn factor_seed_and_kpi_names_cannot_be_table_columns_or_each_other() {
+    let d = tempfile::tempdir().unwrap();
+    let base = "system = \"sys.toml\"\n";
+    // a factor named like a table column, with its line
+    let e = load_err(
+        d.path(),
+        &format!("{base}[[factors]]\nname = \"run\"\nvariable = \"m.k\"\nvalues = [1, 2]\n"),
+    );
+    assert!(
+        e.contains("c.toml:2:") && e.contains("factor name 'run' is a column of the run tables"),
+        "{e}"
+    );
+    // a KPI named like one
+    let e = load_err(
+        d.path(),
+        &format!("{base}[[kpis]]\nname = \"status\"\nvariable = \"m.y\"\nstat = \"mean\"\n"),
+    );
+    assert!(
+        e.contains("c.toml:2:") && e.contains("kpi name 'status' is a column"),
+        "{e}"
+    );
+    // a KPI named like a factor
+    let e = load_err(
+        d.path(),
+        &format!(
+            "{base}[[factors]]\nname = \"k\"\nvariable = \"m.k\"\nvalues = [1, 2]\n\
+             [[kpis]]\nname = \"k\"\nvariable = \"m.y\"\nstat = \"mean\"\n"
+        ),
+    );
+    assert!(
+        e.contains("kpi 'k' has the name of a factor: the run tables would have two columns 'k'"),
+        "{e}"
+    );
+    // a derived KPI named like a table column
+    let e = load_err(
+        d.path(),
+        &format!(
+            "{base}[[kpis]]\nname = \"y\"\nvariable = \"m.y\"\nstat = \"mean\"\n\
+             [[derived]]\nname = \"key\"\nexpr = \"y * 2\"\n"
+        ),
+    );
+    assert!(e.contains("derived kpi name 'key' is a column"), "{e}");
+}
+
+/// A campaign of the C test FMU in `dir`: `sys.toml` and `NAME.toml` with the factor values.
+fn tiny_campaign(dir: &Path, name: &str, values: &str) -> std::path::PathBuf {
+    common::test_fmu(dir);
+    common::write_system(
+        dir,
+        "sys.toml",
+        "[simulation]\nstop_time = 0.2\nstep_size = 0.1\n[[instances]]\nname = \"m\"\n\
+         fmu = \"testfmu.fmu\"\nparameters = { u = 1.0 }\n",
+    );
+    common::write_system(
+        dir,
+        &format!("{name}.toml"),
+        &format!(
+            "system = \"sys.toml\"\n[[factors]]\nvariable = \"m.k\"\nvalues = {values}\n\
+             [[kpis]]\nname = \"y_mean\"\nvariable = \"m.y\"\nstat = \"mean\"\n"
+        ),
+    )
+}
+
+fn shipsim(dir: &Path, args: &[&str]) -> (bool, String) {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_shipsim"))
+        .current_dir(dir)
+        .args(args)
+        .output()
+        .unwrap();
+    (
+        out.status.success(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+#[test]
+fn a_refused_second_process_writes_nothing_into_the_folder() {
+    let d = tempfile::tempdir().unwrap();
+    tiny_campaign(d.path(), "a", "[1, 2]");
+    let (ok, err) = shipsim(d.path(), &["campaign", "run", "a.toml", "-o", "out", "-q"]);
+    assert!(ok, "{err}");
+    let provenance = std::fs::read(d.path().join("out/campaign.json")).unwrap();
+    // another process holds the folder (a campaign running into it)
+    let held = std::fs::OpenOptions::new()
+        .read(true)
+        .append(true)
+        .open(d.path().join("out/runs.jsonl"))
+        .unwrap();
+    held.lock().unwrap();
+    tiny_campaign(d.path(), "b", "[1, 2, 3]");
+    let (ok, err) = shipsim(d.path(), &["campaign", "run", "b.toml", "-o", "out", "-q"]);
+    assert!(
+        !ok && err.contains("is in use by another shipsim process"),
+        "{err}"
+    );
+    assert_eq!(
+        std::fs::read(d.path().join("out/campaign.json")).unwrap(),
+        provenance,
+        "campaign.json was rewritten by the refused run"
+    );
+}
