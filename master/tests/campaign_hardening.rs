@@ -117,3 +117,30 @@ fn a_refused_second_process_writes_nothing_into_the_folder() {
         "campaign.json was rewritten by the refused run"
     );
 }
+
+#[test]
+fn jobs_are_at_least_one_and_at_most_the_runs_and_four_per_core() {
+    let d = tempfile::tempdir().unwrap();
+    tiny_campaign(d.path(), "a", "[1, 2, 3]");
+    let (ok, err) = shipsim(
+        d.path(),
+        &["campaign", "run", "a.toml", "-o", "zero", "-j", "0"],
+    );
+    assert!(
+        !ok && err.contains("jobs = 0: a campaign needs at least one job"),
+        "{err}"
+    );
+    assert!(!d.path().join("zero/campaign.json").exists());
+    // a million threads were started before: now three runs take three jobs
+    let start = std::time::Instant::now();
+    let (ok, err) = shipsim(
+        d.path(),
+        &["campaign", "run", "a.toml", "-o", "many", "-j", "1000000"],
+    );
+    assert!(ok, "{err}");
+    assert!(
+        err.contains("on 3 job(s) (1000000 jobs asked, at most"),
+        "{err}"
+    );
+    assert!(start.elapsed() < std::time::Duration::from_secs(30));
+}

@@ -799,10 +799,20 @@ impl PyCampaign {
         &self,
         py: Python<'py>,
         output: PathBuf,
-        jobs: Option<usize>,
+        jobs: Option<i64>,
         retry_failed: bool,
         progress: Option<Bound<'py, PyAny>>,
     ) -> PyResult<(String, Bound<'py, PyDict>)> {
+        // any integer is accepted here so that a wrong one gets a message, not an OverflowError
+        let jobs = match jobs {
+            Some(n) if n < 1 => {
+                return Err(pyo3::exceptions::PyValueError::new_err(format!(
+                    "jobs = {n}: a campaign needs at least one job (jobs=N, N >= 1)"
+                )))
+            }
+            Some(n) => Some(usize::try_from(n).unwrap_or(usize::MAX)),
+            None => None,
+        };
         let interrupt = Arc::new(AtomicBool::new(false));
         let logs = Logs::default();
         let count = Arc::new(Count::default());

@@ -235,3 +235,13 @@ def test_a_failing_progress_callback_stops_the_campaign(forked, tmp_path):
         c._native.run(str(tmp_path / "out"), jobs=1, progress=boom)
     table = c.run(tmp_path / "out", jobs=2, progress=False)
     assert sorted(table["run"]) == list(range(16))
+
+
+@pytest.mark.parametrize("jobs", [0, -1])
+def test_jobs_below_one_are_a_clear_error(forked, tmp_path, jobs):
+    """jobs=-1 raised a bare OverflowError, jobs=0 ran on a default; both say what is wrong,
+    before anything is written."""
+    c = shipsim.Campaign.load(forked)
+    with pytest.raises(ValueError, match=f"jobs = {jobs}: a campaign needs at least one job"):
+        c.run(tmp_path / "out", jobs=jobs, progress=False)
+    assert not (tmp_path / "out" / "campaign.json").exists()

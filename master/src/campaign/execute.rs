@@ -375,6 +375,7 @@ impl Context<'_> {
 /// Runs the campaign's runs of this shard that are not done yet. See the module documentation.
 pub fn run(campaign: &Campaign, opts: &CampaignOptions) -> Result<CampaignOutcome> {
     let begin = Instant::now();
+    at_least_one_job(opts.jobs)?;
     let dir = &opts.output;
     std::fs::create_dir_all(dir)
         .map_err(|e| Error::io(format!("cannot create output folder {}", dir.display()), e))?;
@@ -387,7 +388,7 @@ pub fn run(campaign: &Campaign, opts: &CampaignOptions) -> Result<CampaignOutcom
         &crate::fmu::Unpack::default(),
         &foreign_isolation(),
     )?;
-    let (jobs, jobs_note) = jobs_for(&fmus, opts.jobs);
+    let (jobs, jobs_note) = jobs_for(&fmus, opts.jobs, campaign.runs.len())?;
     let mut outcome = CampaignOutcome {
         total: campaign.runs.len(),
         jobs,
@@ -454,21 +455,45 @@ fn foreign_isolation() -> Isolation {
 /// The worker threads to use (every core by default), and why they were limited: an FMU in
 /// process that can be instantiated only once per process allows one (isolated, each instance
 /// has a process of its own).
-fn jobs_for(fmus: &[Arc<Fmu>], jobs: Option<usize>) -> (usize, Option<String>) {
-    let jobs = jobs.unwrap_or_else(rayon::current_num_threads).max(1);
-    match fmus
-        .iter()
-        .find(|f| f.is_loaded() && f.co_simulation().can_be_instantiated_only_once_per_process)
-    {
-        Some(f) if jobs > 1 => (
-            1,
-            Some(format!(
-                "{} declares canBeInstantiatedOnlyOncePerProcess: one job (it is built by this project, so it runs in process)",
-                f.path.display()
-            )),
-        ),
-        _ => (jobs, None),
+fn at_least_one_job(jobs: Option<usize>) -> Result<()> {
+    if jobs == Some(0) {
+        return Err(Error::Other(
+            "jobs = 0: a campaign needs at least one job (-j N, Python jobs=N, N >= 1)".into(),
+        ));
     }
+    Ok(())
+}
+
+/// At most this many jobs per core: a run is CPU-bound, so more threads only add switching.
+pub const JOBS_PER_CORE: usize = 4;
+
+/// The number of jobs (threads) for `runs` runs: `jobs` (default: one per core), never 0,
+/// never more than the runs nor [`JOBS_PER_CORE`] per core, and 1 for an FMU that can be
+/// instantiated once per process; with a note when it is not what was asked.
+fn jobs_for(
+    fmus: &[Arc<Fmu>],
+    jobs: Option<usize>,
+    runs: usize,
+) -> Result<(usize, Option<String>)> {
+    at_least_one_job(jobs)?;
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let most = JOBS_PER_CORE * cores;
+    let asked = jobs.unwrap_or_else(rayon::current_num_threads);
+    let mut note = (asked > most).then(|| {
+        format!("{asked} jobs asked, at most {most}: {JOBS_PER_CORE} per core on {cores} cores")
+    });
+    let jobs = asked.min(most).min(runs.max(1));
+    let once = fmus
+        .iter()
+        .find(|f| f.is_loaded() && f.co_simulation().can_be_instantiated_only_once_per_process);
+    if let (Some(f), true) = (once, jobs > 1) {
+        note = Some(format!(
+            "{} declares canBeInstantiatedOnlyOncePerProcess: one job (it is built by this project, so it runs in process)",
+            f.path.display()
+        ));
+        return Ok((1, note));
+    }
+    Ok((jobs, note))
 }
 
 impl<'a> Context<'a> {
@@ -567,7 +592,7 @@ pub(super) fn run_collect(
             })
         })
         .collect::<Result<Vec<&Run>>>()?;
-    let (jobs, _) = jobs_for(fmus, opts.jobs);
+    let (jobs, _) = jobs_for(fmus, opts.jobs, todo.len())?;
     let mds: Vec<&ModelDescription> = fmus.iter().map(|f| &f.model_description).collect();
     let fork = fork_plan(campaign, &mds)?;
     let ctx = Context {
