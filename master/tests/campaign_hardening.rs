@@ -144,3 +144,46 @@ fn jobs_are_at_least_one_and_at_most_the_runs_and_four_per_core() {
     );
     assert!(start.elapsed() < std::time::Duration::from_secs(30));
 }
+
+#[test]
+fn journal_lines_that_do_not_match_the_campaign_are_errors_naming_the_line() {
+    let d = tempfile::tempdir().unwrap();
+    tiny_campaign(d.path(), "a", "[1, 2]");
+    let (ok, err) = shipsim(d.path(), &["campaign", "run", "a.toml", "-o", "out", "-q"]);
+    assert!(ok, "{err}");
+    let journal = d.path().join("out/runs.jsonl");
+    let good = std::fs::read_to_string(&journal).unwrap();
+    let first = good.lines().next().unwrap().to_string();
+    let record: serde_json::Value = serde_json::from_str(&first).unwrap();
+    let with = |f: &dyn Fn(&mut serde_json::Value)| {
+        let mut r = record.clone();
+        f(&mut r);
+        format!("{good}{r}\n")
+    };
+    // a record with fewer KPI values than the campaign defines (it panicked: index out of bounds)
+    std::fs::write(&journal, with(&|r| r["kpis"] = serde_json::json!([]))).unwrap();
+    for args in [
+        &["campaign", "run", "a.toml", "-o", "out", "-q"][..],
+        &["campaign", "merge", "out", "-o", "merged"][..],
+    ] {
+        let (ok, err) = shipsim(d.path(), args);
+        assert!(!ok, "{args:?}");
+        assert!(
+            err.contains("runs.jsonl:3: the record of run ")
+                && err.contains(" has 0 KPI values where the campaign has 1"),
+            "{args:?}: {err}"
+        );
+        assert!(!err.contains("panicked"), "{err}");
+    }
+    // the same run twice with another result: an error, not "the last line wins"
+    std::fs::write(&journal, with(&|r| r["kpis"] = serde_json::json!([123.0]))).unwrap();
+    let (ok, err) = shipsim(d.path(), &["campaign", "run", "a.toml", "-o", "out", "-q"]);
+    assert!(
+        !ok && err.contains("is recorded twice with different results, on lines 1 and 3"),
+        "{err}"
+    );
+    // the same run twice with the same result (another wall time): kept once
+    std::fs::write(&journal, with(&|r| r["wall_time"] = serde_json::json!(9.5))).unwrap();
+    let (ok, err) = shipsim(d.path(), &["campaign", "run", "a.toml", "-o", "out"]);
+    assert!(ok && err.contains("2 were done before"), "{err}");
+}

@@ -381,7 +381,7 @@ pub fn run(campaign: &Campaign, opts: &CampaignOptions) -> Result<CampaignOutcom
         .map_err(|e| Error::io(format!("cannot create output folder {}", dir.display()), e))?;
     // The folder's lock first (the journal holds it): a second process on the folder is refused
     // before it writes anything, campaign.json included.
-    let journal = Journal::open(dir)?;
+    let journal = Journal::open(dir, output::kpi_columns(&campaign.spec).len())?;
     output::check_or_write_provenance(campaign, dir, opts.shard)?;
     let fmus = run::load_fmus_with(
         &campaign.system,

@@ -88,6 +88,35 @@ pub struct RunRecord {
     pub wall_time: f64,
 }
 
+impl RunRecord {
+    /// The same run with the same outcome: index, key, status, message and KPI values (bit for
+    /// bit, NaN equal to NaN); the wall time may differ.
+    pub fn same_result(&self, other: &RunRecord) -> bool {
+        let bits = |r: &RunRecord| -> Vec<Option<u64>> {
+            r.kpis
+                .iter()
+                .map(|k| match k {
+                    JsonKpi::Number(x) => Some(x.map_or(u64::MAX, f64::to_bits)),
+                    JsonKpi::Verdict(_) => None,
+                })
+                .collect()
+        };
+        let verdicts = |r: &RunRecord| -> Vec<Option<String>> {
+            r.kpis
+                .iter()
+                .map(|k| match k {
+                    JsonKpi::Verdict(s) => Some(s.clone()),
+                    JsonKpi::Number(_) => None,
+                })
+                .collect()
+        };
+        (self.index, &self.key, self.status, &self.message)
+            == (other.index, &other.key, other.status, &other.message)
+            && bits(self) == bits(other)
+            && verdicts(self) == verdicts(other)
+    }
+}
+
 /// The journal file, open for appending.
 pub struct Journal {
     path: PathBuf,
@@ -97,9 +126,12 @@ pub struct Journal {
 }
 
 impl Journal {
-    /// Opens (or creates) `dir/runs.jsonl`, reading the runs already done and dropping a
-    /// partial last line.
-    pub fn open(dir: &Path) -> Result<Journal> {
+    /// Opens (or creates) `dir/runs.jsonl` of a campaign with `kpis` KPI columns, reading the
+    /// runs already done and dropping a partial last line. A line that is not a run record of
+    /// this campaign (another number of KPI values) is an error naming the file and line; so is
+    /// a run recorded twice with different results, unless the first failed (a retry, which
+    /// replaces it). A run recorded twice with the same results is kept once.
+    pub fn open(dir: &Path, kpis: usize) -> Result<Journal> {
         let path = crate::output_path::writable(&dir.join("runs.jsonl"))?;
         let io = |what: &str, e| Error::io(format!("{what} {}", path.display()), e);
         let mut file = OpenOptions::new()
@@ -132,13 +164,39 @@ impl Journal {
             file.seek(SeekFrom::End(0))
                 .map_err(|e| io("cannot seek in", e))?;
         }
-        let mut records = HashMap::new();
+        let mut records: HashMap<String, RunRecord> = HashMap::new();
+        let mut lines: HashMap<String, usize> = HashMap::new();
         for (n, line) in text[..complete].split(|b| *b == b'\n').enumerate() {
             if line.is_empty() {
                 continue;
             }
-            let r: RunRecord = serde_json::from_slice(line)
-                .map_err(|e| Error::system(&path, Some(n + 1), format!("not a run record: {e}")))?;
+            let at = |m: String| Error::system(&path, Some(n + 1), m);
+            let r: RunRecord =
+                serde_json::from_slice(line).map_err(|e| at(format!("not a run record: {e}")))?;
+            if r.kpis.len() != kpis {
+                return Err(at(format!(
+                    "the record of run {} has {} KPI values where the campaign has {kpis}: \
+                     not a journal of this campaign",
+                    r.index,
+                    r.kpis.len()
+                )));
+            }
+            match records.get(&r.key) {
+                Some(old) if old.status.failed() => {}
+                Some(old) if old.same_result(&r) => continue,
+                Some(_) => {
+                    return Err(at(format!(
+                        "run {} (key {}) is recorded twice with different results, on lines \
+                         {} and {}; remove the wrong line",
+                        r.index,
+                        r.key,
+                        lines[&r.key],
+                        n + 1
+                    )))
+                }
+                None => {}
+            }
+            lines.insert(r.key.clone(), n + 1);
             records.insert(r.key.clone(), r);
         }
         Ok(Journal {

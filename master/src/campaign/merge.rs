@@ -60,6 +60,12 @@ pub fn merge(inputs: &[PathBuf], out: &Path) -> Result<MergeReport> {
         ));
     };
     let prov = Provenance::read(first)?;
+    // the KPIs of every input are the first's (their hashes are compared below)
+    let kpis = output::kpi_columns(&CampaignSpec::parse(
+        &prov.campaign_file,
+        &prov.campaign_text,
+    )?)
+    .len();
     let mut records: HashMap<String, RunRecord> = HashMap::new();
     let mut duplicates = 0;
     for dir in inputs {
@@ -76,7 +82,7 @@ pub fn merge(inputs: &[PathBuf], out: &Path) -> Result<MergeReport> {
         if !dir.join("runs.jsonl").exists() {
             continue;
         }
-        for r in Journal::open(dir)?.records() {
+        for r in Journal::open(dir, kpis)?.records() {
             match records.get(&r.key) {
                 Some(old) => {
                     duplicates += 1;
@@ -106,7 +112,7 @@ pub fn merge(inputs: &[PathBuf], out: &Path) -> Result<MergeReport> {
     merged_prov.shard = None;
     let text = serde_json::to_string_pretty(&merged_prov).expect("serializable");
     // the output folder's lock before anything is written into it
-    let mut journal = Journal::open(out)?;
+    let mut journal = Journal::open(out, kpis)?;
     write_atomic(&out.join("campaign.json"), text.as_bytes())?;
     let mut found = 0;
     let mut missing = Vec::new();

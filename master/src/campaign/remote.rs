@@ -45,10 +45,12 @@ impl Collector {
     pub fn open(campaign: &Campaign, dir: &Path, retry_failed: bool) -> Result<Collector> {
         std::fs::create_dir_all(dir)
             .map_err(|e| Error::io(format!("cannot create output folder {}", dir.display()), e))?;
+        // the folder's lock (the journal's) before anything is written into it
+        let journal = Journal::open(dir, output::kpi_columns(&campaign.spec).len())?;
         output::check_or_write_provenance(campaign, dir, None)?;
         Ok(Collector {
             dir: dir.to_path_buf(),
-            journal: Journal::open(dir)?,
+            journal,
             retry_failed,
             recorded: HashSet::new(),
         })
@@ -143,7 +145,8 @@ pub fn run_table(campaign: &Campaign, journal: &Journal) -> Table {
 
 /// The run table of a campaign's output folder (from its journal).
 pub fn read_run_table(campaign: &Campaign, dir: &Path) -> Result<Table> {
-    Ok(run_table(campaign, &Journal::open(dir)?))
+    let kpis = output::kpi_columns(&campaign.spec).len();
+    Ok(run_table(campaign, &Journal::open(dir, kpis)?))
 }
 
 /// A worker's side: the campaign and its FMUs, each loaded once for the life of the worker.
