@@ -101,6 +101,18 @@ fn unpack_into_temp(
     unpack: &Unpack,
     only_platform: Option<&str>,
 ) -> Result<tempfile::TempDir> {
+    match crate::limits::regular(path) {
+        Err(crate::limits::ReadError::NotRegular(what)) => {
+            return Err(Error::fmu(
+                path,
+                format!("is {what}; an FMU is a zip archive (a .fmu file)"),
+            ))
+        }
+        Err(crate::limits::ReadError::Io(e)) => {
+            return Err(Error::fmu(path, format!("cannot open: {e}")))
+        }
+        _ => {}
+    }
     let file =
         std::fs::File::open(path).map_err(|e| Error::fmu(path, format!("cannot open: {e}")))?;
     if file.metadata().is_ok_and(|m| m.is_dir()) {

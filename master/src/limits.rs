@@ -58,6 +58,8 @@ pub enum ReadError {
     Io(std::io::Error),
     /// A directory where a file was expected.
     Directory,
+    /// A device, FIFO or socket where a file was expected (what it is).
+    NotRegular(&'static str),
     /// Larger than the limit (the limit in bytes).
     TooLarge(u64),
     /// Not UTF-8 (the offset of the first invalid byte).
@@ -69,6 +71,7 @@ impl std::fmt::Display for ReadError {
         match self {
             ReadError::Io(e) => write!(f, "{e}"),
             ReadError::Directory => write!(f, "it is a directory"),
+            ReadError::NotRegular(what) => write!(f, "it is {what}, not a regular file"),
             ReadError::TooLarge(max) => write!(
                 f,
                 "it is larger than {}, the most shipsim reads",
@@ -82,8 +85,30 @@ impl std::fmt::Display for ReadError {
 /// Reads a UTF-8 text file of at most `max` bytes. A larger file (or an endless one such as
 /// `/dev/zero`) is refused after reading `max + 1` bytes: memory stays bounded by the limit.
 pub fn read_limited(path: &Path, max: u64) -> std::result::Result<String, ReadError> {
+    regular(path)?;
     let file = std::fs::File::open(path).map_err(ReadError::Io)?;
     read_limited_from(file, max)
+}
+
+/// Refuses, before opening it, a path (after its links) that is a directory, a device, a FIFO
+/// or a socket: opening a FIFO blocks until a writer comes, reading a device may never end.
+pub fn regular(path: &Path) -> std::result::Result<(), ReadError> {
+    use std::os::unix::fs::FileTypeExt;
+    let t = match std::fs::metadata(path) {
+        Ok(m) => m.file_type(),
+        Err(e) => return Err(ReadError::Io(e)),
+    };
+    if t.is_file() {
+        Ok(())
+    } else if t.is_dir() {
+        Err(ReadError::Directory)
+    } else if t.is_fifo() {
+        Err(ReadError::NotRegular("a FIFO (named pipe)"))
+    } else if t.is_socket() {
+        Err(ReadError::NotRegular("a socket"))
+    } else {
+        Err(ReadError::NotRegular("a device"))
+    }
 }
 
 /// [`read_limited`] on an open file.
@@ -98,6 +123,7 @@ pub fn read_limited_from(file: std::fs::File, max: u64) -> std::result::Result<S
 /// The bytes of a file of at most `max` bytes (a binary file: a checkpoint), refused like
 /// [`read_limited`] when larger.
 pub fn read_bytes_limited(path: &Path, max: u64) -> std::result::Result<Vec<u8>, ReadError> {
+    regular(path)?;
     let file = std::fs::File::open(path).map_err(ReadError::Io)?;
     if file.metadata().is_ok_and(|m| m.is_dir()) {
         return Err(ReadError::Directory);

@@ -1,6 +1,7 @@
 //! Every system, campaign and model-description file is read with a bound (issue 19, defect
-//! 7): `/dev/zero` as a system file grew to 6.5 GB before; now it is refused at once, naming
-//! the file and the limit. The binary runs with a 4 GB address-space limit, so the old
+//! 7): `/dev/zero` as a system file grew to 6.5 GB before; a file larger than the limit is
+//! refused, naming the file and the limit, and a device, FIFO or socket is refused before it is
+//! opened (issue 38, item 11: a FIFO blocked `open` forever). The binary runs with a 4 GB address-space limit, so the old
 //! unbounded read fails instead of filling the machine.
 mod common;
 mod hardening;
@@ -15,7 +16,7 @@ fn endless_system_file_is_refused() {
         assert_eq!(code, Some(1), "{cmd}: {err}");
         assert!(
             err.contains(
-                "/dev/zero: cannot read the system file: it is larger than 64 MiB, the most shipsim reads"
+                "/dev/zero: cannot read the system file: it is a device, not a regular file"
             ),
             "{cmd}: {err}"
         );
@@ -24,7 +25,47 @@ fn endless_system_file_is_refused() {
     std::os::unix::fs::symlink("/dev/zero", s.path().join("OspSystemStructure.xml")).unwrap();
     let (code, err) = s.run(&["run", "OspSystemStructure.xml"]);
     assert_eq!(code, Some(1), "{err}");
-    assert!(err.contains("it is larger than 64 MiB"), "{err}");
+    assert!(err.contains("it is a device, not a regular file"), "{err}");
+    // A regular file over the limit (sparse: 65 MiB of zeros) is refused after 64 MiB + 1 bytes.
+    let big = std::fs::File::create(s.path().join("big.toml")).unwrap();
+    big.set_len(65 << 20).unwrap();
+    let (code, err) = s.run(&["check", "big.toml"]);
+    assert_eq!(code, Some(1), "{err}");
+    assert!(
+        err.contains(
+            "big.toml: cannot read the system file: it is larger than 64 MiB, the most shipsim reads"
+        ),
+        "{err}"
+    );
+}
+
+/// A FIFO as a system, campaign or FMU file is refused before it is opened (opening one blocks
+/// until a writer comes: `timeout 3 shipsim check fifo` took 13 s and a SIGKILL).
+#[test]
+fn fifos_are_refused_before_they_block() {
+    let s = Sandbox::new();
+    let fifo = s.path().join("fifo.toml");
+    let c = std::ffi::CString::new(fifo.to_str().unwrap()).unwrap();
+    // SAFETY: a valid NUL-terminated path.
+    assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0);
+    for (args, what) in [
+        (&["check", "fifo.toml"][..], "cannot read the system file"),
+        (
+            &["campaign", "run", "fifo.toml"][..],
+            "cannot read the campaign file",
+        ),
+        (
+            &["inspect", "fifo.toml"][..],
+            "is a FIFO (named pipe); an FMU is a zip archive",
+        ),
+    ] {
+        let (code, err) = s.run(args);
+        assert_eq!(code, Some(1), "{args:?}: {err}");
+        assert!(
+            err.contains(what) && err.contains("FIFO (named pipe)"),
+            "{args:?}: {err}"
+        );
+    }
 }
 
 #[test]
@@ -34,7 +75,7 @@ fn endless_campaign_file_is_refused() {
     let (code, err) = s.run(&["campaign", "run", "c.toml"]);
     assert_eq!(code, Some(1), "{err}");
     assert!(
-        err.contains("c.toml: cannot read the campaign file: it is larger than 64 MiB"),
+        err.contains("c.toml: cannot read the campaign file: it is a device, not a regular file"),
         "{err}"
     );
 }
@@ -64,7 +105,7 @@ fn endless_checkpoint_is_refused() {
     let (code, err) = s.run(&["run", "s.toml", "--resume", "cp.bin", "-o", "out.csv"]);
     assert_eq!(code, Some(1), "{err}");
     assert!(
-        err.contains("checkpoint file cp.bin: cannot read it: it is larger than 1 GiB"),
+        err.contains("checkpoint file cp.bin: cannot read it: it is a device, not a regular file"),
         "{err}"
     );
     assert!(s.leftovers().is_empty(), "{:?}", s.leftovers());
