@@ -187,3 +187,30 @@ fn journal_lines_that_do_not_match_the_campaign_are_errors_naming_the_line() {
     let (ok, err) = shipsim(d.path(), &["campaign", "run", "a.toml", "-o", "out"]);
     assert!(ok && err.contains("2 were done before"), "{err}");
 }
+
+#[test]
+fn a_mistake_every_run_would_make_is_one_error_before_anything_runs() {
+    let d = tempfile::tempdir().unwrap();
+    tiny_campaign(d.path(), "a", "[1, 2]");
+    // an unknown KPI variable: every run was recorded as an error, and the exit status was 0
+    std::fs::write(
+        d.path().join("bad.toml"),
+        "system = \"sys.toml\"\n[[factors]]\nvariable = \"m.k\"\nvalues = [1, 2]\n\
+         [[kpis]]\nname = \"y_mean\"\nvariable = \"m.nope\"\nstat = \"mean\"\n",
+    )
+    .unwrap();
+    let (ok, err) = shipsim(
+        d.path(),
+        &["campaign", "run", "bad.toml", "-o", "out", "-q"],
+    );
+    assert!(!ok, "{err}");
+    assert!(
+        err.contains("run 0 cannot run, and so no run of the campaign would")
+            && err.contains("nope"),
+        "{err}"
+    );
+    assert!(
+        !d.path().join("out").exists(),
+        "the output folder was created"
+    );
+}

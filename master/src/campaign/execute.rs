@@ -376,6 +376,12 @@ impl Context<'_> {
 pub fn run(campaign: &Campaign, opts: &CampaignOptions) -> Result<CampaignOutcome> {
     let begin = Instant::now();
     at_least_one_job(opts.jobs)?;
+    let fmus = run::load_fmus_with(
+        &campaign.system,
+        &crate::fmu::Unpack::default(),
+        &foreign_isolation(),
+    )?;
+    validate_first_runs(campaign, &fmus)?;
     let dir = &opts.output;
     std::fs::create_dir_all(dir)
         .map_err(|e| Error::io(format!("cannot create output folder {}", dir.display()), e))?;
@@ -383,11 +389,6 @@ pub fn run(campaign: &Campaign, opts: &CampaignOptions) -> Result<CampaignOutcom
     // before it writes anything, campaign.json included.
     let journal = Journal::open(dir, output::kpi_columns(&campaign.spec).len())?;
     output::check_or_write_provenance(campaign, dir, opts.shard)?;
-    let fmus = run::load_fmus_with(
-        &campaign.system,
-        &crate::fmu::Unpack::default(),
-        &foreign_isolation(),
-    )?;
     let (jobs, jobs_note) = jobs_for(&fmus, opts.jobs, campaign.runs.len())?;
     let mut outcome = CampaignOutcome {
         total: campaign.runs.len(),
@@ -427,6 +428,36 @@ pub fn run(campaign: &Campaign, opts: &CampaignOptions) -> Result<CampaignOutcom
     outcome.files = output::write_tables(&campaign.spec, &campaign.runs, &journal, dir)?;
     outcome.wall = begin.elapsed();
     Ok(outcome)
+}
+
+/// Validates the system of the first run of each arm (of the campaign, when it has no arms)
+/// against the FMUs, as `shipsim check` validates a system, before anything runs or is
+/// written: a mistake every run would make (an unknown KPI or seed variable, a value out of
+/// its variable's range, a stop time that cannot be) is one error instead of a campaign of
+/// failed runs. Values that only some runs take still fail those runs, which are recorded.
+fn validate_first_runs(campaign: &Campaign, fmus: &[Arc<Fmu>]) -> Result<()> {
+    let mds: Vec<&ModelDescription> = fmus.iter().map(|f| &f.model_description).collect();
+    let arms = campaign.spec.arms.len().max(1);
+    for arm in 0..arms {
+        let Some(run) = campaign.runs.iter().find(|r| r.arm == arm) else {
+            continue;
+        };
+        campaign
+            .system_for(run)
+            .and_then(|s| s.validate(&mds).map(drop))
+            .map_err(|e| {
+                Error::Other(format!(
+                    "campaign {}: run {} cannot run, and so no run of {} would: {e}",
+                    campaign.spec.source.display(),
+                    run.index,
+                    match campaign.spec.arms.get(arm) {
+                        Some(a) => format!("arm '{}'", a.name),
+                        None => "the campaign".to_string(),
+                    }
+                ))
+            })?;
+    }
+    Ok(())
 }
 
 /// Whether a run still has to run: not in the journal, or failed there and retried.
