@@ -15,6 +15,7 @@ Usage (from the repository root, after `cargo build --release -p shipsim` and th
     python master/bench/bench_events.py [--repeat 3] [--sizes 8000 16000 32000]
 """
 import argparse
+import json
 import os
 import pathlib
 import statistics
@@ -36,7 +37,7 @@ def system_text(fmu, n):
         "",
         "[[instances]]",
         'name = "ap"',
-        f"fmu = {str(fmu)!r}".replace("'", '"'),
+        f"fmu = {json.dumps(str(fmu))}",  # a JSON string is a TOML basic string
         "",
     ]
     for i in range(n):
