@@ -448,12 +448,13 @@ fn bench(extra: &[String]) -> Result<()> {
     let campaigns = script("bench_campaign.py", &[])?;
     let python_pkg = script("bench_python.py", &[])?;
     let isolated = script("bench_isolated.py", &[])?;
+    let events = script("bench_events.py", &[])?;
     let variants = variants()?;
     let doc = format!(
         "# Benchmarks\n\nWritten by `cargo xtask bench` (do not edit by hand). Ratios are \
          measured in one run on one machine; absolute times depend on it.\n\n\
          ## Master overhead per FMU-step (master/bench/bench_master.py)\n\n```text\n{master}```\n\n\
-         {systems}\n{campaigns}\n{python_pkg}\n{isolated}\n{variants}"
+         {systems}\n{campaigns}\n{python_pkg}\n{isolated}\n{events}\n{variants}"
     );
     std::fs::write(root.join("docs/bench.md"), doc)?;
     println!("wrote docs/bench.md");

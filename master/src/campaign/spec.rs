@@ -292,6 +292,7 @@ fn value(v: &toml::Value) -> Option<Value> {
 struct Reader<'a> {
     path: &'a Path,
     text: &'a str,
+    lines: crate::format::LineIndex,
     errors: Vec<Error>,
 }
 
@@ -305,12 +306,15 @@ impl CampaignSpec {
     /// Checks the text of a campaign file read from `path`.
     pub fn parse(path: &Path, text: &str) -> Result<CampaignSpec> {
         let raw: Raw = toml::from_str(text).map_err(|e| {
-            let line = e.span().map(|s| crate::format::line_of(text, s.start));
+            let line = e
+                .span()
+                .map(|s| crate::format::LineIndex::new(text).line(s.start));
             Error::system(path, line, e.message().to_string())
         })?;
         let mut r = Reader {
             path,
             text,
+            lines: crate::format::LineIndex::new(text),
             errors: Vec::new(),
         };
         let spec = r.spec(raw);
@@ -321,7 +325,7 @@ impl CampaignSpec {
 
 impl Reader<'_> {
     fn line(&self, span: std::ops::Range<usize>) -> Option<usize> {
-        Some(crate::format::line_of(self.text, span.start))
+        Some(self.lines.line(span.start))
     }
 
     fn error(&mut self, line: Option<usize>, message: String) {

@@ -35,9 +35,30 @@ impl System {
     }
 }
 
-/// 1-based line of a byte offset.
-pub fn line_of(text: &str, offset: usize) -> usize {
-    text[..offset.min(text.len())].matches('\n').count() + 1
+/// The line numbers of one text: the offsets of its newlines, found once, so that each lookup
+/// is a binary search. A reader that numbers every entry of a file builds one and reads in
+/// linear time (counting the newlines before each entry took 30 s for 32,000 `[[events]]`,
+/// issue 36).
+pub struct LineIndex {
+    newlines: Vec<usize>,
+}
+
+impl LineIndex {
+    pub fn new(text: &str) -> LineIndex {
+        let newlines = text
+            .bytes()
+            .enumerate()
+            .filter(|&(_, b)| b == b'\n')
+            .map(|(i, _)| i)
+            .collect();
+        LineIndex { newlines }
+    }
+
+    /// 1-based line of a byte offset: one more than the newlines before it (an offset past
+    /// the end is on the last line).
+    pub fn line(&self, offset: usize) -> usize {
+        self.newlines.partition_point(|&n| n < offset) + 1
+    }
 }
 
 /// The errors a reader collected, as one error (or `Ok` when there are none).
@@ -66,4 +87,30 @@ pub(crate) fn isolation_left_out(sys: &crate::system::System, format: &str) -> O
             isolated.join(",")
         )
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::LineIndex;
+
+    /// The index gives every offset the line a count of the newlines before it gives.
+    #[test]
+    fn line_index_counts_the_newlines_before_an_offset() {
+        for text in [
+            "",
+            "a",
+            "\n",
+            "a\nb",
+            "a\r\nb\n\nc\n",
+            "é\nü\n\nx",
+            "\n\n\n",
+        ] {
+            let lines = LineIndex::new(text);
+            for offset in 0..text.len() + 3 {
+                let before = &text.as_bytes()[..offset.min(text.len())];
+                let count = before.iter().filter(|&&b| b == b'\n').count();
+                assert_eq!(lines.line(offset), count + 1, "{text:?} at {offset}");
+            }
+        }
+    }
 }

@@ -7,7 +7,7 @@
 //! a `LinearTransformation` function between two `SignalConnection`s -> a connection with gain
 //! (`factor`) and `offset`. Events and outputs have no place in this file; `export-osp` says so.
 
-use super::{collected, line_of};
+use super::{collected, LineIndex};
 use crate::error::{Error, Result};
 use crate::model_description::{Causality, ModelDescription, ScalarVariable, VarType};
 use crate::system::{
@@ -174,15 +174,11 @@ struct SignalEndpoint {
     name: String,
 }
 
-/// Line of the first occurrence of `needle` (OSP errors point at the element when they can).
-fn line_of_needle(text: &str, needle: &str) -> Option<usize> {
-    text.find(needle).map(|p| line_of(text, p))
-}
-
 /// One reading of an `OspSystemStructure.xml`.
 struct Reader<'t> {
     path: &'t Path,
     text: &'t str,
+    lines: LineIndex,
     errors: Vec<Error>,
     /// Simulator name -> its FMU (variable groups are read from beside it).
     fmus: HashMap<String, PathBuf>,
@@ -204,6 +200,7 @@ pub fn parse(path: &Path, text: &str) -> Result<System> {
     let mut r = Reader {
         path,
         text,
+        lines: LineIndex::new(text),
         errors: Vec::new(),
         fmus: HashMap::new(),
         groups: HashMap::new(),
@@ -249,8 +246,10 @@ impl Reader<'_> {
         self.errors.push(Error::system(self.path, line, message));
     }
 
+    /// Line of the first occurrence of `needle` (OSP errors point at the element when they
+    /// can).
     fn line_of(&self, needle: &str) -> Option<usize> {
-        line_of_needle(self.text, needle)
+        self.text.find(needle).map(|p| self.lines.line(p))
     }
 
     fn algorithm(&mut self, a: Option<&str>) -> Algorithm {

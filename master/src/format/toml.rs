@@ -74,7 +74,7 @@
 //!
 //! Errors name the file and line; all errors of a file are reported together.
 
-use super::{collected, line_of};
+use super::{collected, LineIndex};
 use crate::error::{Error, Result};
 use crate::system::{
     Algorithm, ConnectionSpec, EventSpec, Format, InstanceSpec, LastStep, OutputSpec, System,
@@ -179,10 +179,10 @@ fn toml_value(v: &toml::Value) -> Option<Value> {
     })
 }
 
-/// One reading of a TOML system file: where it is, its text, and the errors found so far.
+/// One reading of a TOML system file: where it is, its lines, and the errors found so far.
 struct Reader<'t> {
     path: &'t Path,
-    text: &'t str,
+    lines: LineIndex,
     dir: &'t Path,
     errors: Vec<Error>,
 }
@@ -192,7 +192,7 @@ pub fn parse(path: &Path, text: &str) -> Result<System> {
     let raw: RawSystem = toml::from_str(text).map_err(|e| parse_error(path, text, &e))?;
     let mut r = Reader {
         path,
-        text,
+        lines: LineIndex::new(text),
         dir: path.parent().unwrap_or(Path::new(".")),
         errors: Vec::new(),
     };
@@ -246,7 +246,7 @@ impl Reader<'_> {
     }
 
     fn line(&self, span: std::ops::Range<usize>) -> Option<usize> {
-        Some(line_of(self.text, span.start))
+        Some(self.lines.line(span.start))
     }
 
     fn error(&mut self, line: Option<usize>, message: String) {
@@ -481,7 +481,7 @@ fn short_connection(s: &str) -> std::result::Result<Link, String> {
 /// first table, and a key holds one value, so `connections = [...]` and `[[connections]]`
 /// tables cannot both be in one file.
 fn parse_error(path: &Path, text: &str, e: &toml::de::Error) -> Error {
-    let line = e.span().map(|s| line_of(text, s.start));
+    let line = e.span().map(|s| LineIndex::new(text).line(s.start));
     let msg = e.message().trim();
     const LIST: &str = "connections = [\"a.y -> b.u\", \"c.y -> d.u, gain = 2.5, convert\", { from = \"e.y\", to = \"f.u\", offset = 1.0 }]";
     let explained = if msg.contains("duplicate key `connections`") {

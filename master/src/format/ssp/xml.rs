@@ -7,6 +7,7 @@
 //! cannot exhaust the stack or the memory.
 
 use crate::error::{Error, Result};
+use crate::format::LineIndex;
 use quick_xml::events::{BytesStart, Event};
 use std::path::Path;
 
@@ -45,8 +46,8 @@ impl Element {
 }
 
 /// 1-based line of a byte offset.
-fn line_at(text: &str, pos: u64) -> usize {
-    super::super::line_of(text, usize::try_from(pos).unwrap_or(usize::MAX))
+fn line_at(lines: &LineIndex, pos: u64) -> usize {
+    lines.line(usize::try_from(pos).unwrap_or(usize::MAX))
 }
 
 fn start(e: &BytesStart, line: usize, path: &Path) -> Result<Element> {
@@ -85,7 +86,8 @@ pub fn parse(path: &Path, text: &str) -> Result<Element> {
     let mut stack: Vec<Element> = Vec::new();
     let mut root: Option<Element> = None;
     let mut count = 0usize;
-    let bad = |pos: u64, msg: String| Error::system(path, Some(line_at(text, pos)), msg);
+    let lines = LineIndex::new(text);
+    let bad = |pos: u64, msg: String| Error::system(path, Some(line_at(&lines, pos)), msg);
     loop {
         let pos = reader.buffer_position();
         let event = reader
@@ -111,7 +113,7 @@ pub fn parse(path: &Path, text: &str) -> Result<Element> {
                         ),
                     ));
                 }
-                stack.push(start(&e, line_at(text, pos), path)?);
+                stack.push(start(&e, line_at(&lines, pos), path)?);
             }
             Event::Empty(e) => {
                 count += 1;
@@ -121,7 +123,7 @@ pub fn parse(path: &Path, text: &str) -> Result<Element> {
                         format!("the XML has more than {MAX_ELEMENTS} elements"),
                     ));
                 }
-                let el = start(&e, line_at(text, pos), path)?;
+                let el = start(&e, line_at(&lines, pos), path)?;
                 match stack.last_mut() {
                     Some(parent) => parent.children.push(el),
                     None => root = Some(el),
