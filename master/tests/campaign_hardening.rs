@@ -205,8 +205,7 @@ fn a_mistake_every_run_would_make_is_one_error_before_anything_runs() {
     );
     assert!(!ok, "{err}");
     assert!(
-        err.contains("run 0 cannot run, and so no run of the campaign would")
-            && err.contains("nope"),
+        err.contains("run 0 cannot run, and no run would") && err.contains("nope"),
         "{err}"
     );
     assert!(

@@ -432,32 +432,34 @@ pub fn run(campaign: &Campaign, opts: &CampaignOptions) -> Result<CampaignOutcom
 
 /// Validates the system of the first run of each arm (of the campaign, when it has no arms)
 /// against the FMUs, as `shipsim check` validates a system, before anything runs or is
-/// written: a mistake every run would make (an unknown KPI or seed variable, a value out of
-/// its variable's range, a stop time that cannot be) is one error instead of a campaign of
-/// failed runs. Values that only some runs take still fail those runs, which are recorded.
+/// written. When every one fails, the mistake is one that every run would make (an unknown KPI
+/// or seed variable, a campaign-wide value out of its variable's range, a stop time that cannot
+/// be): one error instead of a campaign of failed runs. A mistake of some arms or values only
+/// fails those runs, which are recorded.
 fn validate_first_runs(campaign: &Campaign, fmus: &[Arc<Fmu>]) -> Result<()> {
     let mds: Vec<&ModelDescription> = fmus.iter().map(|f| &f.model_description).collect();
-    let arms = campaign.spec.arms.len().max(1);
-    for arm in 0..arms {
+    let mut first_error = None;
+    for arm in 0..campaign.spec.arms.len().max(1) {
         let Some(run) = campaign.runs.iter().find(|r| r.arm == arm) else {
             continue;
         };
-        campaign
+        match campaign
             .system_for(run)
             .and_then(|s| s.validate(&mds).map(drop))
-            .map_err(|e| {
-                Error::Other(format!(
-                    "campaign {}: run {} cannot run, and so no run of {} would: {e}",
-                    campaign.spec.source.display(),
-                    run.index,
-                    match campaign.spec.arms.get(arm) {
-                        Some(a) => format!("arm '{}'", a.name),
-                        None => "the campaign".to_string(),
-                    }
-                ))
-            })?;
+        {
+            Ok(()) => return Ok(()),
+            Err(e) if first_error.is_none() => first_error = Some((run.index, e)),
+            Err(_) => {}
+        }
     }
-    Ok(())
+    match first_error {
+        None => Ok(()),
+        Some((index, e)) => Err(Error::Other(format!(
+            "campaign {}: run {index} cannot run, and no run would (the first run of every arm \
+             fails the same checks): {e}",
+            campaign.spec.source.display(),
+        ))),
+    }
 }
 
 /// Whether a run still has to run: not in the journal, or failed there and retried.
