@@ -213,3 +213,40 @@ fn a_mistake_every_run_would_make_is_one_error_before_anything_runs() {
         "the output folder was created"
     );
 }
+
+#[test]
+fn derived_expressions_are_bounded_and_checked_at_load() {
+    let d = tempfile::tempdir().unwrap();
+    tiny_campaign(d.path(), "a", "[1, 2]");
+    let base = std::fs::read_to_string(d.path().join("a.toml")).unwrap();
+    // 2^2^...^2 with 100,000 operators took a minute to parse, after every run had run
+    let long = vec!["2"; 100_000].join("^");
+    std::fs::write(
+        d.path().join("long.toml"),
+        format!("{base}[[derived]]\nname = \"big\"\nexpr = \"y_mean * {long}\"\n"),
+    )
+    .unwrap();
+    let start = std::time::Instant::now();
+    let (ok, err) = shipsim(
+        d.path(),
+        &["campaign", "run", "long.toml", "-o", "out", "-q"],
+    );
+    assert!(
+        !ok && err.contains("characters, more than the 1000 a derived expression may have"),
+        "{err}"
+    );
+    assert!(start.elapsed() < std::time::Duration::from_secs(10));
+    assert!(!d.path().join("out").exists());
+    // an unknown KPI in a derived expression is found before the runs, not after them
+    std::fs::write(
+        d.path().join("typo.toml"),
+        format!("{base}[[derived]]\nname = \"twice\"\nexpr = \"2 * y_maen\"\n"),
+    )
+    .unwrap();
+    let (ok, err) = shipsim(
+        d.path(),
+        &["campaign", "run", "typo.toml", "-o", "out", "-q"],
+    );
+    assert!(!ok && err.contains("no KPI 'y_maen'"), "{err}");
+    assert!(!d.path().join("out").exists());
+}

@@ -10,6 +10,41 @@ use super::spec::CampaignSpec;
 use crate::error::{Error, Result};
 use exmex::{Express, FlatEx};
 
+/// The longest derived expression [characters] and its deepest nesting of parentheses: real
+/// expressions are a line; the parser's time grows faster than the length (`2^2^...^2` with
+/// 100,000 operators took a minute).
+pub const MAX_EXPRESSION_CHARS: usize = 1000;
+pub const MAX_EXPRESSION_DEPTH: usize = 32;
+
+/// Refuses an expression over [`MAX_EXPRESSION_CHARS`] or nested deeper than
+/// [`MAX_EXPRESSION_DEPTH`].
+fn bounded(expr: &str) -> std::result::Result<(), String> {
+    let chars = expr.chars().count();
+    if chars > MAX_EXPRESSION_CHARS {
+        return Err(format!(
+            "{chars} characters, more than the {MAX_EXPRESSION_CHARS} a derived expression may have"
+        ));
+    }
+    let (mut depth, mut deepest) = (0usize, 0usize);
+    for c in expr.chars() {
+        match c {
+            '(' => {
+                depth += 1;
+                deepest = deepest.max(depth);
+            }
+            ')' => depth = depth.saturating_sub(1),
+            _ => {}
+        }
+    }
+    if deepest > MAX_EXPRESSION_DEPTH {
+        return Err(format!(
+            "parentheses nested {deepest} deep, more than the {MAX_EXPRESSION_DEPTH} a derived \
+             expression may have"
+        ));
+    }
+    Ok(())
+}
+
 /// One compiled derived KPI.
 pub struct DerivedKpi {
     pub name: String,
@@ -63,6 +98,7 @@ impl DerivedKpi {
                         d.expr
                     ))
                 };
+                bounded(&d.expr).map_err(err)?;
                 let text = braced(&d.expr);
                 let expr = FlatEx::<f64>::parse(&text).map_err(|e| err(e.to_string()))?;
                 let mut inputs = Vec::new();
@@ -110,6 +146,19 @@ impl DerivedKpi {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn long_or_deep_expressions_are_refused() {
+        assert!(bounded("100 * (1 - a[on] / a[off])").is_ok());
+        let long = vec!["2"; 100_000].join("^");
+        assert!(bounded(&long)
+            .unwrap_err()
+            .contains("199999 characters, more than the 1000"));
+        let deep = format!("{}1{}", "(".repeat(40), ")".repeat(40));
+        assert!(bounded(&deep)
+            .unwrap_err()
+            .contains("nested 40 deep, more than the 32"));
+    }
 
     #[test]
     fn arm_references_become_single_variables() {

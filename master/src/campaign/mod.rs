@@ -76,6 +76,8 @@ impl Campaign {
     /// elsewhere): records the KPI variables, hashes the system file and FMUs, expands the runs.
     pub fn new(spec: CampaignSpec, mut system: System) -> Result<Campaign> {
         system.apply_stop_time(spec.stop_time)?;
+        // derived expressions are checked now, not after every run has run
+        derived::DerivedKpi::compile(&spec, &output::kpi_columns(&spec))?;
         let mut variables: Vec<String> = Vec::new();
         let series = spec.series.iter().flat_map(|s| s.variables.iter().cloned());
         for v in spec
