@@ -18,10 +18,9 @@ use std::path::{Path, PathBuf};
 /// The file to write for the output path `path` (see the module documentation): `path` itself,
 /// or for a symbolic link to a regular file, that file.
 pub fn writable(path: &Path) -> Result<PathBuf> {
-    let meta = match std::fs::symlink_metadata(path) {
-        Ok(m) => m,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(path.to_path_buf()),
-        Err(e) => return Err(Error::io(format!("output {}", path.display()), e)),
+    let Ok(meta) = std::fs::symlink_metadata(path) else {
+        // nothing there (or a folder on the way that is not one): creating it says why not
+        return Ok(path.to_path_buf());
     };
     if meta.file_type().is_file() {
         return Ok(path.to_path_buf());

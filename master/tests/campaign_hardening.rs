@@ -250,3 +250,63 @@ fn derived_expressions_are_bounded_and_checked_at_load() {
     assert!(!ok && err.contains("no KPI 'y_maen'"), "{err}");
     assert!(!d.path().join("out").exists());
 }
+
+/// Column `name` of a CSV table.
+fn csv_column(path: &Path, name: &str) -> Vec<String> {
+    let mut r = csv::Reader::from_path(path).unwrap();
+    let at = r.headers().unwrap().iter().position(|h| h == name).unwrap();
+    r.records().map(|x| x.unwrap()[at].to_string()).collect()
+}
+
+#[test]
+fn non_finite_kpis_are_not_recorded_as_ok() {
+    let d = tempfile::tempdir().unwrap();
+    tiny_campaign(d.path(), "a", "[1, 2]");
+    let base = std::fs::read_to_string(d.path().join("a.toml")).unwrap();
+    // a window after the run's end: refused when the campaign is loaded
+    std::fs::write(
+        d.path().join("late.toml"),
+        format!("{base}[[kpis]]\nname = \"late\"\nvariable = \"m.y\"\nstat = \"max\"\nwindow = [5, 10]\n"),
+    )
+    .unwrap();
+    let (ok, err) = shipsim(
+        d.path(),
+        &["campaign", "run", "late.toml", "-o", "late", "-q"],
+    );
+    assert!(
+        !ok && err.contains("kpi 'late': its window [5, 10] starts after the run ends"),
+        "{err}"
+    );
+    // a window between two samples holds none (NaN), a derived x / 0 is infinite
+    std::fs::write(
+        d.path().join("gap.toml"),
+        format!(
+            "{base}[[kpis]]\nname = \"gap\"\nvariable = \"m.y\"\nstat = \"max\"\n\
+             window = [0.13, 0.14]\n[[derived]]\nname = \"ratio\"\nexpr = \"y_mean / 0\"\n"
+        ),
+    )
+    .unwrap();
+    let (ok, err) = shipsim(
+        d.path(),
+        &["campaign", "run", "gap.toml", "-o", "gap", "-q"],
+    );
+    assert!(ok, "{err}");
+    let status = csv_column(&d.path().join("gap/runs.csv"), "status");
+    assert_eq!(status, ["non_finite_kpi", "non_finite_kpi"]);
+    let message = csv_column(&d.path().join("gap/runs.csv"), "message");
+    assert!(message[0].starts_with("KPI 'gap' is NaN"), "{message:?}");
+    std::fs::write(
+        d.path().join("inf.toml"),
+        format!("{base}[[derived]]\nname = \"ratio\"\nexpr = \"y_mean / 0\"\n"),
+    )
+    .unwrap();
+    let (ok, err) = shipsim(
+        d.path(),
+        &["campaign", "run", "inf.toml", "-o", "inf", "-q"],
+    );
+    assert!(ok, "{err}");
+    assert_eq!(
+        csv_column(&d.path().join("inf/derived.csv"), "status"),
+        ["non_finite", "non_finite"]
+    );
+}

@@ -492,7 +492,8 @@ fn errors_name_the_problem() {
         None,
         &PlotOptions::new(dir.join("d.png")),
     ));
-    assert!(e.contains("cannot write") && e.contains("d.png"), "{e}");
+    // an output that exists and is not a regular file is refused (issue 38, item 2)
+    assert!(e.contains("d.png is a directory; an output must be a regular file"), "{e}");
     let e = err(line_band(
         &t,
         "wave_dir",

@@ -272,6 +272,25 @@ impl Recorder for RunRecorders<'_> {
 }
 
 /// How a run's execution ends: the master's result and the recorders.
+/// "KPI 'x' is NaN (...)" for the first window statistic that is not finite.
+fn non_finite_stat(specs: &[super::kpi::KpiSpec], values: &[KpiValue]) -> Option<String> {
+    let mut at = 0;
+    for k in specs {
+        let columns = k.columns();
+        if let (super::kpi::KpiSpec::Stat { .. }, Some(KpiValue::Number(x))) = (k, values.get(at)) {
+            if !x.is_finite() {
+                return Some(format!(
+                    "KPI '{}' is {x}: its window holds no sample of the run, or the statistic \
+                     overflowed",
+                    columns[0]
+                ));
+            }
+        }
+        at += columns.len();
+    }
+    None
+}
+
 fn classify(
     result: std::thread::Result<Result<run::Summary>>,
     recorders: &RunRecorders<'_>,
@@ -290,10 +309,15 @@ fn classify(
                 Some(m) => (Status::Terminated, m),
                 None => (Status::Ok, String::new()),
             };
+            let kpis = recorders.kpis.values();
+            let (status, message) = match non_finite_stat(specs, &kpis) {
+                Some(m) => (Status::NonFiniteKpi, m),
+                None => (status, message),
+            };
             Outcome::Done {
                 status,
                 message,
-                kpis: recorders.kpis.values(),
+                kpis,
                 wall,
             }
         }

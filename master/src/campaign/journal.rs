@@ -32,6 +32,9 @@ pub enum Status {
     Nan,
     /// The master panicked (a bug): the run is recorded, the campaign goes on.
     Panic,
+    /// The run ended, but a window statistic is NaN or infinite (an empty window, an
+    /// overflow): its value is not a result.
+    NonFiniteKpi,
 }
 
 impl Status {
@@ -42,6 +45,7 @@ impl Status {
             Status::Error => "error",
             Status::Nan => "nan",
             Status::Panic => "panic",
+            Status::NonFiniteKpi => "non_finite_kpi",
         }
     }
 

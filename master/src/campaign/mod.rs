@@ -55,6 +55,28 @@ pub fn file_hash(path: &Path) -> Result<String> {
     Ok(design::hex(&hasher.finalize()))
 }
 
+/// Every KPI window holds part of the run: a window that starts after the stop time gives every
+/// run a NaN statistic.
+fn windows_fit(spec: &CampaignSpec, system: &System) -> Result<()> {
+    let Some(stop) = system.stop_time else {
+        return Ok(());
+    };
+    for k in &spec.kpis {
+        if let kpi::KpiSpec::Stat { name, window, .. } = k {
+            if window.0 > stop {
+                return Err(Error::Other(format!(
+                    "campaign {}: kpi '{name}': its window [{}, {}] starts after the run ends \
+                     (stop time {stop} s), so it would hold no sample",
+                    spec.source.display(),
+                    window.0,
+                    window.1
+                )));
+            }
+        }
+    }
+    Ok(())
+}
+
 impl Campaign {
     /// Reads a campaign file and its base system, and expands the runs.
     pub fn load(path: &Path) -> Result<Campaign> {
@@ -78,6 +100,7 @@ impl Campaign {
         system.apply_stop_time(spec.stop_time)?;
         // derived expressions are checked now, not after every run has run
         derived::DerivedKpi::compile(&spec, &output::kpi_columns(&spec))?;
+        windows_fit(&spec, &system)?;
         let mut variables: Vec<String> = Vec::new();
         let series = spec.series.iter().flat_map(|s| s.variables.iter().cloned());
         for v in spec

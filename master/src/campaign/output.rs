@@ -257,19 +257,24 @@ pub fn derived_table(
                 .collect()
         })
         .collect();
-    for d in &kpis {
-        t.push(
-            &d.name,
-            ColumnData::Float(values.iter().map(|v| d.eval(v)).collect()),
-        );
+    let derived: Vec<Vec<f64>> = kpis
+        .iter()
+        .map(|d| values.iter().map(|v| d.eval(v)).collect())
+        .collect();
+    for (d, column) in kpis.iter().zip(&derived) {
+        t.push(&d.name, ColumnData::Float(column.clone()));
     }
     let status = rows
         .iter()
-        .map(|(_, recs)| {
+        .enumerate()
+        .map(|(i, (_, recs))| {
             if recs.iter().any(Option::is_none) {
                 "incomplete".to_string()
             } else if recs.iter().any(|r| r.is_some_and(|r| r.status.failed())) {
                 "failed".to_string()
+            } else if derived.iter().any(|c| !c[i].is_finite()) {
+                // x[on] / 0 and the like: a value that is not a result
+                "non_finite".to_string()
             } else {
                 "ok".to_string()
             }
