@@ -493,7 +493,10 @@ fn errors_name_the_problem() {
         &PlotOptions::new(dir.join("d.png")),
     ));
     // an output that exists and is not a regular file is refused (issue 38, item 2)
-    assert!(e.contains("d.png is a directory; an output must be a regular file"), "{e}");
+    assert!(
+        e.contains("d.png is a directory; an output must be a regular file"),
+        "{e}"
+    );
     let e = err(line_band(
         &t,
         "wave_dir",
