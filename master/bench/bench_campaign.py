@@ -81,7 +81,7 @@ def run(exe, text, d, name, jobs):
     r = subprocess.run([exe, "campaign", "run", "-j", str(jobs), "-o", str(out), str(f)],
                        capture_output=True, text=True, check=True)
     wall = time.perf_counter() - t
-    m = re.search(r"(\d+) of (\d+) runs in this shard ran \((\d+) failed\)", r.stderr)
+    m = re.search(r"(\d+) of (\d+) runs (?:of shard \S+ )?ran \((\d+) failed\)", r.stderr)
     ran, failed = int(m.group(1)), int(m.group(3))
     assert failed == 0, r.stderr
     return wall, ran

@@ -310,3 +310,22 @@ fn non_finite_kpis_are_not_recorded_as_ok() {
         ["non_finite", "non_finite"]
     );
 }
+
+/// The summary names a shard only when there is one (issue 36, item 11: it said "20 of 20 runs
+/// in this shard ran" without --shard).
+#[test]
+fn the_summary_names_the_shard_only_with_one() {
+    let d = tempfile::tempdir().unwrap();
+    tiny_campaign(d.path(), "a", "[1, 2, 3, 4]");
+    let (ok, err) = shipsim(d.path(), &["campaign", "run", "a.toml", "-o", "all"]);
+    assert!(ok && err.contains("4 of 4 runs ran (0 failed)"), "{err}");
+    assert!(!err.contains("shard"), "{err}");
+    let (ok, err) = shipsim(
+        d.path(),
+        &["campaign", "run", "a.toml", "-o", "half", "--shard", "0/2"],
+    );
+    assert!(
+        ok && err.contains("2 of 2 runs of shard 0/2 ran (0 failed)"),
+        "{err}"
+    );
+}

@@ -81,6 +81,8 @@ pub struct CampaignOutcome {
     pub wall: Duration,
     /// The slowest run executed now: (index, wall time [s]).
     pub slowest: Option<(usize, f64)>,
+    /// The shard run (`--shard I/N`), if any.
+    pub shard: Option<(usize, usize)>,
     /// With forks: the runs per warm-up group (of this shard).
     pub groups: Option<Vec<usize>>,
     pub files: Vec<PathBuf>,
@@ -95,9 +97,13 @@ impl CampaignOutcome {
 
 impl std::fmt::Display for CampaignOutcome {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let shard = match self.shard {
+            Some((i, n)) => format!(" of shard {i}/{n}"),
+            None => String::new(),
+        };
         write!(
             f,
-            "{} of {} runs in this shard ran ({} failed), {} were done before; {:.1} s, {:.2} runs/s on {} job(s)",
+            "{} of {} runs{shard} ran ({} failed), {} were done before; {:.1} s, {:.2} runs/s on {} job(s)",
             self.ran,
             self.selected,
             self.failed,
@@ -418,6 +424,7 @@ pub fn run(campaign: &Campaign, opts: &CampaignOptions) -> Result<CampaignOutcom
         total: campaign.runs.len(),
         jobs,
         jobs_note,
+        shard: opts.shard,
         ..Default::default()
     };
     let mds: Vec<&ModelDescription> = fmus.iter().map(|f| &f.model_description).collect();
