@@ -79,23 +79,11 @@ fn tiny_campaign(dir: &Path, name: &str, values: &str) -> std::path::PathBuf {
     )
 }
 
-fn shipsim(dir: &Path, args: &[&str]) -> (bool, String) {
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_shipsim"))
-        .current_dir(dir)
-        .args(args)
-        .output()
-        .unwrap();
-    (
-        out.status.success(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
-
 #[test]
 fn a_refused_second_process_writes_nothing_into_the_folder() {
     let d = tempfile::tempdir().unwrap();
     tiny_campaign(d.path(), "a", "[1, 2]");
-    let (ok, err) = shipsim(d.path(), &["campaign", "run", "a.toml", "-o", "out", "-q"]);
+    let (ok, err) = common::shipsim_in(d.path(), &["campaign", "run", "a.toml", "-o", "out", "-q"]);
     assert!(ok, "{err}");
     let provenance = std::fs::read(d.path().join("out/campaign.json")).unwrap();
     // another process holds the folder (a campaign running into it)
@@ -106,7 +94,7 @@ fn a_refused_second_process_writes_nothing_into_the_folder() {
         .unwrap();
     held.lock().unwrap();
     tiny_campaign(d.path(), "b", "[1, 2, 3]");
-    let (ok, err) = shipsim(d.path(), &["campaign", "run", "b.toml", "-o", "out", "-q"]);
+    let (ok, err) = common::shipsim_in(d.path(), &["campaign", "run", "b.toml", "-o", "out", "-q"]);
     assert!(
         !ok && err.contains("is in use by another shipsim process"),
         "{err}"
@@ -122,7 +110,7 @@ fn a_refused_second_process_writes_nothing_into_the_folder() {
 fn jobs_are_at_least_one_and_at_most_the_runs_and_four_per_core() {
     let d = tempfile::tempdir().unwrap();
     tiny_campaign(d.path(), "a", "[1, 2, 3]");
-    let (ok, err) = shipsim(
+    let (ok, err) = common::shipsim_in(
         d.path(),
         &["campaign", "run", "a.toml", "-o", "zero", "-j", "0"],
     );
@@ -133,7 +121,7 @@ fn jobs_are_at_least_one_and_at_most_the_runs_and_four_per_core() {
     assert!(!d.path().join("zero/campaign.json").exists());
     // a million threads were started before: now three runs take three jobs
     let start = std::time::Instant::now();
-    let (ok, err) = shipsim(
+    let (ok, err) = common::shipsim_in(
         d.path(),
         &["campaign", "run", "a.toml", "-o", "many", "-j", "1000000"],
     );
@@ -149,7 +137,7 @@ fn jobs_are_at_least_one_and_at_most_the_runs_and_four_per_core() {
 fn journal_lines_that_do_not_match_the_campaign_are_errors_naming_the_line() {
     let d = tempfile::tempdir().unwrap();
     tiny_campaign(d.path(), "a", "[1, 2]");
-    let (ok, err) = shipsim(d.path(), &["campaign", "run", "a.toml", "-o", "out", "-q"]);
+    let (ok, err) = common::shipsim_in(d.path(), &["campaign", "run", "a.toml", "-o", "out", "-q"]);
     assert!(ok, "{err}");
     let journal = d.path().join("out/runs.jsonl");
     let good = std::fs::read_to_string(&journal).unwrap();
@@ -166,7 +154,7 @@ fn journal_lines_that_do_not_match_the_campaign_are_errors_naming_the_line() {
         &["campaign", "run", "a.toml", "-o", "out", "-q"][..],
         &["campaign", "merge", "out", "-o", "merged"][..],
     ] {
-        let (ok, err) = shipsim(d.path(), args);
+        let (ok, err) = common::shipsim_in(d.path(), args);
         assert!(!ok, "{args:?}");
         assert!(
             err.contains("runs.jsonl:3: the record of run ")
@@ -177,14 +165,14 @@ fn journal_lines_that_do_not_match_the_campaign_are_errors_naming_the_line() {
     }
     // the same run twice with another result: an error, not "the last line wins"
     std::fs::write(&journal, with(&|r| r["kpis"] = serde_json::json!([123.0]))).unwrap();
-    let (ok, err) = shipsim(d.path(), &["campaign", "run", "a.toml", "-o", "out", "-q"]);
+    let (ok, err) = common::shipsim_in(d.path(), &["campaign", "run", "a.toml", "-o", "out", "-q"]);
     assert!(
         !ok && err.contains("is recorded twice with different results, on lines 1 and 3"),
         "{err}"
     );
     // the same run twice with the same result (another wall time): kept once
     std::fs::write(&journal, with(&|r| r["wall_time"] = serde_json::json!(9.5))).unwrap();
-    let (ok, err) = shipsim(d.path(), &["campaign", "run", "a.toml", "-o", "out"]);
+    let (ok, err) = common::shipsim_in(d.path(), &["campaign", "run", "a.toml", "-o", "out"]);
     assert!(ok && err.contains("2 were done before"), "{err}");
 }
 
@@ -199,7 +187,7 @@ fn a_mistake_every_run_would_make_is_one_error_before_anything_runs() {
          [[kpis]]\nname = \"y_mean\"\nvariable = \"m.nope\"\nstat = \"mean\"\n",
     )
     .unwrap();
-    let (ok, err) = shipsim(
+    let (ok, err) = common::shipsim_in(
         d.path(),
         &["campaign", "run", "bad.toml", "-o", "out", "-q"],
     );
@@ -227,7 +215,7 @@ fn derived_expressions_are_bounded_and_checked_at_load() {
     )
     .unwrap();
     let start = std::time::Instant::now();
-    let (ok, err) = shipsim(
+    let (ok, err) = common::shipsim_in(
         d.path(),
         &["campaign", "run", "long.toml", "-o", "out", "-q"],
     );
@@ -243,7 +231,7 @@ fn derived_expressions_are_bounded_and_checked_at_load() {
         format!("{base}[[derived]]\nname = \"twice\"\nexpr = \"2 * y_maen\"\n"),
     )
     .unwrap();
-    let (ok, err) = shipsim(
+    let (ok, err) = common::shipsim_in(
         d.path(),
         &["campaign", "run", "typo.toml", "-o", "out", "-q"],
     );
@@ -269,7 +257,7 @@ fn non_finite_kpis_are_not_recorded_as_ok() {
         format!("{base}[[kpis]]\nname = \"late\"\nvariable = \"m.y\"\nstat = \"max\"\nwindow = [5, 10]\n"),
     )
     .unwrap();
-    let (ok, err) = shipsim(
+    let (ok, err) = common::shipsim_in(
         d.path(),
         &["campaign", "run", "late.toml", "-o", "late", "-q"],
     );
@@ -286,7 +274,7 @@ fn non_finite_kpis_are_not_recorded_as_ok() {
         ),
     )
     .unwrap();
-    let (ok, err) = shipsim(
+    let (ok, err) = common::shipsim_in(
         d.path(),
         &["campaign", "run", "gap.toml", "-o", "gap", "-q"],
     );
@@ -300,7 +288,7 @@ fn non_finite_kpis_are_not_recorded_as_ok() {
         format!("{base}[[derived]]\nname = \"ratio\"\nexpr = \"y_mean / 0\"\n"),
     )
     .unwrap();
-    let (ok, err) = shipsim(
+    let (ok, err) = common::shipsim_in(
         d.path(),
         &["campaign", "run", "inf.toml", "-o", "inf", "-q"],
     );
@@ -317,10 +305,10 @@ fn non_finite_kpis_are_not_recorded_as_ok() {
 fn the_summary_names_the_shard_only_with_one() {
     let d = tempfile::tempdir().unwrap();
     tiny_campaign(d.path(), "a", "[1, 2, 3, 4]");
-    let (ok, err) = shipsim(d.path(), &["campaign", "run", "a.toml", "-o", "all"]);
+    let (ok, err) = common::shipsim_in(d.path(), &["campaign", "run", "a.toml", "-o", "all"]);
     assert!(ok && err.contains("4 of 4 runs ran (0 failed)"), "{err}");
     assert!(!err.contains("shard"), "{err}");
-    let (ok, err) = shipsim(
+    let (ok, err) = common::shipsim_in(
         d.path(),
         &["campaign", "run", "a.toml", "-o", "half", "--shard", "0/2"],
     );

@@ -14,7 +14,7 @@ use shipsim::run::{
 };
 use shipsim::system::{Algorithm, EventSpec, Plan, System, Value, VarRef};
 use shipsim::Error;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::Command;
 use std::sync::Arc;
 
@@ -418,16 +418,6 @@ fn an_fmu_without_state_functions_is_refused_before_the_run() {
 }
 
 // ---- the command line ----
-
-/// systems/rrs.toml pointing at $SHIPSIM_FMU_DIR, in `dir`.
-fn rrs_file(dir: &Path) -> PathBuf {
-    let text =
-        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("../systems/rrs.toml"))
-            .unwrap();
-    let fmu_dir = our_fmu("RrsShip").parent().unwrap().to_path_buf();
-    let text = text.replace("../target/fmu/", &format!("{}/", fmu_dir.display()));
-    write_system(dir, "rrs.toml", &text)
-}
 
 /// `shipsim run SYSTEM --stop-time 30 -q ARGS`: (success, stderr).
 fn shipsim_run(system: &Path, args: &[&str]) -> (bool, String) {

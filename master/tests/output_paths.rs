@@ -7,8 +7,7 @@ mod common;
 use common::*;
 use shipsim::campaign::CampaignSpec;
 use std::os::unix::fs::FileTypeExt;
-use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::path::Path;
 
 fn mkfifo(path: &Path) {
     let c = std::ffi::CString::new(path.to_str().unwrap()).unwrap();
@@ -18,43 +17,6 @@ fn mkfifo(path: &Path) {
 
 fn is_fifo(path: &Path) -> bool {
     std::fs::symlink_metadata(path).is_ok_and(|m| m.file_type().is_fifo())
-}
-
-/// systems/rrs.toml pointing at $SHIPSIM_FMU_DIR, in `dir`.
-fn rrs_file(dir: &Path) -> PathBuf {
-    let text =
-        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("../systems/rrs.toml"))
-            .unwrap();
-    let fmu_dir = our_fmu("RrsShip").parent().unwrap().to_path_buf();
-    let text = text.replace("../target/fmu/", &format!("{}/", fmu_dir.display()));
-    write_system(dir, "rrs.toml", &text)
-}
-
-/// `shipsim ARGS` in `dir`, killed after 60 s (a write into a FIFO would block forever):
-/// (success, stderr).
-fn shipsim(dir: &Path, args: &[&str]) -> (bool, String) {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_shipsim"))
-        .current_dir(dir)
-        .args(args)
-        .stdout(std::process::Stdio::null())
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .unwrap();
-    let start = std::time::Instant::now();
-    loop {
-        if let Some(status) = child.try_wait().unwrap() {
-            let out = child.wait_with_output().unwrap();
-            return (
-                status.success(),
-                String::from_utf8_lossy(&out.stderr).into_owned(),
-            );
-        }
-        if start.elapsed() > std::time::Duration::from_secs(60) {
-            let _ = child.kill();
-            panic!("shipsim {args:?} did not end in 60 s");
-        }
-        std::thread::sleep(std::time::Duration::from_millis(20));
-    }
 }
 
 const CAMPAIGN: &str = r#"system = "sys.toml"
@@ -95,7 +57,7 @@ fn campaign_run_writes_nothing_outside_results_for_a_hostile_name() {
         format!("name = \"../../..\"\n{CAMPAIGN}"),
     )
     .unwrap();
-    let (ok, err) = shipsim(&work, &["campaign", "run", "c.toml", "-q"]);
+    let (ok, err) = shipsim_in(&work, &["campaign", "run", "c.toml", "-q"]);
     assert!(!ok && err.contains("must be one folder name"), "{err}");
     for stale in ["runs.csv", "runs.jsonl", "campaign.json"] {
         assert!(!d.path().join(stale).exists(), "{stale} written");
@@ -112,7 +74,7 @@ fn a_checkpoint_through_a_symbolic_link_writes_its_target_and_keeps_the_link() {
     std::fs::write(&target, "old").unwrap();
     let link = d.path().join("cp-link.bin");
     std::os::unix::fs::symlink(&target, &link).unwrap();
-    let (ok, err) = shipsim(
+    let (ok, err) = shipsim_in(
         d.path(),
         &[
             "run",
@@ -157,7 +119,7 @@ fn outputs_that_are_not_regular_files_are_refused_and_left_alone() {
         &["export-osp", sys, "-o", f],
     ];
     for args in cases {
-        let (ok, err) = shipsim(d.path(), args);
+        let (ok, err) = shipsim_in(d.path(), args);
         assert!(!ok, "{args:?} succeeded");
         assert!(
             err.contains("is a FIFO (named pipe); an output must be a regular file"),
@@ -165,6 +127,6 @@ fn outputs_that_are_not_regular_files_are_refused_and_left_alone() {
         );
         assert!(is_fifo(&fifo), "{args:?} replaced the FIFO");
     }
-    let (ok, err) = shipsim(d.path(), &["run", sys, "--stop-time", "1", "-q", "-o", "."]);
+    let (ok, err) = shipsim_in(d.path(), &["run", sys, "--stop-time", "1", "-q", "-o", "."]);
     assert!(!ok && err.contains("is a directory"), "{err}");
 }

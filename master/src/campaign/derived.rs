@@ -90,12 +90,18 @@ impl DerivedKpi {
         spec.derived
             .iter()
             .map(|d| {
+                // a refused long expression is quoted by its start only
+                let quoted: String = d.expr.chars().take(80).collect();
+                let more = if quoted.len() < d.expr.len() {
+                    "..."
+                } else {
+                    ""
+                };
                 let err = |m: String| {
                     Error::Other(format!(
-                        "campaign {}: derived kpi '{}' = \"{}\": {m}",
+                        "campaign {}: derived kpi '{}' = \"{quoted}{more}\": {m}",
                         spec.source.display(),
                         d.name,
-                        d.expr
                     ))
                 };
                 bounded(&d.expr).map_err(err)?;

@@ -177,3 +177,42 @@ pub fn run_memory(path: &Path) -> shipsim::run::MemoryRecorder {
 pub fn bits(xs: &[f64]) -> Vec<u64> {
     xs.iter().map(|x| x.to_bits()).collect()
 }
+
+/// systems/rrs.toml pointing at $SHIPSIM_FMU_DIR, written into `dir`.
+pub fn rrs_file(dir: &Path) -> PathBuf {
+    let text =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("../systems/rrs.toml"))
+            .unwrap();
+    let fmu_dir = our_fmu("RrsShip").parent().unwrap().to_path_buf();
+    let text = text.replace("../target/fmu/", &format!("{}/", fmu_dir.display()));
+    write_system(dir, "rrs.toml", &text)
+}
+
+/// `shipsim ARGS` in `dir`, killed after 60 s (a write into a FIFO would block forever):
+/// (success, stderr).
+pub fn shipsim_in(dir: &Path, args: &[&str]) -> (bool, String) {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_shipsim"))
+        .current_dir(dir)
+        .args(args)
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    // read stderr while waiting: a long message would fill the pipe and block the child
+    let mut pipe = child.stderr.take().unwrap();
+    let reader = std::thread::spawn(move || {
+        let mut text = String::new();
+        let _ = std::io::Read::read_to_string(&mut pipe, &mut text);
+        text
+    });
+    let start = std::time::Instant::now();
+    while child.try_wait().unwrap().is_none() {
+        if start.elapsed() > std::time::Duration::from_secs(60) {
+            let _ = child.kill();
+            panic!("shipsim {args:?} did not end in 60 s");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    let status = child.wait().unwrap();
+    (status.success(), reader.join().unwrap())
+}
