@@ -76,6 +76,8 @@ pub struct Fmu {
     pub unpacked: PathBuf,
     pub(crate) lib: Arc<FmuLibrary>,
     index: HashMap<String, usize>,
+    /// SHA-256 of the `.fmu` file, computed on first use ([`Fmu::archive_hash`]).
+    archive_hash: std::sync::OnceLock<String>,
 }
 
 impl std::fmt::Debug for Fmu {
@@ -602,6 +604,7 @@ impl Fmu {
                 _dir: unpacked.dir,
             }),
             index,
+            archive_hash: Default::default(),
         })
     }
 
@@ -623,6 +626,7 @@ impl Fmu {
                 _dir: unpacked.dir,
             }),
             index,
+            archive_hash: Default::default(),
         })
     }
 
@@ -640,6 +644,17 @@ impl Fmu {
 
     pub fn guid(&self) -> &str {
         &self.model_description.guid
+    }
+
+    /// SHA-256 (hex) of the `.fmu` file, read on the first call: it tells two builds of an FMU
+    /// apart where the GUID does not (a checkpoint's fingerprint). The file is read again
+    /// after loading, so one replaced in between is hashed as it is now.
+    pub fn archive_hash(&self) -> Result<&str> {
+        if let Some(h) = self.archive_hash.get() {
+            return Ok(h);
+        }
+        let h = crate::digest::file_sha256(&self.path)?;
+        Ok(self.archive_hash.get_or_init(|| h))
     }
 
     pub fn variable(&self, name: &str) -> Option<&ScalarVariable> {

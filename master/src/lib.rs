@@ -40,6 +40,7 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod campaign;
+pub mod digest;
 pub mod error;
 pub mod fmu;
 pub mod format;

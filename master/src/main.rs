@@ -90,8 +90,10 @@ enum Command {
         /// inside the run) and go on to the end.
         #[arg(long, num_args = 2, value_names = ["T", "FILE"])]
         checkpoint_at: Option<Vec<String>>,
-        /// Continue from a checkpoint of this system (same system file, --set and
-        /// --stop-time); the output has the rows from the checkpoint's time on.
+        /// Continue from a checkpoint of this system (same instances, FMU files, connections,
+        /// time grid, fixed parameters and events before it; a new value of a tunable
+        /// parameter or input, by --set or in the file, applies at the checkpoint's time); the
+        /// output has the rows from the checkpoint's time on.
         #[arg(long, value_name = "FILE")]
         resume: Option<PathBuf>,
         #[command(flatten)]
@@ -582,7 +584,7 @@ fn run_cli(
         // An FMU in process that calls exit() or hangs is named (cli/isolate.rs).
         monitor: Some(cli::isolate::guard(flags.isolation.call_timeout)),
     };
-    let (plan, fmus) = prepare_with(sys, &session.unpack(limits), &flags.isolation)?;
+    let (mut plan, fmus) = prepare_with(sys, &session.unpack(limits), &flags.isolation)?;
     print_warnings(&plan.warnings);
     if !quiet && !flags.no_output {
         output_note(sys, out_file.as_deref());
@@ -599,6 +601,9 @@ fn run_cli(
         None => run(&plan, &fmus, out, &opts)?,
         Some(file) => {
             let cp = Checkpoint::read(file)?;
+            for note in cp.adopt(&mut plan, &fmus) {
+                eprintln!("note: {note}");
+            }
             cp.check_plan(&plan, &fmus).map_err(|e| Error::Checkpoint {
                 file: file.clone(),
                 message: e.to_string(),

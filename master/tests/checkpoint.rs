@@ -311,15 +311,129 @@ fn a_checkpoint_from_another_system_is_refused() {
         e.contains("instance 'wind': FMU GUID") && e.contains("a different FMU"),
         "{e}"
     );
-    // A different start value is no difference: the restored states replace it.
+    // Start values and connection gains change the result: refused, naming them (issue 38,
+    // item 3; before, a resume under them gave a hybrid of the two systems).
     let mut other = sys.clone();
     other
         .apply_overrides(&["gear.time_constant=0.5".into()])
         .unwrap();
-    let fmus2 = load_fmus(&other).unwrap();
-    let tail = resumed(&plan(&other, &fmus2), &fmus2, &cp);
-    let full = full_run(&p, &fmus, &RunOptions::default());
-    assert!(tail == full[200..]);
+    let e = refused(&other);
+    assert!(
+        e.contains("gear.time_constant is 0.2 in the checkpoint, 0.5 in this system"),
+        "{e}"
+    );
+    let mut other = sys.clone();
+    other.connections[0].gain *= 10.0;
+    let e = refused(&other);
+    assert!(
+        e.contains("connection waves.roll_moment -> ship.roll_disturbance (gain 1, offset 0) in the checkpoint, waves.roll_moment -> ship.roll_disturbance (gain 10, offset 0) in this system"),
+        "{e}"
+    );
+    // An event before the checkpoint made the run it holds: one added there is refused.
+    let e = refused(&with_event(
+        &sys,
+        5.0,
+        "autopilot.roll_mode",
+        Value::Integer(0),
+    ));
+    assert!(
+        e.contains("0 event(s) before t = 10 s in the checkpoint, 1 in this system"),
+        "{e}"
+    );
+}
+
+/// Another build of an FMU under the same GUID is another FMU: refused, naming the instance.
+#[test]
+fn a_checkpoint_from_another_build_of_an_fmu_is_refused() {
+    let d = tempfile::tempdir().unwrap();
+    let sys = system("rrs.toml", 30.0, Algorithm::Jacobi);
+    let fmus = load_fmus(&sys).unwrap();
+    let cp =
+        run_to_checkpoint(&plan(&sys, &fmus), &fmus, 200, None, &RunOptions::default()).unwrap();
+    // The same archive with one more file: same GUID, other bytes.
+    let copy = d.path().join("SteeringGear.fmu");
+    std::fs::copy(&sys.instances[1].fmu, &copy).unwrap();
+    let file = std::fs::OpenOptions::new()
+        .read(true)
+        .write(true)
+        .open(&copy)
+        .unwrap();
+    let mut zip = zip::ZipWriter::new_append(file).unwrap();
+    zip.start_file(
+        "documentation/rebuilt.txt",
+        zip::write::SimpleFileOptions::default(),
+    )
+    .unwrap();
+    std::io::Write::write_all(&mut zip, b"another build").unwrap();
+    zip.finish().unwrap();
+    let mut other = sys.clone();
+    other.instances[1].fmu = copy;
+    let fmus = load_fmus(&other).unwrap();
+    assert_eq!(fmus[1].guid(), load_fmus(&sys).unwrap()[1].guid());
+    let e = resume_into(
+        &plan(&other, &fmus),
+        &fmus,
+        &cp,
+        None,
+        &RunOptions::default(),
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains("instance 'gear': the FMU file has SHA-256") && e.contains("another build"),
+        "{e}"
+    );
+}
+
+/// `Checkpoint::adopt`: a new value of a tunable parameter becomes an event at the
+/// checkpoint's step, so the resumed run is the cold run with that event, bit for bit.
+#[test]
+fn a_new_tunable_value_is_adopted_as_an_event_at_the_checkpoint() {
+    let sys = system("rrs.toml", 30.0, Algorithm::Jacobi);
+    let fmus = load_fmus(&sys).unwrap();
+    let cp =
+        run_to_checkpoint(&plan(&sys, &fmus), &fmus, 200, None, &RunOptions::default()).unwrap();
+    let mut changed = sys.clone();
+    changed
+        .apply_overrides(&[
+            "autopilot.roll_mode=0".into(),
+            "gear.time_constant=0.5".into(),
+        ])
+        .unwrap();
+    let mut p = plan(&changed, &fmus);
+    let notes = cp.adopt(&mut p, &fmus);
+    assert_eq!(notes.len(), 2, "{notes:?}");
+    assert!(
+        notes.iter().any(
+            |n| n.starts_with("gear.time_constant = 0.5: applied at t = 10 s")
+                && n.ends_with("(the checkpoint's run had 0.2)")
+        ),
+        "{notes:?}"
+    );
+    let tail = resumed(&p, &fmus, &cp);
+    let cold = with_event(&sys, 10.0, "autopilot.roll_mode", Value::Integer(0));
+    let cold = with_event(&cold, 10.0, "gear.time_constant", Value::Real(0.5));
+    let full = full_run(&plan(&cold, &fmus), &fmus, &RunOptions::default());
+    assert!(
+        tail == full[200..],
+        "the adopted resume differs from the cold run"
+    );
+    assert!(tail != full_run(&plan(&sys, &fmus), &fmus, &RunOptions::default())[200..]);
+    // A fixed parameter cannot change after initialization: left for `check` to refuse.
+    let mut fixed = sys.clone();
+    fixed
+        .apply_overrides(&["gear.servo_order=2".into()])
+        .unwrap();
+    let mut p = plan(&fixed, &fmus);
+    assert!(cp.adopt(&mut p, &fmus).is_empty());
+    let e = resume_into(&p, &fmus, &cp, None, &RunOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("gear.servo_order is not set in the checkpoint, 2 in this system")
+            && e.contains("a fixed parameter cannot change after initialization"),
+        "{e}"
+    );
 }
 
 #[test]
@@ -358,9 +472,21 @@ fn truncated_corrupt_and_hostile_files_are_clear_errors() {
         e.contains("4294967295 instances") && e.contains("truncated or corrupt"),
         "{e}"
     );
-    let mut b = bytes.clone();
-    b[8..12].copy_from_slice(&2u32.to_le_bytes());
-    assert!(decode_err(&b).contains("format version 2"));
+    // Version 1 (before the fingerprint covered connections, start values and events) and a
+    // future version.
+    for (v, said) in [
+        (1u32, "from an older shipsim: take the checkpoint again"),
+        (3, "from a newer shipsim"),
+    ] {
+        let mut b = bytes.clone();
+        b[8..12].copy_from_slice(&v.to_le_bytes());
+        let e = decode_err(&b);
+        assert!(
+            e.contains(&format!("format version {v}; this shipsim reads version 2"))
+                && e.contains(said),
+            "{e}"
+        );
+    }
     let mut b = bytes.clone();
     b.push(0);
     assert!(decode_err(&b).contains("checksum"));
@@ -505,6 +631,89 @@ fn cli_refuses_times_off_the_grid_and_truncated_files() {
     let (ok, err) = shipsim_run(&sys, &["--resume", &cp]);
     assert!(
         !ok && err.contains(&format!("checkpoint file {cp}: truncated")),
+        "{err}"
+    );
+}
+
+/// `--resume` with `--set` (issue 38, item 3): a tunable parameter's new value applies at the
+/// checkpoint's time, said in a note, and the rows are those of the cold run with that event
+/// (before, they were those of the unchanged run); a fixed parameter's new value and an edited
+/// connection gain are refused, naming them.
+#[test]
+fn cli_resume_applies_a_tunable_set_at_the_checkpoint_and_refuses_the_rest() {
+    let d = tempfile::tempdir().unwrap();
+    let sys = rrs_file(d.path());
+    let path = |n: &str| d.path().join(n).display().to_string();
+    let (ok, err) = shipsim_run(
+        &sys,
+        &[
+            "-o",
+            &path("full.csv"),
+            "--checkpoint-at",
+            "12.35",
+            &path("cp.bin"),
+        ],
+    );
+    assert!(ok, "{err}");
+    let text = std::fs::read_to_string(&sys).unwrap();
+    let cold = text.replace(
+        "\n[output]",
+        "\n[[events]]\ntime = 12.35\nset = \"autopilot.roll_mode\"\nvalue = 0\n\n[output]",
+    );
+    assert_ne!(cold, text);
+    let cold_sys = write_system(d.path(), "cold.toml", &cold);
+    let (ok, err) = shipsim_run(&cold_sys, &["-o", &path("cold.csv")]);
+    assert!(ok, "{err}");
+    let (ok, err) = shipsim_run(
+        &sys,
+        &[
+            "-o",
+            &path("tail.csv"),
+            "--resume",
+            &path("cp.bin"),
+            "--set",
+            "autopilot.roll_mode=0",
+        ],
+    );
+    assert!(ok, "{err}");
+    assert!(
+        err.contains("note: autopilot.roll_mode = 0: applied at t = 12.35 s, the checkpoint's time, as an event (the checkpoint's run had 1)"),
+        "{err}"
+    );
+    let read = |n: &str| std::fs::read_to_string(d.path().join(n)).unwrap();
+    let (full, cold, tail) = (read("full.csv"), read("cold.csv"), read("tail.csv"));
+    let lines = |t: &str| t.lines().map(str::to_string).collect::<Vec<_>>();
+    let (full, cold, tail) = (lines(&full), lines(&cold), lines(&tail));
+    assert_eq!(
+        tail[1..],
+        cold[1 + 247..],
+        "the resume is not the cold run with the event"
+    );
+    assert_ne!(tail[1..], full[1 + 247..], "roll_mode=0 changed nothing");
+
+    let (ok, err) = shipsim_run(
+        &sys,
+        &[
+            "--no-output",
+            "--resume",
+            &path("cp.bin"),
+            "--set",
+            "gear.servo_order=2",
+        ],
+    );
+    assert!(
+        !ok && err.contains("gear.servo_order is not set in the checkpoint, 2 in this system"),
+        "{err}"
+    );
+    let edited = write_system(
+        d.path(),
+        "edited.toml",
+        &text.replacen("convert = true", "convert = true\ngain = 10.0", 1),
+    );
+    let (ok, err) = shipsim_run(&edited, &["--no-output", "--resume", &path("cp.bin")]);
+    assert!(
+        !ok && err.contains(&format!("checkpoint file {}", path("cp.bin")))
+            && err.contains("(gain 10, offset 0) in this system"),
         "{err}"
     );
 }

@@ -47,12 +47,7 @@ pub struct Campaign {
 
 /// SHA-256 of a file's bytes, hex.
 pub fn file_hash(path: &Path) -> Result<String> {
-    let io = |e| Error::io(format!("cannot read {}", path.display()), e);
-    let mut file = std::fs::File::open(path).map_err(io)?;
-    // Streamed: an FMU of any size hashes in constant memory.
-    let mut hasher = Sha256::new();
-    std::io::copy(&mut file, &mut hasher).map_err(io)?;
-    Ok(design::hex(&hasher.finalize()))
+    crate::digest::file_sha256(path)
 }
 
 /// Every KPI window holds part of the run: a window that starts after the stop time gives every

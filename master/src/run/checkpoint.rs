@@ -13,11 +13,13 @@
 //! as usual: a warm-up run to t_k followed by runs that change a parameter at t_k (campaign
 //! forks) gives what a cold run with that change as an event at t_k gives.
 //!
-//! Its [`Fingerprint`] says which system it belongs to (instances and their FMUs' GUIDs, the
-//! time grid, the algorithm and stepping order, the exchanged and recorded variables); a
-//! checkpoint is refused by a plan whose fingerprint differs, naming the difference. Start
-//! values and events are not part of it: the restored states replace the start values, and
-//! events are what a fork changes. The file format is in [`file`].
+//! Its [`Fingerprint`] says which run it belongs to: the instances, their FMUs' GUIDs and
+//! archive hashes, the time grid, the algorithm and stepping order, the exchanged and recorded
+//! variables, the connections' gains, offsets and mappings, the start values and the events
+//! before it. A checkpoint is refused by a plan whose fingerprint differs, naming the
+//! difference, with one exception: events at the checkpoint's step and later are what a fork
+//! changes, and [`Checkpoint::adopt`] turns a new start value of a tunable parameter or input
+//! into such an event ([`settings`]). The file format is in [`file`].
 
 use super::exchange::Values;
 use super::slot::Slot;
@@ -29,6 +31,9 @@ use crate::system::{Algorithm, Plan};
 use std::sync::Arc;
 
 mod file;
+mod settings;
+
+pub use settings::{Coupling, Setting};
 
 /// A run at communication point t_`step` (see the module documentation).
 #[derive(Debug, Clone)]
@@ -64,6 +69,12 @@ pub struct Fingerprint {
     /// The variables the exchange reads (connection sources, then recorded outputs), which
     /// lay out [`Values`].
     pub observed: Vec<ObservedId>,
+    /// The connections' destinations and transformations, in plan order.
+    pub couplings: Vec<Coupling>,
+    /// The start values set, by instance.
+    pub starts: Vec<Setting>,
+    /// Every event of the plan; those before the checkpoint's step must agree.
+    pub events: Vec<Setting>,
 }
 
 /// An instance, its FMU and its rate.
@@ -71,6 +82,8 @@ pub struct Fingerprint {
 pub struct InstanceId {
     pub name: String,
     pub guid: String,
+    /// SHA-256 of the `.fmu` file ([`Fmu::archive_hash`]).
+    pub fmu_hash: String,
     pub step_multiple: u32,
 }
 
@@ -104,8 +117,9 @@ fn kind_code(t: crate::model_description::VarType) -> u8 {
 }
 
 impl Fingerprint {
-    /// The fingerprint of a plan run with `fmus` (`fmus[i]` for `plan.instances[i]`).
-    pub fn of(plan: &Plan, fmus: &[Arc<Fmu>]) -> Fingerprint {
+    /// The fingerprint of a plan run with `fmus` (`fmus[i]` for `plan.instances[i]`); an
+    /// FMU file that cannot be read again for its hash is an error.
+    pub fn of(plan: &Plan, fmus: &[Arc<Fmu>]) -> Result<Fingerprint> {
         let sources = plan.connections.iter().map(|c| ObservedId {
             instance: c.from_instance as u32,
             kind: kind_code(c.var_type),
@@ -118,7 +132,8 @@ impl Fingerprint {
             vr: o.vr,
             label: o.header.clone(),
         });
-        Fingerprint {
+        let (couplings, starts, events) = settings::of_plan(plan);
+        Ok(Fingerprint {
             start_time: plan.start_time,
             step_size: plan.step_size,
             n_steps: plan.n_steps,
@@ -127,15 +142,21 @@ impl Fingerprint {
                 .instances
                 .iter()
                 .zip(fmus)
-                .map(|(pi, f)| InstanceId {
-                    name: pi.name.clone(),
-                    guid: f.guid().to_string(),
-                    step_multiple: pi.step_multiple,
+                .map(|(pi, f)| {
+                    Ok(InstanceId {
+                        name: pi.name.clone(),
+                        guid: f.guid().to_string(),
+                        fmu_hash: f.archive_hash()?.to_string(),
+                        step_multiple: pi.step_multiple,
+                    })
                 })
-                .collect(),
+                .collect::<Result<_>>()?,
             order: plan.order.iter().map(|&i| i as u32).collect(),
             observed: sources.chain(outputs).collect(),
-        }
+            couplings,
+            starts,
+            events,
+        })
     }
 
     /// The first difference between the system of checkpoint `self` and `here`, said for a
@@ -169,6 +190,12 @@ impl Fingerprint {
                     a.name, a.guid, b.guid
                 ));
             }
+            if a.fmu_hash != b.fmu_hash {
+                return Some(format!(
+                    "instance '{}': the FMU file has SHA-256 {} in the checkpoint, {} in this system (another build of the FMU)",
+                    a.name, a.fmu_hash, b.fmu_hash
+                ));
+            }
             if a.step_multiple != b.step_multiple {
                 return Some(format!(
                     "instance '{}': step_multiple {} in the checkpoint, {} in this system",
@@ -178,6 +205,7 @@ impl Fingerprint {
         }
         self.grid_difference(here)
             .or_else(|| self.exchange_difference(here))
+            .or_else(|| self.settings_difference(here))
     }
 
     /// Time grid and algorithm.
@@ -267,6 +295,26 @@ impl Fingerprint {
                 o.label, o.instance
             ));
         }
+        if let Some(c) = self.couplings.iter().find(|c| c.to_instance as usize >= n) {
+            return Err(format!(
+                "connection '{}' names instance {} of {n}",
+                c.label, c.to_instance
+            ));
+        }
+        let mut set = self.starts.iter().chain(&self.events);
+        if let Some(s) = set.find(|s| s.instance as usize >= n) {
+            return Err(format!(
+                "'{}' names instance {} of {n}",
+                s.label, s.instance
+            ));
+        }
+        if self.couplings.len() > self.observed.len() {
+            return Err(format!(
+                "{} connections but {} exchanged variables",
+                self.couplings.len(),
+                self.observed.len()
+            ));
+        }
         Ok(())
     }
 }
@@ -300,13 +348,17 @@ impl Checkpoint {
     /// The checkpoint belongs to the system of `plan` (run with `fmus`), else an error naming
     /// the first difference.
     pub fn check_plan(&self, plan: &Plan, fmus: &[Arc<Fmu>]) -> Result<()> {
-        self.check(&Fingerprint::of(plan, fmus))
+        self.check(&Fingerprint::of(plan, fmus)?)
     }
 
     /// The checkpoint belongs to the system of fingerprint `here` and is consistent in itself.
     pub fn check(&self, here: &Fingerprint) -> Result<()> {
         let at = format!("the checkpoint at t = {} s (step {})", self.time, self.step);
-        if let Some(d) = self.fingerprint.difference(here) {
+        let differs = self
+            .fingerprint
+            .difference(here)
+            .or_else(|| self.fingerprint.past_events_difference(here, self.step));
+        if let Some(d) = differs {
             return Err(Error::Other(format!(
                 "{at} is from a different system: {d}"
             )));

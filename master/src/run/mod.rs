@@ -490,7 +490,8 @@ fn execute<A: Algorithm>(
 ) -> Result<(Summary, Option<Checkpoint>)> {
     let begin = Instant::now();
     let fingerprint = (course.resume.is_some() || course.checkpoint.is_some())
-        .then(|| Fingerprint::of(plan, fmus));
+        .then(|| Fingerprint::of(plan, fmus))
+        .transpose()?;
     let (first, stop) = course_steps(plan, fmus, fingerprint.as_ref(), &course)?;
     let Exchange {
         ports,

@@ -1,30 +1,39 @@
 //! The checkpoint file: a versioned little-endian binary layout, checked on reading.
 //!
 //! ```text
-//! magic "SHIPCKPT", version u32 (1)
+//! magic "SHIPCKPT", version u32 (2)
 //! step u64, time f64
 //! fingerprint: start_time f64, step_size f64, n_steps u64, algorithm u8 (0 Jacobi, 1 Gauss-Seidel)
-//!   instances: u32 n, n x (name str, guid str, step_multiple u32)
+//!   instances: u32 n, n x (name str, guid str, FMU SHA-256 hex str, step_multiple u32)
 //!   order:     u32 n, n x u32
 //!   observed:  u32 n, n x (instance u32, type u8, value reference u32, label str)
+//!   couplings: u32 n, n x (to instance u32, to value reference u32, gain f64, offset f64,
+//!              flags u8 (1 summed, 2 mapped, 4 Boolean mapping), [u32 m, m x (i32, i32)
+//!              when mapped], label str)
+//!   starts:    u32 n, n x (instance u32, value reference u32, value, label str)
+//!   events:    u32 n, n x (step u64, instance u32, value reference u32, value, label str)
+//!   value:     u8 type (0 Real f64, 1 Integer i32, 2 Boolean u8, 3 String str), the value
 //! values: u32 n, n x f64 (Real); u32 n, n x i32 (Integer); u32 n, n x i32 (Boolean)
 //! states: u32 n, n x (name str, u64 length, the FMU's bytes)
 //! checksum u64: FNV-1a 64 of every byte before it
 //! str: u32 length, UTF-8 bytes
 //! ```
 //!
+//! Version 1 (before issue 38) had no FMU hashes, couplings, start values or events; such a
+//! file is refused with the advice to take the checkpoint again.
+//!
 //! Reading never trusts a length: a count is checked against the bytes left in the file
 //! before anything is allocated for it, so a truncated or hostile file is an error naming the
 //! file and what was being read, never a panic or a huge allocation.
 
-use super::{Checkpoint, Fingerprint, InstanceId, InstanceState, ObservedId};
+use super::{Checkpoint, Coupling, Fingerprint, InstanceId, InstanceState, ObservedId, Setting};
 use crate::error::{Error, Result};
 use crate::run::exchange::Values;
-use crate::system::Algorithm;
+use crate::system::{Algorithm, TypedValue};
 use std::path::Path;
 
 const MAGIC: &[u8; 8] = b"SHIPCKPT";
-const VERSION: u32 = 1;
+const VERSION: u32 = 2;
 
 /// FNV-1a 64-bit (Fowler, Noll, Vo), the file's checksum.
 fn fnv1a(bytes: &[u8]) -> u64 {
@@ -214,7 +223,12 @@ impl Checkpoint {
         let version = r.u32("the version")?;
         if version != VERSION {
             return Err(r.err(format!(
-                "checkpoint format version {version}; this shipsim reads version {VERSION}"
+                "checkpoint format version {version}; this shipsim reads version {VERSION}{}",
+                if version < VERSION {
+                    " (the file is from an older shipsim: take the checkpoint again)"
+                } else {
+                    " (the file is from a newer shipsim)"
+                }
             )));
         }
         let step = r.u64("the step")?;
@@ -268,6 +282,7 @@ fn encode_fingerprint(o: &mut Out, f: &Fingerprint) -> Result<()> {
     for i in &f.instances {
         o.str(&i.name)?;
         o.str(&i.guid)?;
+        o.str(&i.fmu_hash)?;
         o.u32(i.step_multiple);
     }
     o.len(f.order.len(), "instances")?;
@@ -279,7 +294,106 @@ fn encode_fingerprint(o: &mut Out, f: &Fingerprint) -> Result<()> {
         o.u32(v.vr);
         o.str(&v.label)?;
     }
+    o.len(f.couplings.len(), "connections")?;
+    for c in &f.couplings {
+        encode_coupling(o, c)?;
+    }
+    o.len(f.starts.len(), "start values")?;
+    for s in &f.starts {
+        o.u32(s.instance);
+        o.u32(s.vr);
+        encode_value(o, &s.value)?;
+        o.str(&s.label)?;
+    }
+    o.len(f.events.len(), "events")?;
+    for e in &f.events {
+        o.u64(e.step);
+        o.u32(e.instance);
+        o.u32(e.vr);
+        encode_value(o, &e.value)?;
+        o.str(&e.label)?;
+    }
     Ok(())
+}
+
+fn encode_coupling(o: &mut Out, c: &Coupling) -> Result<()> {
+    o.u32(c.to_instance);
+    o.u32(c.to_vr);
+    o.f64(c.gain);
+    o.f64(c.offset);
+    let boolean = c.mapping.as_ref().is_some_and(|m| m.0);
+    o.u8(u8::from(c.sum) | u8::from(c.mapping.is_some()) << 1 | u8::from(boolean) << 2);
+    if let Some((_, pairs)) = &c.mapping {
+        o.len(pairs.len(), "mapping entries")?;
+        for &(a, b) in pairs {
+            o.u32(a as u32);
+            o.u32(b as u32);
+        }
+    }
+    o.str(&c.label)
+}
+
+fn encode_value(o: &mut Out, v: &TypedValue) -> Result<()> {
+    match v {
+        TypedValue::Real(x) => {
+            o.u8(0);
+            o.f64(*x);
+        }
+        TypedValue::Integer(i) => {
+            o.u8(1);
+            o.u32(*i as u32);
+        }
+        TypedValue::Boolean(b) => {
+            o.u8(2);
+            o.u8(u8::from(*b));
+        }
+        TypedValue::String(s) => {
+            o.u8(3);
+            o.str(s)?;
+        }
+    }
+    Ok(())
+}
+
+fn decode_value(r: &mut In) -> Result<TypedValue> {
+    let at = r.pos;
+    Ok(match r.u8("a value's type")? {
+        0 => TypedValue::Real(r.f64("a Real value")?),
+        1 => TypedValue::Integer(r.i32("an Integer value")?),
+        2 => TypedValue::Boolean(r.u8("a Boolean value")? != 0),
+        3 => TypedValue::String(r.str("a String value")?),
+        t => return Err(r.err(format!("unknown value type {t} at byte {at}"))),
+    })
+}
+
+fn decode_coupling(r: &mut In) -> Result<Coupling> {
+    let to_instance = r.u32("a connection")?;
+    let to_vr = r.u32("a connection")?;
+    let gain = r.f64("a connection's gain")?;
+    let offset = r.f64("a connection's offset")?;
+    let at = r.pos;
+    let flags = r.u8("a connection's flags")?;
+    if flags > 7 {
+        return Err(r.err(format!("unknown connection flags {flags} at byte {at}")));
+    }
+    let mapping = match flags & 2 {
+        0 => None,
+        _ => {
+            let pairs = r.list(8, "mapping entries", |r| {
+                Ok((r.i32("a mapping entry")?, r.i32("a mapping entry")?))
+            })?;
+            Some((flags & 4 != 0, pairs))
+        }
+    };
+    Ok(Coupling {
+        to_instance,
+        to_vr,
+        gain,
+        offset,
+        sum: flags & 1 != 0,
+        mapping,
+        label: r.str("a connection's label")?,
+    })
 }
 
 fn decode_fingerprint(r: &mut In) -> Result<Fingerprint> {
@@ -292,10 +406,11 @@ fn decode_fingerprint(r: &mut In) -> Result<Fingerprint> {
         1 => Algorithm::GaussSeidel,
         a => return Err(r.err(format!("unknown algorithm code {a} at byte {at}"))),
     };
-    let instances = r.list(12, "instances", |r| {
+    let instances = r.list(16, "instances", |r| {
         Ok(InstanceId {
             name: r.str("an instance name")?,
             guid: r.str("a GUID")?,
+            fmu_hash: r.str("an FMU hash")?,
             step_multiple: r.u32("a step multiple")?,
         })
     })?;
@@ -310,6 +425,25 @@ fn decode_fingerprint(r: &mut In) -> Result<Fingerprint> {
             label: r.str("an observed variable's label")?,
         })
     })?;
+    let couplings = r.list(29, "connections", decode_coupling)?;
+    let starts = r.list(13, "start values", |r| {
+        Ok(Setting {
+            instance: r.u32("a start value")?,
+            vr: r.u32("a start value")?,
+            value: decode_value(r)?,
+            label: r.str("a start value's label")?,
+            step: 0,
+        })
+    })?;
+    let events = r.list(21, "events", |r| {
+        Ok(Setting {
+            step: r.u64("an event")?,
+            instance: r.u32("an event")?,
+            vr: r.u32("an event")?,
+            value: decode_value(r)?,
+            label: r.str("an event's label")?,
+        })
+    })?;
     Ok(Fingerprint {
         start_time,
         step_size,
@@ -318,5 +452,8 @@ fn decode_fingerprint(r: &mut In) -> Result<Fingerprint> {
         instances,
         order,
         observed,
+        couplings,
+        starts,
+        events,
     })
 }
