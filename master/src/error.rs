@@ -51,6 +51,11 @@ pub enum Error {
     #[error("interrupted at t = {time} s")]
     Interrupted { time: f64 },
 
+    /// A campaign ran to its end and wrote its tables, but runs in them failed (the command
+    /// line exits with status 2).
+    #[error("{0}")]
+    RunsFailed(String),
+
     #[error("{0}")]
     Other(String),
 

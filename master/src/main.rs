@@ -287,6 +287,10 @@ fn main() -> ExitCode {
             );
             ExitCode::from(130)
         }
+        Err(Error::RunsFailed(m)) => {
+            eprintln!("error: {m}");
+            ExitCode::from(2)
+        }
         Err(e) if interrupted => {
             eprintln!("interrupted: {e}");
             ExitCode::from(130)

@@ -317,3 +317,49 @@ fn the_summary_names_the_shard_only_with_one() {
         "{err}"
     );
 }
+
+/// A campaign whose runs fail exits with status 2, after writing its tables (issue 38, item 7:
+/// the exit status was 0); running it again (the failed runs count as done) says so again.
+#[test]
+fn failed_runs_make_the_exit_status_2() {
+    let d = tempfile::tempdir().unwrap();
+    tiny_campaign(d.path(), "a", "[1, 1e300]");
+    // u k = 1e600 overflows: the second run's KPI is infinite (status non_finite_kpi)
+    let sys = std::fs::read_to_string(d.path().join("sys.toml")).unwrap();
+    common::write_system(d.path(), "sys.toml", &sys.replace("u = 1.0", "u = 1e300"));
+    let run = |extra: &[&str]| {
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_shipsim"))
+            .current_dir(d.path())
+            .args(["campaign", "run", "a.toml", "-o", "out"])
+            .args(extra)
+            .output()
+            .unwrap();
+        (
+            out.status.code(),
+            String::from_utf8_lossy(&out.stderr).into_owned(),
+        )
+    };
+    let (code, err) = run(&[]);
+    assert_eq!(code, Some(2), "{err}");
+    assert!(
+        err.contains("2 of 2 runs ran (1 failed)")
+            && err.contains("error: 1 of 2 runs failed (status and message in runs.csv; --retry-failed runs them again)"),
+        "{err}"
+    );
+    let table = std::fs::read_to_string(d.path().join("out/runs.csv")).unwrap();
+    assert!(table.contains(",non_finite_kpi,"), "{table}");
+    let (code, err) = run(&[]);
+    assert_eq!(code, Some(2), "{err}");
+    assert!(
+        err.contains("2 were done before") && err.contains("1 of the runs done before had failed"),
+        "{err}"
+    );
+    // Without failures: 0.
+    tiny_campaign(d.path(), "b", "[1, 2]");
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_shipsim"))
+        .current_dir(d.path())
+        .args(["campaign", "run", "b.toml", "-o", "out_b", "-q"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(0), "{out:?}");
+}

@@ -74,6 +74,9 @@ pub struct CampaignOutcome {
     /// Runs executed now, and how many of them failed.
     pub ran: usize,
     pub failed: usize,
+    /// Of the runs done before (`skipped`), how many had failed (not run again without
+    /// `retry_failed`).
+    pub failed_before: usize,
     pub interrupted: bool,
     pub jobs: usize,
     /// Why the jobs were limited, if they were.
@@ -112,6 +115,13 @@ impl std::fmt::Display for CampaignOutcome {
             self.runs_per_second(),
             self.jobs
         )?;
+        if self.failed_before > 0 {
+            write!(
+                f,
+                "\n{} of the runs done before had failed (--retry-failed runs them again)",
+                self.failed_before
+            )?;
+        }
         if let Some(note) = &self.jobs_note {
             write!(f, " ({note})")?;
         }
@@ -437,6 +447,11 @@ pub fn run(campaign: &Campaign, opts: &CampaignOptions) -> Result<CampaignOutcom
         .filter(|r| to_do(&journal, r, opts.retry_failed))
         .collect();
     outcome.skipped = outcome.selected - todo.len();
+    outcome.failed_before = selected
+        .iter()
+        .filter_map(|&i| journal.done(&campaign.runs[i].key))
+        .filter(|r| r.status.failed() && !opts.retry_failed)
+        .count();
     let ctx = Context {
         progress: opts.progress.then(|| progress_bar(todo.len())),
         observer: opts.observer.clone(),

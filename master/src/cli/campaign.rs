@@ -117,7 +117,7 @@ pub fn dispatch(
             if outcome.interrupted {
                 return Err(Error::Interrupted { time: f64::NAN });
             }
-            Ok(())
+            failures(&outcome)
         }
         CampaignCommand::Show { file, runs } => {
             let c = Campaign::load(&file)?;
@@ -171,6 +171,19 @@ pub fn dispatch(
             plot(&table, &req, &opts)
         }
     }
+}
+
+/// A campaign whose runs (of this shard) failed, now or before, ends with status 2 after its
+/// tables are written: a script sees it without reading them (issue 38, item 7).
+fn failures(outcome: &campaign::execute::CampaignOutcome) -> shipsim::Result<()> {
+    let failed = outcome.failed + outcome.failed_before;
+    if failed == 0 {
+        return Ok(());
+    }
+    Err(Error::RunsFailed(format!(
+        "{failed} of {} runs failed (status and message in runs.csv; --retry-failed runs them again)",
+        outcome.selected
+    )))
 }
 
 /// `I/N` with I < N.
