@@ -56,6 +56,8 @@ pub(crate) struct FmuLibrary {
     /// None for an FMU opened without its binary ([`Fmu::open_unloaded`]).
     pub api: Option<Api>,
     lib: Option<Library>,
+    /// The binary runs on the process's Python runtime ([`python`]).
+    pub python: bool,
     _dir: tempfile::TempDir,
 }
 
@@ -601,6 +603,7 @@ impl Fmu {
             lib: Arc::new(FmuLibrary {
                 api: Some(api),
                 lib,
+                python: uses_python,
                 _dir: unpacked.dir,
             }),
             index,
@@ -623,6 +626,7 @@ impl Fmu {
             lib: Arc::new(FmuLibrary {
                 api: None,
                 lib: None,
+                python: false,
                 _dir: unpacked.dir,
             }),
             index,
@@ -783,7 +787,8 @@ pub mod python {
             .is_some_and(|sym| sym.starts_with("Py") || sym.starts_with("_Py"))
     }
 
-    /// Loads libpython globally once per process; returns the library path or why it failed.
+    /// Loads libpython globally once per process; returns which Python (its version, executable
+    /// and library) or why it failed.
     pub fn ensure_runtime() -> std::result::Result<String, String> {
         RUNTIME.get_or_init(load).clone()
     }
@@ -801,7 +806,7 @@ print(sys.version.split()[0])\n";
         // Already present (e.g. the host is itself a Python process)?
         let this = Library::this();
         if unsafe { this.get::<*const c_void>(b"Py_IsInitialized\0") }.is_ok() {
-            return Ok("(already in the process)".into());
+            return Ok("the Python of this process".into());
         }
         let exe = python_executable();
         let out = Command::new(&exe).arg("-c").arg(PROBE).output().map_err(|e| {
@@ -881,6 +886,10 @@ print(sys.version.split()[0])\n";
             }
         }
         std::mem::forget(lib);
-        Ok(libpath.display().to_string())
+        Ok(format!(
+            "Python {version} at '{}' ({})",
+            exe.display(),
+            libpath.display()
+        ))
     }
 }

@@ -596,3 +596,41 @@ fn isolated_checkpoints_and_resumes_equal_the_in_process_ones() {
     assert!(tail_iso == tail, "the isolated resume's rows differ");
     assert_no_temp_dirs(d.path());
 }
+
+/// A run that fails before its first row (here in fmi2ExitInitializationMode) leaves the CSV
+/// of the last run as it was (issue 36, item 1: it was truncated to its header, or to nothing).
+#[test]
+fn a_run_that_fails_to_initialize_keeps_the_last_csv() {
+    let d = tempfile::tempdir().unwrap();
+    evil_fmu(d.path(), "evil", &[]);
+    evil_fmu(d.path(), "broken", &["EVIL_INIT_FAIL"]);
+    let sys = |fmu: &str| {
+        format!("[simulation]\nstop_time = 0.3\nstep_size = 0.1\n[[instances]]\nname = \"m\"\nfmu = \"{fmu}\"\n")
+    };
+    write_system(d.path(), "good.toml", &sys("evil.fmu"));
+    write_system(d.path(), "bad.toml", &sys("broken.fmu"));
+    let out = shipsim(d.path(), &["run", "good.toml", "-q", "-o", "out.csv"]);
+    assert!(out.status.success(), "{out:?}");
+    let good = std::fs::read_to_string(d.path().join("out.csv")).unwrap();
+    assert_eq!(good.lines().count(), 1 + 4, "{good}");
+    for isolate in [false, true] {
+        let mut args = vec!["run", "bad.toml", "-q", "-o", "out.csv"];
+        if isolate {
+            args.push("--isolate");
+        }
+        let err = failing(d.path(), &args);
+        assert!(
+            err.contains("fmi2ExitInitializationMode returned fmi2Error"),
+            "{err}"
+        );
+        let now = std::fs::read_to_string(d.path().join("out.csv")).unwrap();
+        assert_eq!(
+            now, good,
+            "isolate = {isolate}: the failed run touched the CSV"
+        );
+    }
+    // A new file is not created by a run that fails so early.
+    let err = failing(d.path(), &["run", "bad.toml", "-q", "-o", "new.csv"]);
+    assert!(err.contains("fmi2Error"), "{err}");
+    assert!(!d.path().join("new.csv").exists());
+}

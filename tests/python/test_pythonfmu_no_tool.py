@@ -106,3 +106,49 @@ def test_no_external_tool_pythonfmu_without_a_python_names_the_cause(no_tool_fmu
     assert r.returncode != 0
     assert "calls the Python C API" in r.stderr and "_Py" in r.stderr, r.stderr
     assert "no-such-python" in r.stderr, r.stderr
+
+
+PICKY = """
+import importlib, os
+from pythonfmu import Fmi2Causality, Fmi2Slave, Real
+
+class Picky(Fmi2Slave):
+    author = "shipsim tests"
+    description = "needs the module named by $PICKY_NEEDS (as an FMU needs numpy): y = 2"
+
+    def __init__(self, **kwargs):
+        super().__init__(**kwargs)
+        importlib.import_module(os.environ.get("PICKY_NEEDS", "math"))
+        self.y = 2.0
+        self.register_variable(Real("y", causality=Fmi2Causality.output))
+
+    def do_step(self, current_time, step_size):
+        return True
+"""
+
+
+def test_a_run_that_fails_to_instantiate_keeps_the_last_csv_and_names_its_python(tmp_path):
+    """Issue 36, item 1: the run that failed at fmi2Instantiate (its Python lacked a package)
+    truncated the last good CSV to its header, and the error named neither the Python used
+    nor SHIPSIM_PYTHON."""
+    (tmp_path / "Picky.py").write_text(textwrap.dedent(PICKY))
+    subprocess.run([sys.executable, "-m", "pythonfmu", "build", "-f", str(tmp_path / "Picky.py"), "-d",
+                    str(tmp_path), "--no-external-tool"], check=True, capture_output=True)
+    (tmp_path / "p.toml").write_text(textwrap.dedent(f"""
+        [simulation]
+        stop_time = 0.5
+        step_size = 0.125
+        [[instances]]
+        name = "p"
+        fmu = "{tmp_path / 'Picky.fmu'}"
+    """))
+    csv = tmp_path / "p.csv"
+    shipsim("run", tmp_path / "p.toml", "-o", csv)
+    good = csv.read_text()
+    assert good.splitlines() == ["time,p.y", "0,2", "0.125,2", "0.25,2", "0.375,2", "0.5,2"], good
+    r = shipsim("run", tmp_path / "p.toml", "-o", csv, env_extra={"PICKY_NEEDS": "no_such_package_here"},
+                check=False)
+    assert r.returncode != 0
+    assert "fmi2Instantiate returned NULL" in r.stderr, r.stderr
+    assert csv.read_text() == good, "the failed run touched the last CSV"
+    assert "the FMU runs on Python 3." in r.stderr and "SHIPSIM_PYTHON" in r.stderr, r.stderr

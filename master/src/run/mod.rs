@@ -298,16 +298,16 @@ fn into_csv(
     Ok(summary)
 }
 
-/// The output file, with its folder created; buffered.
+/// The output file, checked and with its folder created, but opened (and so truncated) only
+/// when the run writes into it: a run that fails before its instances are initialized leaves
+/// the file of the last run as it was (issue 36, item 1). Buffered.
 fn create_output_file(p: &std::path::Path) -> Result<Box<dyn Write>> {
-    let p = &crate::output_path::writable(p)?;
+    let p = crate::output_path::writable(p)?;
     if let Some(dir) = p.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir)
             .map_err(|e| Error::io(format!("cannot create output folder {}", dir.display()), e))?;
     }
-    let f = std::fs::File::create(p)
-        .map_err(|e| Error::io(format!("cannot create output file {}", p.display()), e))?;
-    Ok(Box::new(std::io::BufWriter::with_capacity(1 << 16, f)))
+    Ok(Box::new(recorder::OpenOnWrite::new(p)))
 }
 
 /// Runs a validated plan with loaded FMUs, recording into any [`Recorder`] (or none). With
@@ -498,11 +498,12 @@ fn execute<A: Algorithm>(
         mut values,
         columns,
     } = Exchange::build(plan);
+    let mut slots = initialize::initialize(algorithm, plan, fmus, ports, &mut values, opts)?;
+    // After the instances are initialized: a run that fails before has recorded nothing.
     let mut recording = match recorder {
         Some(r) => Some(start_recording(plan, r, &columns, first, stop)?),
         None => None,
     };
-    let mut slots = initialize::initialize(algorithm, plan, fmus, ports, &mut values, opts)?;
     if let Some(cp) = course.resume {
         cp.restore(&mut slots, &mut values)?;
     }

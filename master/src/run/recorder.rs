@@ -116,6 +116,47 @@ impl CsvRecorder {
     }
 }
 
+/// A file created (truncated) on the first write, buffered: a recorder that is never written
+/// to leaves what is at the path alone.
+pub struct OpenOnWrite {
+    path: std::path::PathBuf,
+    file: Option<std::io::BufWriter<std::fs::File>>,
+}
+
+impl OpenOnWrite {
+    pub fn new(path: std::path::PathBuf) -> OpenOnWrite {
+        OpenOnWrite { path, file: None }
+    }
+
+    fn file(&mut self) -> std::io::Result<&mut std::io::BufWriter<std::fs::File>> {
+        if self.file.is_none() {
+            let f = std::fs::File::create(&self.path).map_err(|e| {
+                std::io::Error::new(
+                    e.kind(),
+                    format!("cannot create output file {}: {e}", self.path.display()),
+                )
+            })?;
+            self.file = Some(std::io::BufWriter::with_capacity(1 << 16, f));
+        }
+        Ok(self.file.as_mut().expect("opened above"))
+    }
+}
+
+impl Write for OpenOnWrite {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        self.file()?.write(buf)
+    }
+    fn write_all(&mut self, buf: &[u8]) -> std::io::Result<()> {
+        self.file()?.write_all(buf)
+    }
+    fn flush(&mut self) -> std::io::Result<()> {
+        match &mut self.file {
+            Some(f) => f.flush(),
+            None => Ok(()),
+        }
+    }
+}
+
 /// When to flush a stream of rows: when `period` of wall time has passed since the last
 /// flush. The clock is read only every `every` rows, a number that adapts so that the reads
 /// are between about 10 ms and 100 ms of wall time apart (it doubles when they come faster,

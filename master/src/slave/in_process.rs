@@ -151,11 +151,23 @@ fn instantiate_failed(
     Error::fmu(
         &fmu.path,
         format!(
-            "fmi2Instantiate returned NULL for instance '{name}' (GUID \"{}\"){note}; FMU log: {}",
+            "fmi2Instantiate returned NULL for instance '{name}' (GUID \"{}\"){note}; FMU log: {}{}",
             fmu.guid(),
-            log.recent_or_hint(debug_logging).join(" | ")
+            log.recent_or_hint(debug_logging).join(" | "),
+            python_note(fmu)
         ),
     )
+}
+
+/// For an FMU that runs on the process's Python ([`crate::fmu::python`]): which one, and how
+/// to choose another (its packages, e.g. numpy, must be installed there).
+fn python_note(fmu: &Fmu) -> String {
+    match crate::fmu::python::ensure_runtime() {
+        Ok(which) if fmu.lib.python => format!(
+            "; the FMU runs on {which}: install its Python packages there, or set SHIPSIM_PYTHON to a Python that has them"
+        ),
+        _ => String::new(),
+    }
 }
 
 // SAFETY (every call below): the FMI 2.0 functions of the loaded library on the component it
