@@ -428,6 +428,39 @@ fn shards_are_disjoint_their_union_is_the_campaign_and_merge_reports_what_is_mis
     let d = Table::read(&dir.path().join("m3/derived.parquet")).unwrap();
     assert_eq!(d.rows(), 200);
     assert!(floats(&d, "ratio").iter().all(|r| (r - 2.0).abs() < 1e-12));
+    // Merging into a folder that is complete is a no-op (issue 36, item 2: it reported the
+    // folder's runs missing and appended the shard's runs to its journal again).
+    let lines = |d: &str| {
+        std::fs::read_to_string(dir.path().join(d).join("runs.jsonl"))
+            .unwrap()
+            .lines()
+            .count()
+    };
+    let again = shipsim::campaign::merge::merge(&two[..1], &dir.path().join("one")).unwrap();
+    assert!(
+        again.missing.is_empty() && again.found == 400 && again.present == 400,
+        "{again}"
+    );
+    assert_eq!(lines("one"), 400);
+    // ... and a partial merge is completed by the shard it lacked.
+    let rest = shipsim::campaign::merge::merge(&three[2..], &dir.path().join("m2")).unwrap();
+    assert!(rest.missing.is_empty() && rest.found == 400, "{rest}");
+    assert_eq!(rest.present, 400 - shard_keys[2].len());
+    assert_eq!(lines("m2"), 400);
+    // A folder of another campaign (other KPIs) is not merged into.
+    let other = Campaign::from_spec(spec(
+        dir.path(),
+        "o.toml",
+        &text.replace("stat = \"final\"", "stat = \"max\""),
+    ))
+    .unwrap();
+    let mut o = opts(&dir.path().join("o"), 1);
+    o.shard = Some((0, 50));
+    execute::run(&other, &o).unwrap();
+    let e = shipsim::campaign::merge::merge(&[dir.path().join("o")], &dir.path().join("one"))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("is from another campaign"), "{e}");
 }
 
 // ------------------------------------------------------------------------------------------

@@ -18,6 +18,8 @@ pub struct MergeReport {
     pub found: usize,
     /// Runs found in more than one input folder (kept once: a successful record first).
     pub duplicates: usize,
+    /// Runs the output folder had already (merging them again is a no-op).
+    pub present: usize,
     /// Indices of the runs no input has.
     pub missing: Vec<usize>,
     pub files: Vec<PathBuf>,
@@ -27,8 +29,8 @@ impl std::fmt::Display for MergeReport {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(
             f,
-            "{} of {} runs found ({} in several inputs)",
-            self.found, self.total, self.duplicates
+            "{} of {} runs found ({} in several inputs, {} already in the output folder)",
+            self.found, self.total, self.duplicates, self.present
         )?;
         if !self.missing.is_empty() {
             let shown: Vec<String> = self
@@ -68,7 +70,12 @@ pub fn merge(inputs: &[PathBuf], out: &Path) -> Result<MergeReport> {
     .len();
     let mut records: HashMap<String, RunRecord> = HashMap::new();
     let mut duplicates = 0;
-    for dir in inputs {
+    // An output folder that holds a campaign already must hold this one.
+    let earlier = out.join("campaign.json").exists().then_some(out);
+    for dir in earlier
+        .into_iter()
+        .chain(inputs.iter().map(PathBuf::as_path))
+    {
         let p = Provenance::read(dir)?;
         if (p.base_hash.as_str(), p.kpi_hash.as_str())
             != (prov.base_hash.as_str(), prov.kpi_hash.as_str())
@@ -79,7 +86,7 @@ pub fn merge(inputs: &[PathBuf], out: &Path) -> Result<MergeReport> {
                 first.display()
             )));
         }
-        if !dir.join("runs.jsonl").exists() {
+        if !dir.join("runs.jsonl").exists() || Some(dir) == earlier {
             continue;
         }
         for r in Journal::open(dir, kpis)?.records() {
@@ -96,10 +103,12 @@ pub fn merge(inputs: &[PathBuf], out: &Path) -> Result<MergeReport> {
             }
         }
     }
-    // The campaign as the newest input describes it (its runs, keyed like the journals).
-    let newest = inputs
-        .iter()
-        .map(|d| Provenance::read(d))
+    // The campaign as the newest input (or the output folder) describes it: its runs, keyed
+    // like the journals.
+    let newest = earlier
+        .into_iter()
+        .chain(inputs.iter().map(PathBuf::as_path))
+        .map(Provenance::read)
         .collect::<Result<Vec<_>>>()?
         .into_iter()
         .max_by_key(|p| p.runs)
@@ -114,17 +123,24 @@ pub fn merge(inputs: &[PathBuf], out: &Path) -> Result<MergeReport> {
     // the output folder's lock before anything is written into it
     let mut journal = Journal::open(out, kpis)?;
     write_atomic(&out.join("campaign.json"), text.as_bytes())?;
-    let mut found = 0;
+    let (mut found, mut present) = (0, 0);
     let mut missing = Vec::new();
     for run in &runs {
-        match records.get(&run.key) {
-            Some(r) => {
+        let new = records.get(&run.key);
+        // what the folder has stands, unless it failed and an input has the run done
+        let kept = journal
+            .done(&run.key)
+            .is_some_and(|h| !h.status.failed() || new.is_none_or(|n| n.status.failed()));
+        match (kept, new) {
+            (true, _) => {
                 found += 1;
-                if journal.done(&run.key) != Some(r) {
-                    journal.append(r.clone())?;
-                }
+                present += 1;
             }
-            None => missing.push(run.index),
+            (false, Some(r)) => {
+                found += 1;
+                journal.append(r.clone())?;
+            }
+            (false, None) => missing.push(run.index),
         }
     }
     let files = output::write_tables(&spec, &runs, &journal, out)?;
@@ -132,6 +148,7 @@ pub fn merge(inputs: &[PathBuf], out: &Path) -> Result<MergeReport> {
         total: runs.len(),
         found,
         duplicates,
+        present,
         missing,
         files,
     })
