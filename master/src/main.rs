@@ -48,6 +48,10 @@ enum Command {
         /// Override the stop time [s].
         #[arg(long)]
         stop_time: Option<f64>,
+        /// Override the base step size [s] (an SSD without an OSP or OMSimulator fixed-step
+        /// annotation gives none).
+        #[arg(long)]
+        step_size: Option<f64>,
         /// CSV output file (overrides the system's output.file).
         #[arg(long, short)]
         output: Option<PathBuf>,
@@ -320,6 +324,7 @@ fn dispatch(cmd: Command, session: &Session) -> shipsim::Result<()> {
         Command::Run {
             system,
             stop_time,
+            step_size,
             output,
             no_output,
             profile,
@@ -343,6 +348,7 @@ fn dispatch(cmd: Command, session: &Session) -> shipsim::Result<()> {
             let mut sys = System::load(&system)?;
             sys.apply_overrides(&set)?;
             sys.apply_stop_time(stop_time)?;
+            sys.apply_step_size(step_size)?;
             if let Some(a) = algorithm {
                 sys.algorithm = a
                     .parse::<Algorithm>()

@@ -412,13 +412,6 @@ fn refused_elements_are_named() {
             "<SignalDictionaries> are not supported",
         ],
     );
-    let no_step = load_error("linear", |t| {
-        t.replace("<osp:FixedStepAlgorithm baseStepSize=\"0.0625\"/>", "")
-    });
-    has(
-        &no_step,
-        &["SystemStructure.ssd", "no fixed-step master annotation"],
-    );
     let v2 = load_error("linear", |t| {
         t.replace("version=\"1.0\">\n", "version=\"2.0\">\n")
     });
@@ -538,6 +531,60 @@ fn a_missing_stop_time_asks_for_one() {
     has(&e, &["SystemStructure.ssd", "stopTime", "--stop-time"]);
     sys.stop_time = Some(0.5);
     sys.require_stop_time().unwrap();
+}
+
+/// SSP 1.0 defines no step size: an SSD without an OSP or OMSimulator fixed-step annotation
+/// loads, and a run asks for one (issue 36, item 9: such a file could not be run from the
+/// command line at all). Given by `--step-size`, the run equals the annotated file's.
+#[test]
+fn a_missing_step_size_asks_for_one_and_step_size_gives_it() {
+    let d = case("linear");
+    let p = d.path().join("SystemStructure.ssd");
+    let annotated = run(&p);
+    let t = std::fs::read_to_string(&p)
+        .unwrap()
+        .replace("<osp:FixedStepAlgorithm baseStepSize=\"0.0625\"/>", "");
+    std::fs::write(&p, t).unwrap();
+    let mut sys = System::load(&p).unwrap();
+    let e = sys.apply_step_size(None).unwrap_err().to_string();
+    has(
+        &e,
+        &[
+            "SystemStructure.ssd",
+            "gives no step size",
+            "--step-size",
+            "step_size = SECONDS",
+        ],
+    );
+    sys.apply_step_size(Some(H)).unwrap();
+    let shipsim = |args: &[&str]| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_shipsim"))
+            .current_dir(d.path())
+            .args(["run", "SystemStructure.ssd", "-q", "-o", "cli.csv"])
+            .args(args)
+            .output()
+            .unwrap()
+    };
+    let out = shipsim(&[]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !out.status.success() && err.contains("--step-size SECONDS"),
+        "{err}"
+    );
+    let out = shipsim(&["--step-size", "0.0625"]);
+    assert!(out.status.success(), "{out:?}");
+    assert_eq!(read_csv(&d.path().join("cli.csv")), annotated);
+    // `shipsim check` names what is missing.
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_shipsim"))
+        .args(["check"])
+        .arg(&p)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !out.status.success() && err.contains("gives no step size"),
+        "{err}"
+    );
 }
 
 #[test]

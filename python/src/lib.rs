@@ -577,9 +577,7 @@ impl PySystem {
         if let Some(t) = start_time {
             sys.start_time = t;
         }
-        if let Some(h) = step_size {
-            sys.step_size = h;
-        }
+        sys.apply_step_size(step_size).map_err(|e| py_err(py, e))?;
         if let Some(a) = algorithm {
             // The library's parser, as for system files and `shipsim run --algorithm`.
             sys.algorithm = a.parse().map_err(|e: shipsim::system::UnknownAlgorithm| {

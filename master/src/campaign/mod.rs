@@ -93,6 +93,7 @@ impl Campaign {
     /// elsewhere): records the KPI variables, hashes the system file and FMUs, expands the runs.
     pub fn new(spec: CampaignSpec, mut system: System) -> Result<Campaign> {
         system.apply_stop_time(spec.stop_time)?;
+        system.apply_step_size(spec.step_size)?;
         // derived expressions are checked now, not after every run has run
         derived::DerivedKpi::compile(&spec, &output::kpi_columns(&spec))?;
         windows_fit(&spec, &system)?;

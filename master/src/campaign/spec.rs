@@ -4,6 +4,7 @@
 //! name = "rrs_polar"
 //! system = "../systems/rrs.toml"      # TOML or OSP XML, relative to this file
 //! stop_time = 1200.0                   # optional: overrides the system's
+//! step_size = 0.05                     # optional: overrides the system's (an SSD may have none)
 //! seed = 2026                          # campaign seed: random designs and replication seeds
 //! fork_at = 200.0                      # optional: shared warm-up to t = 200 s
 //! set = { "autopilot.adaptation_enabled" = true }   # optional: for every run
@@ -84,6 +85,8 @@ pub struct CampaignSpec {
     /// The base system file, resolved against the campaign file's folder.
     pub system: PathBuf,
     pub stop_time: Option<f64>,
+    /// Overrides the system's step size (an SSD without a fixed-step annotation needs it).
+    pub step_size: Option<f64>,
     pub seed: u64,
     pub fork_at: Option<f64>,
     /// Set in every run.
@@ -173,6 +176,7 @@ struct Raw {
     description: Option<String>,
     system: String,
     stop_time: Option<f64>,
+    step_size: Option<f64>,
     #[serde(default)]
     seed: u64,
     fork_at: Option<f64>,
@@ -350,6 +354,12 @@ impl Reader<'_> {
                 self.error(None, format!("{what} = {} must be finite", t.unwrap()));
             }
         }
+        if let Some(h) = raw.step_size.filter(|h| !(*h > 0.0 && h.is_finite())) {
+            self.error(
+                None,
+                format!("step_size = {h} must be a positive number of seconds"),
+            );
+        }
         let set = self.sets("set", &raw.set, None);
         let factors: Vec<Factor> = raw.factors.into_iter().map(|f| self.factor(f)).collect();
         let sampling = self.sampling(raw.sampling, &factors);
@@ -381,6 +391,7 @@ impl Reader<'_> {
             description: raw.description,
             system: dir.join(&raw.system),
             stop_time: raw.stop_time,
+            step_size: raw.step_size,
             seed: raw.seed,
             fork_at: raw.fork_at,
             set,

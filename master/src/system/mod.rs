@@ -274,6 +274,19 @@ pub struct System {
     pub archive: Option<std::sync::Arc<tempfile::TempDir>>,
 }
 
+/// How a run whose file gives no step size (an SSD without a fixed-step master annotation:
+/// SSP 1.0 defines none) is given one, the same words for every entry point.
+const GIVE_STEP_SIZE: &str = "give the run a step size: shipsim run --step-size SECONDS, \
+     System.run(step_size=SECONDS) in Python, or step_size = SECONDS in a campaign file";
+
+/// The message for a system without a step size.
+pub(crate) fn no_step_size() -> String {
+    format!(
+        "the file gives no step size (SSP 1.0 defines none; OSP's <osp:FixedStepAlgorithm \
+         baseStepSize> or OMSimulator's <oms:FixedStepMaster stepSize> would); {GIVE_STEP_SIZE}"
+    )
+}
+
 /// How a run whose file has no end time is given one, the same words for every entry point.
 const GIVE_STOP_TIME: &str = "give the run a stop time: shipsim run --stop-time SECONDS, \
      System.run(stop_time=SECONDS) in Python, or stop_time = SECONDS in a campaign file";
@@ -289,6 +302,20 @@ impl System {
             self.stop_time = Some(t);
         }
         self.require_stop_time()
+    }
+
+    /// The step size of a run: the one its caller gives, if any (`shipsim run --step-size`,
+    /// Python's `System.run(step_size=...)`, a campaign file's `step_size`), replaces the
+    /// file's. A file that gives none (`step_size` NaN: an SSD without an OSP or OMSimulator
+    /// fixed-step annotation) then needs one: an error naming the file and the three ways.
+    pub fn apply_step_size(&mut self, given: Option<f64>) -> Result<()> {
+        if let Some(h) = given {
+            self.step_size = h;
+        }
+        if !self.step_size.is_nan() {
+            return Ok(());
+        }
+        Err(Error::system(&self.source, None, no_step_size()))
     }
 
     /// The end-time rule of a run: an OSP file may leave out `<EndTime>` (libcosim then runs

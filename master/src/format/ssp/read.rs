@@ -545,11 +545,16 @@ impl Reader<'_> {
             steps.push((h, line, "oms:FixedStepMaster of a nested system"));
         }
         match steps.as_slice() {
+            // SSP 1.0 defines no step size: the run's caller gives one
+            // (System::apply_step_size), unless a component's rate needs the base step now.
             [] => {
-                self.error(
-                    None,
-                    "no fixed-step master annotation gives the step size: add <osp:FixedStepAlgorithm baseStepSize=\"...\"> (type \"com.opensimulationplatform\") to <DefaultExperiment>, or OMSimulator's <oms:FixedStepMaster stepSize=\"...\"> to the root system",
-                );
+                if let Some(i) = self.step_hints.iter().position(Option::is_some) {
+                    let (name, line) = (self.instances[i].name.clone(), self.instances[i].line);
+                    self.error(
+                        line,
+                        format!("component '{name}' has an osp:StepSizeHint, but no <osp:FixedStepAlgorithm baseStepSize=\"...\"> gives the base step it is a multiple of"),
+                    );
+                }
                 None
             }
             [(h, ..)] => Some(*h),

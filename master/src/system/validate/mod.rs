@@ -159,7 +159,9 @@ impl<'a> Checker<'a> {
             let e = c.err(None, m);
             c.errors.push(e);
         };
-        if !(h > 0.0 && h.is_finite()) {
+        if h.is_nan() {
+            fail(self, super::no_step_size());
+        } else if !(h > 0.0 && h.is_finite()) {
             fail(
                 self,
                 format!("step_size = {}; it must be a positive number", short(h)),
