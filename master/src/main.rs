@@ -596,6 +596,9 @@ fn run_cli(
     };
     let (mut plan, fmus) = prepare_with(sys, &session.unpack(limits), &flags.isolation)?;
     print_warnings(&plan.warnings);
+    if !quiet {
+        sys.notes.iter().for_each(|n| eprintln!("note: {n}"));
+    }
     if !quiet && !flags.no_output {
         output_note(sys, out_file.as_deref());
     }

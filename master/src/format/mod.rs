@@ -4,6 +4,7 @@
 //! - [`toml`]: shipsim's native system file (read).
 //! - [`osp`]: OSP `OspSystemStructure.xml`, libcosim's format (read and write).
 //! - [`ssp`]: SSP 1.0, an `.ssp` archive or a `SystemStructure.ssd` (read).
+//! - [`fmu`]: one `.fmu` run alone over its default experiment (read).
 //!
 //! The readers depend on [`crate::system`]; `system` depends on no reader.
 
@@ -11,14 +12,19 @@ use crate::error::{Error, Result};
 use crate::system::System;
 use std::path::Path;
 
+pub mod fmu;
 pub mod osp;
 pub mod ssp;
 pub mod toml;
 
 impl System {
     /// Reads a system file: `.ssp` is an SSP 1.0 archive and `.ssd` an SSP system structure
-    /// description, `.xml` is OSP `OspSystemStructure.xml`, anything else TOML.
+    /// description, `.xml` is OSP `OspSystemStructure.xml`, `.fmu` one FMU run alone,
+    /// anything else TOML.
     pub fn load(path: &Path) -> Result<System> {
+        if fmu::is_fmu_path(path) {
+            return fmu::load(path);
+        }
         if ssp::is_ssp_path(path) {
             return ssp::load(path);
         }

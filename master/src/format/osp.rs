@@ -238,6 +238,7 @@ pub fn parse(path: &Path, text: &str) -> Result<System> {
         strict_units: false,
         last_step: Default::default(),
         archive: None,
+        notes: Vec::new(),
     })
 }
 

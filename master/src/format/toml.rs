@@ -222,6 +222,7 @@ pub fn parse(path: &Path, text: &str) -> Result<System> {
         strict_units: true,
         last_step,
         archive: None,
+        notes: Vec::new(),
     })
 }
 

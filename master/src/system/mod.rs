@@ -83,6 +83,8 @@ pub enum Format {
     Osp,
     /// SSP 1.0: an `.ssp` archive or a `.ssd` file (`format::ssp`).
     Ssp,
+    /// One FMU run alone (`format::fmu`).
+    Fmu,
 }
 
 /// A value given in a system file or on the command line.
@@ -272,6 +274,9 @@ pub struct System {
     /// The unpacked SSP archive the FMU paths point into, kept as long as the system (set by
     /// the SSP reader for `.ssp` files).
     pub archive: Option<std::sync::Arc<tempfile::TempDir>>,
+    /// What the reader chose for the user where the file does not say (`shipsim run` prints
+    /// them): an FMU run alone names its time span and output file.
+    pub notes: Vec<String>,
 }
 
 /// How a run whose file gives no step size (an SSD without a fixed-step master annotation:
@@ -327,7 +332,7 @@ impl System {
     /// nothing.
     pub fn require_stop_time(&self) -> Result<()> {
         let missing = match (self.stop_time, self.format) {
-            (Some(_), _) | (None, Format::Toml) => return Ok(()),
+            (Some(_), _) | (None, Format::Toml | Format::Fmu) => return Ok(()),
             (None, Format::Osp) => "<EndTime>",
             (None, Format::Ssp) => "<DefaultExperiment stopTime=\"...\">",
         };

@@ -129,6 +129,7 @@ impl Reader<'_> {
             strict_units: true,
             last_step: Default::default(),
             archive: None,
+            notes: Vec::new(),
         })
     }
 
