@@ -163,7 +163,8 @@ enum Command {
     /// Write an OSP OspSystemStructure.xml for a native system file (runs in libcosim).
     ExportOsp {
         system: PathBuf,
-        /// Output file (default: OspSystemStructure.xml beside the system file).
+        /// Output file (default: NAME/OspSystemStructure.xml in the current folder, NAME the
+        /// system file's name: a folder libcosim's `cosim run NAME` reads).
         #[arg(long, short)]
         output: Option<PathBuf>,
     },
@@ -171,7 +172,7 @@ enum Command {
     /// for a system; what SSP cannot express (events, summed inputs, ...) is an error.
     ExportSsp {
         system: PathBuf,
-        /// Output file (default: the system file with the extension .ssp).
+        /// Output file (default: NAME.ssp in the current folder, NAME the system file's name).
         #[arg(long, short)]
         output: Option<PathBuf>,
     },
@@ -701,22 +702,32 @@ fn run_json(
 /// `shipsim export-osp`: OspSystemStructure.xml (and scenario.json for events).
 fn export_osp(system: &Path, output: Option<PathBuf>) -> shipsim::Result<()> {
     let sys = System::load(system)?;
-    let out = output.unwrap_or_else(|| {
-        system
-            .parent()
-            .unwrap_or(Path::new("."))
-            .join("OspSystemStructure.xml")
-    });
+    let out = output.unwrap_or_else(|| export_name(system, "").join("OspSystemStructure.xml"));
+    if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir)
+            .map_err(|e| Error::io(format!("cannot create folder {}", dir.display()), e))?;
+    }
     let warnings = shipsim::format::osp::write(&sys, &out)?;
     print_warnings(&warnings);
     eprintln!("wrote {}", out.display());
     Ok(())
 }
 
+/// The default name of an export of `system`: its file name without the extension, plus
+/// `extension`, in the current folder (never beside the system file, which may be in the
+/// source tree; issue 36, item 6).
+fn export_name(system: &Path, extension: &str) -> PathBuf {
+    let stem = system.file_stem().map(|s| s.to_string_lossy().into_owned());
+    PathBuf::from(format!(
+        "{}{extension}",
+        stem.unwrap_or_else(|| "system".into())
+    ))
+}
+
 /// `shipsim export-ssp`: an SSP 1.0 archive (SystemStructure.ssd, the FMUs, the parameters).
 fn export_ssp(system: &Path, output: Option<PathBuf>) -> shipsim::Result<()> {
     let sys = System::load(system)?;
-    let out = output.unwrap_or_else(|| system.with_extension("ssp"));
+    let out = output.unwrap_or_else(|| export_name(system, ".ssp"));
     let warnings = shipsim::format::ssp::write::write(&sys, &out)?;
     print_warnings(&warnings);
     eprintln!("wrote {}", out.display());
