@@ -491,3 +491,33 @@ fn refused(out: &std::process::Output, parts: &[&str]) {
         assert!(err.contains(part), "{part} not in: {err}");
     }
 }
+
+/// A bare number above a full turn on a variable in radians is said to be taken in radians
+/// (issue 36, item 11: `--set waves.wave_direction=90` silently meant 90 rad); with a unit, or
+/// within a turn, nothing is said.
+#[test]
+fn a_bare_angle_above_a_turn_is_said_to_be_radians() {
+    let d = tempfile::tempdir().unwrap();
+    let sys = common::rrs_file(d.path());
+    let check = |set: &str| {
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_shipsim"))
+            .args(["check", sys.to_str().unwrap(), "--set", set])
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{out:?}");
+        String::from_utf8_lossy(&out.stderr).into_owned()
+    };
+    let err = check("waves.wave_direction=90");
+    assert!(
+        err.contains("warning: ")
+            && err.contains("--set waves.wave_direction=90: 90 has no unit and is taken in the variable's, rad (90 rad = 5157 deg); for degrees write \"90 deg\" (instance 'waves', variable 'wave_direction')"),
+        "{err}"
+    );
+    for quiet in [
+        "waves.wave_direction=90deg",
+        "waves.wave_direction=3",
+        "waves.wave_direction=-6.2",
+    ] {
+        assert!(!check(quiet).contains("has no unit"), "{quiet}");
+    }
+}

@@ -198,6 +198,13 @@ impl Checker<'_> {
                     continue;
                 }
             };
+            if let Some(w) = bare_angle(&v.value, &tv, md, sv) {
+                let w = format!("{}: {}{}", self.loc(v.line), set_origin(inst, v), w);
+                self.warnings.push(format!(
+                    "{w} (instance '{}', variable '{}')",
+                    inst.name, v.variable
+                ));
+            }
             let before = sv.settable_in_instantiated();
             if sv.variability == Variability::Constant {
                 let e = self.err(v.line, refused(format!(
@@ -226,6 +233,30 @@ impl Checker<'_> {
         }
         svs
     }
+}
+
+/// A number without a unit on a variable in radians, above a full turn: most likely meant in
+/// degrees (`--set waves.wave_direction=90` is 90 rad). Said, not refused: 7 rad is a value.
+fn bare_angle(
+    value: &Value,
+    tv: &TypedValue,
+    md: &ModelDescription,
+    sv: &ScalarVariable,
+) -> Option<String> {
+    let TypedValue::Real(x) = *tv else {
+        return None;
+    };
+    let bare = match value {
+        Value::Real(_) | Value::Integer(_) => true,
+        Value::Text(t) | Value::String(t) => Quantity::parse(t).is_ok_and(|q| q.unit.is_none()),
+        Value::Boolean(_) => false,
+    };
+    (bare && md.real_unit(sv) == Some("rad") && x.abs() > std::f64::consts::TAU).then(|| {
+        format!(
+            "{x} has no unit and is taken in the variable's, rad ({x} rad = {:.0} deg); for degrees write \"{x} deg\"",
+            x.to_degrees()
+        )
+    })
 }
 
 /// `--set inst.var=value: ` for a value set on the command line (or by a campaign or the
