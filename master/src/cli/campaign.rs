@@ -123,7 +123,7 @@ pub fn dispatch(
             let c = Campaign::load(&file)?;
             println!("{}", describe(&c));
             if runs {
-                for r in &c.runs {
+                for r in c.runs.iter() {
                     let sets: Vec<String> =
                         r.sets.iter().map(|(k, v)| format!("{k}={v}")).collect();
                     println!("{:>6}  {}", r.index, sets.join(" "));
