@@ -24,6 +24,11 @@ fn spec(dir: &Path, name: &str, text: &str) -> CampaignSpec {
     CampaignSpec::load(&p).unwrap()
 }
 
+/// Every run of a campaign file (with "h" for the base inputs' hash).
+fn all_runs(s: &CampaignSpec) -> Vec<Run> {
+    design::Design::new(s, "h").unwrap().iter().collect()
+}
+
 fn opts(out: &Path, jobs: usize) -> CampaignOptions {
     CampaignOptions {
         jobs: Some(jobs),
@@ -76,7 +81,7 @@ fn grids_cross_first_factor_slowest_and_ranges_include_their_end() {
     for (p, v) in points.iter().enumerate() {
         assert_eq!(v, &vec![a[p / 2], [1.0, 2.0][p % 2]]);
     }
-    let runs = design::runs(&s, "h").unwrap();
+    let runs = all_runs(&s);
     assert_eq!(runs.len(), 30);
     // index = point * R + r (no arms); the keys are all different.
     assert_eq!((runs[7].point, runs[7].replication), (2, 1));
@@ -93,8 +98,8 @@ fn seeds_never_change_when_factors_points_or_replications_are_added() {
         .replace("values = [1, 2]", "values = [1, 2, 3]")
         + "[[factors]]\nname = \"c\"\nvariable = \"m.w\"\nlinspace = [0, 1, 4]\n";
     let s2 = spec(dir.path(), "c2.toml", &more);
-    let r1 = design::runs(&s, "h").unwrap();
-    let r2 = design::runs(&s2, "h").unwrap();
+    let r1 = all_runs(&s);
+    let r2 = all_runs(&s2);
     for r in 0..3u32 {
         let a: Vec<_> = r1
             .iter()
@@ -128,7 +133,7 @@ fn seeds_never_change_when_factors_points_or_replications_are_added() {
         "a new factor sets a new variable, so every key changes"
     );
     let grown = BASE.replace("count = 3", "count = 5");
-    let r3 = design::runs(&spec(dir.path(), "c3.toml", &grown), "h").unwrap();
+    let r3 = all_runs(&spec(dir.path(), "c3.toml", &grown));
     assert_eq!(r3.iter().filter(|r| k1.contains(&r.key)).count(), 30);
 }
 
@@ -377,8 +382,8 @@ fn a_sigkill_mid_campaign_loses_no_run_and_resume_repeats_none() {
         "no run lost, none repeated"
     );
     let c = Campaign::load(&file).unwrap();
-    let all: HashSet<_> = c.runs.iter().map(|r| &r.key).collect();
-    assert_eq!(unique, all);
+    let all: HashSet<_> = c.runs.iter().map(|r| r.key).collect();
+    assert_eq!(unique, all.iter().collect());
     let t = Table::read(&out.join("runs.csv")).unwrap();
     assert_eq!(t.rows(), 200);
 }
@@ -562,7 +567,7 @@ fn campaign_kpis_equal_the_accumulator_over_the_csv_of_shipsim_run() {
     let t = Table::read(&dir.path().join("out/runs.parquet")).unwrap();
     assert!(texts(&t, "status").iter().all(|s| s == "ok"));
     for row in [0usize, 5] {
-        let run = &c.runs[row];
+        let run = c.runs.run(row);
         let csv = dir.path().join(format!("run{row}.csv"));
         let mut cmd = std::process::Command::new(env!("CARGO_BIN_EXE_shipsim"));
         cmd.args(["run", "-q", "--stop-time", "120", "-o"])
@@ -613,8 +618,8 @@ fn forked_runs_equal_cold_runs_that_apply_the_change_by_events_at_the_fork() {
     let mds: Vec<_> = fmus.iter().map(|f| &f.model_description).collect();
     let changeable =
         |r: &shipsim::system::VarRef| shipsim::campaign::changeable_in(&c.system, &mds, r);
-    for run in &c.runs {
-        let (_, cold) = c.fork_systems_for(run, 20.0, &changeable).unwrap();
+    for run in c.runs.iter() {
+        let (_, cold) = c.fork_systems_for(&run, 20.0, &changeable).unwrap();
         assert_eq!(cold.events.len(), 2, "direction and roll mode change at T");
         let plan = cold.validate(&mds).unwrap();
         let mut kpis = KpiRecorder::new(&c.spec.kpis);
@@ -779,7 +784,7 @@ speed = 8.37667
     assert_eq!(texts(&t, "status"), ["ok", "ok"]);
     // The turning run: the batch metrics over the CSV of the same run by `shipsim run`.
     let csv = dir.path().join("turn.csv");
-    shipsim_run(&system, &c.runs[0].sets, &csv);
+    shipsim_run(&system, &c.runs.run(0).sets, &csv);
     let s = manoeuvre_samples(&csv);
     let m = models::manoeuvre::turning_circle(&s, 10.0).unwrap();
     let got = [
@@ -798,7 +803,7 @@ speed = 8.37667
     assert!(floats(&t, "tc_advance")[1].is_nan() && texts(&t, "tc_imo")[1].is_empty());
     assert!(floats(&t, "zz_first_overshoot")[0].is_nan());
     let csv = dir.path().join("zz.csv");
-    shipsim_run(&system, &c.runs[1].sets, &csv);
+    shipsim_run(&system, &c.runs.run(1).sets, &csv);
     let z =
         models::manoeuvre::zigzag(&manoeuvre_samples(&csv), 10.0, 1.0, 10f64.to_radians()).unwrap();
     let got = [
@@ -839,7 +844,7 @@ fn selected_runs_write_their_decimated_series() {
     assert_eq!(rows.len(), 11);
     assert!((rows[10][0] - 0.1).abs() < 1e-12);
     // y2 = k u with run 3's k from the linspace (0.5 + 0 * ...: point 0) and u = 1.
-    let k = c.runs[3].factors[0];
+    let k = c.runs.run(3).factors[0];
     assert!(rows.iter().all(|r| r[2] == k), "{k}");
 }
 

@@ -27,11 +27,18 @@
 //! **Run order.** `index = (point · R + r) · A + arm`. A run's key (for resume) is the
 //! SHA-256 of everything that determines it: the base inputs' hash (system and FMU files),
 //! the stop time, the warm-up time and every value set, sorted.
+//!
+//! **Runs on demand.** A [`Design`] holds the factors' levels, not the runs: run i is made from
+//! i when it is needed (its point is a mixed-radix number over the dimensions' levels), so a
+//! campaign of [`MAX_RUNS`] runs is shown and counted in the memory of its levels. Two runs
+//! that set the same values are found without making the runs ([`distinct`]).
 
-use super::spec::{CampaignSpec, Levels, SamplingMethod, MAX_RUNS};
+use super::spec::{CampaignSpec, Factor, Levels, SamplingMethod, MAX_RUNS};
 use crate::error::{Error, Result};
 use crate::system::Value;
 use sha2::{Digest, Sha256};
+
+mod distinct;
 
 /// One run of the campaign.
 #[derive(Debug, Clone, PartialEq)]
@@ -93,174 +100,345 @@ fn unit_samples(spec: &CampaignSpec, factor: &str) -> Vec<f64> {
     }
 }
 
-/// One dimension of the crossing: the factors it moves and their values per level.
+/// One dimension of the crossing: the factors it moves and their values, level by level.
+#[derive(Debug, Clone)]
 struct Dimension {
     factors: Vec<usize>,
-    /// `levels[l][j]` is the value of `factors[j]` at level l.
-    levels: Vec<Vec<f64>>,
+    levels: usize,
+    /// `values[l * factors.len() + j]` is the value of `factors[j]` at level l.
+    values: Vec<f64>,
 }
 
-fn dimensions(spec: &CampaignSpec) -> Result<Vec<Dimension>> {
-    let mut dims: Vec<Dimension> = Vec::new();
-    let mut zip_dim: Vec<(String, usize)> = Vec::new();
-    let mut random_dim: Option<usize> = None;
-    let normal = statrs::distribution::Normal::new(0.0, 1.0).expect("standard normal");
-    for (fi, f) in spec.factors.iter().enumerate() {
-        let values: Vec<f64> = match &f.levels {
-            Levels::Grid(v) => v.clone(),
-            Levels::Uniform { low, high } => unit_samples(spec, &f.name)
+impl Dimension {
+    fn level(&self, l: usize) -> &[f64] {
+        let k = self.factors.len();
+        &self.values[l * k..(l + 1) * k]
+    }
+}
+
+/// The number of values of a factor.
+fn level_count(spec: &CampaignSpec, f: &Factor) -> usize {
+    match &f.levels {
+        Levels::Grid(v) => v.len(),
+        _ => spec.sampling.samples,
+    }
+}
+
+/// Every value of a factor (random factors: its samples).
+fn factor_values(spec: &CampaignSpec, f: &Factor) -> Vec<f64> {
+    use statrs::distribution::ContinuousCDF;
+    match &f.levels {
+        Levels::Grid(v) => v.clone(),
+        Levels::Uniform { low, high } => unit_samples(spec, &f.name)
+            .into_iter()
+            .map(|u| low + u * (high - low))
+            .collect(),
+        Levels::Normal { mean, std } => {
+            let normal = statrs::distribution::Normal::new(0.0, 1.0).expect("standard normal");
+            unit_samples(spec, &f.name)
                 .into_iter()
-                .map(|u| low + u * (high - low))
-                .collect(),
-            Levels::Normal { mean, std } => {
-                use statrs::distribution::ContinuousCDF;
-                unit_samples(spec, &f.name)
-                    .into_iter()
-                    .map(|u| mean + std * normal.inverse_cdf(u))
-                    .collect()
-            }
-        };
-        let existing = if f.levels.is_random() {
-            random_dim
-        } else {
-            f.zip
-                .as_ref()
-                .and_then(|z| zip_dim.iter().find(|(n, _)| n == z).map(|(_, d)| *d))
-        };
-        match existing {
-            Some(d) => {
-                let dim = &mut dims[d];
-                if dim.levels.len() != values.len() {
-                    return Err(Error::Other(format!(
-                        "campaign {}: factor '{}' has {} values but the factors it is zipped with have {}",
-                        spec.source.display(),
-                        f.name,
-                        values.len(),
-                        dim.levels.len()
-                    )));
-                }
-                dim.factors.push(fi);
-                for (l, v) in values.into_iter().enumerate() {
-                    dim.levels[l].push(v);
-                }
-            }
-            None => {
-                if f.levels.is_random() {
-                    random_dim = Some(dims.len());
-                } else if let Some(z) = &f.zip {
-                    zip_dim.push((z.clone(), dims.len()));
-                }
-                dims.push(Dimension {
-                    factors: vec![fi],
-                    levels: values.into_iter().map(|v| vec![v]).collect(),
-                });
-            }
+                .map(|u| mean + std * normal.inverse_cdf(u))
+                .collect()
         }
+    }
+}
+
+/// The dimensions without their values: the factors each moves, in order of first appearance,
+/// with its number of levels (zipped factors must have equal lengths).
+fn layout(spec: &CampaignSpec) -> Result<Vec<Dimension>> {
+    let mut dims: Vec<Dimension> = Vec::new();
+    let mut zip_dim: Vec<(&str, usize)> = Vec::new();
+    let mut random_dim: Option<usize> = None;
+    for (fi, f) in spec.factors.iter().enumerate() {
+        let n = level_count(spec, f);
+        let existing = match (&f.zip, f.levels.is_random()) {
+            (_, true) => random_dim,
+            (Some(z), false) => zip_dim.iter().find(|(n, _)| n == z).map(|(_, d)| *d),
+            (None, false) => None,
+        };
+        if let Some(d) = existing {
+            if dims[d].levels != n {
+                return Err(Error::Other(format!(
+                    "campaign {}: factor '{}' has {n} values but the factors it is zipped with have {}",
+                    spec.source.display(),
+                    f.name,
+                    dims[d].levels
+                )));
+            }
+            dims[d].factors.push(fi);
+            continue;
+        }
+        match (&f.zip, f.levels.is_random()) {
+            (_, true) => random_dim = Some(dims.len()),
+            (Some(z), false) => zip_dim.push((z, dims.len())),
+            (None, false) => {}
+        }
+        dims.push(Dimension {
+            factors: vec![fi],
+            levels: n,
+            values: Vec::new(),
+        });
     }
     Ok(dims)
 }
 
-/// The design points: `points[p][f]` is factor f's value at point p.
-pub fn design_points(spec: &CampaignSpec) -> Result<Vec<Vec<f64>>> {
-    let dims = dimensions(spec)?;
-    let total = dims
+/// Fills the dimensions' values (after the counts were checked against the limits).
+fn fill(spec: &CampaignSpec, dims: &mut [Dimension]) {
+    for d in dims {
+        let k = d.factors.len();
+        d.values = vec![0.0; d.levels * k];
+        for (j, &fi) in d.factors.iter().enumerate() {
+            for (l, v) in factor_values(spec, &spec.factors[fi])
+                .into_iter()
+                .enumerate()
+            {
+                d.values[l * k + j] = v;
+            }
+        }
+    }
+}
+
+/// A count for a message: the number, or "more than 10^38" when it does not fit.
+fn count_text(n: Option<u128>) -> String {
+    n.map_or_else(|| "more than 10^38".into(), |n| n.to_string())
+}
+
+/// Refuses a design with more than [`MAX_RUNS`] points or runs, from the counts alone.
+fn check_counts(spec: &CampaignSpec, dims: &[Dimension], reps: u32, arms: usize) -> Result<()> {
+    let points = dims
         .iter()
-        .try_fold(1usize, |n, d| n.checked_mul(d.levels.len()))
-        .filter(|n| *n <= MAX_RUNS)
-        .ok_or_else(|| {
-            Error::Other(format!(
-                "campaign {}: more than {MAX_RUNS} design points",
-                spec.source.display()
-            ))
-        })?;
-    let mut points = Vec::with_capacity(total);
-    for p in 0..total {
-        let mut values = vec![0.0; spec.factors.len()];
-        let mut rest = p;
-        for d in dims.iter().rev() {
-            let l = rest % d.levels.len();
-            rest /= d.levels.len();
-            for (j, &fi) in d.factors.iter().enumerate() {
-                values[fi] = d.levels[l][j];
-            }
-        }
-        points.push(values);
-    }
-    Ok(points)
-}
-
-/// A number as the text `--set` takes: whole numbers without a fraction (so that Integer,
-/// Enumeration and Boolean variables take them), others in shortest round-trip form.
-fn number_text(x: f64) -> String {
-    if x.fract() == 0.0 && x.abs() < 2f64.powi(53) {
-        format!("{}", x as i64)
+        .try_fold(1u128, |n, d| n.checked_mul(d.levels as u128));
+    let runs = points.and_then(|p| p.checked_mul(reps as u128 * arms as u128));
+    let max = MAX_RUNS as u128;
+    let levels: Vec<String> = dims.iter().map(|d| d.levels.to_string()).collect();
+    let (what, count, how) = if points.is_none_or(|p| p > max) {
+        (
+            "design points",
+            points,
+            format!("{} levels crossed", levels.join(" × ")),
+        )
+    } else if runs.is_none_or(|r| r > max) {
+        let how = format!(
+            "{} points × {reps} replications × {arms} arms",
+            points.unwrap_or(0)
+        );
+        ("runs", runs, how)
     } else {
-        format!("{x:?}")
-    }
+        return Ok(());
+    };
+    Err(Error::Other(format!(
+        "campaign {}: {} {what} ({how}), more than the {MAX_RUNS} a campaign may have: the \
+         journal and the tables of a finished campaign hold every run in memory (see the limits \
+         in docs/campaigns.md); split it into several campaign files",
+        spec.source.display(),
+        count_text(count)
+    )))
 }
 
-/// Every run of the campaign, in index order. `base_hash` identifies the base system and its
-/// FMUs (see [`super::Campaign`]).
-pub fn runs(spec: &CampaignSpec, base_hash: &str) -> Result<Vec<Run>> {
-    let points = design_points(spec)?;
-    let reps = spec.replications.count.max(1);
-    let arms = spec.arms.len().max(1);
-    let total = points
-        .len()
-        .checked_mul(reps as usize)
-        .and_then(|n| n.checked_mul(arms))
-        .filter(|n| *n <= 100_000_000)
-        .ok_or_else(|| {
-            Error::Other(format!(
-                "campaign {}: more than 10^8 runs",
-                spec.source.display()
-            ))
-        })?;
-    let mut out = Vec::with_capacity(total);
-    for (point, values) in points.iter().enumerate() {
-        for r in 0..reps {
-            let seeds: Vec<i64> = spec
-                .replications
-                .seeds
+/// The design points: `points[p][f]` is factor f's value at point p. Every point at once: for
+/// small designs and tests ([`Design::point`] gives one).
+pub fn design_points(spec: &CampaignSpec) -> Result<Vec<Vec<f64>>> {
+    let d = Design::unchecked(spec, "")?;
+    Ok((0..d.points()).map(|p| d.point(p)).collect())
+}
+
+/// The runs of a campaign (design points × replications × arms), each computed from its index
+/// when asked for: a campaign of any size takes the memory of its factors' levels, not of its
+/// runs.
+#[derive(Debug, Clone)]
+pub struct Design {
+    dims: Vec<Dimension>,
+    points: usize,
+    replications: u32,
+    arms: usize,
+    seed: u64,
+    common: Vec<(String, Value)>,
+    /// Each factor's (variable, scale).
+    factors: Vec<(String, f64)>,
+    seed_params: Vec<String>,
+    arm_sets: Vec<Vec<(String, Value)>>,
+    /// What every run key hashes first: the base inputs' hash, the stop and warm-up times.
+    key_head: String,
+}
+
+impl Design {
+    /// The design of a campaign file; `base_hash` identifies the base system and its FMUs (see
+    /// [`super::Campaign`]). Refuses more than [`MAX_RUNS`] points or runs before it allocates
+    /// anything for them, and two runs that set the same values.
+    pub fn new(spec: &CampaignSpec, base_hash: &str) -> Result<Design> {
+        let design = Design::unchecked(spec, base_hash)?;
+        match design.duplicate() {
+            Some((a, b)) => Err(Error::Other(format!(
+                "campaign {}: runs {a} and {b} set the same values (identical factor values or arms?)",
+                spec.source.display(),
+            ))),
+            None => Ok(design),
+        }
+    }
+
+    /// The design without the check for runs that set the same values.
+    fn unchecked(spec: &CampaignSpec, base_hash: &str) -> Result<Design> {
+        let mut dims = layout(spec)?;
+        let replications = spec.replications.count.max(1);
+        let arms = spec.arms.len().max(1);
+        check_counts(spec, &dims, replications, arms)?;
+        fill(spec, &mut dims);
+        Ok(Design {
+            points: dims.iter().map(|d| d.levels).product(),
+            dims,
+            replications,
+            arms,
+            seed: spec.seed,
+            common: spec.set.clone(),
+            factors: spec
+                .factors
                 .iter()
-                .map(|p| derived_seed(spec.seed, p, r))
-                .collect();
-            for arm in 0..arms {
-                let mut sets = spec.set.clone();
-                for (f, x) in spec.factors.iter().zip(values) {
-                    sets.push((f.variable.clone(), Value::Text(number_text(x * f.scale))));
-                }
-                for (p, s) in spec.replications.seeds.iter().zip(&seeds) {
-                    sets.push((p.clone(), Value::Integer(*s)));
-                }
-                if let Some(a) = spec.arms.get(arm) {
-                    sets.extend(a.set.iter().cloned());
-                }
-                let key = run_key(spec, base_hash, &sets);
-                out.push(Run {
-                    index: out.len(),
-                    point,
-                    replication: r,
-                    arm,
-                    factors: values.clone(),
-                    seeds: seeds.clone(),
-                    sets,
-                    key,
-                });
+                .map(|f| (f.variable.clone(), f.scale))
+                .collect(),
+            seed_params: spec.replications.seeds.clone(),
+            arm_sets: spec.arms.iter().map(|a| a.set.clone()).collect(),
+            key_head: format!(
+                "shipsim-run-v1\n{base_hash}\nstop={:?}\nfork={:?}\n",
+                spec.stop_time, spec.fork_at
+            ),
+        })
+    }
+
+    /// The number of runs.
+    pub fn len(&self) -> usize {
+        self.points * self.replications as usize * self.arms
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The number of design points.
+    pub fn points(&self) -> usize {
+        self.points
+    }
+
+    /// The index of the run of (point, replication, arm).
+    pub fn index(&self, point: usize, replication: u32, arm: usize) -> usize {
+        (point * self.replications as usize + replication as usize) * self.arms + arm
+    }
+
+    /// The factor values of design point `p` (before the factors' scales), in factor order.
+    pub fn point(&self, p: usize) -> Vec<f64> {
+        let mut values = vec![0.0; self.factors.len()];
+        let mut rest = p;
+        for d in self.dims.iter().rev() {
+            let l = rest % d.levels;
+            rest /= d.levels;
+            for (&fi, &x) in d.factors.iter().zip(d.level(l)) {
+                values[fi] = x;
             }
         }
+        values
     }
-    let mut seen = std::collections::HashMap::new();
-    for r in &out {
-        if let Some(first) = seen.insert(&r.key, r.index) {
-            return Err(Error::Other(format!(
-                "campaign {}: runs {first} and {} set the same values (identical factor values or arms?)",
-                spec.source.display(),
-                r.index
-            )));
+
+    /// The derived seeds of replication `r`, in the order of `replications.seeds`.
+    pub fn seeds(&self, r: u32) -> Vec<i64> {
+        let seed = self.seed;
+        self.seed_params
+            .iter()
+            .map(|p| derived_seed(seed, p, r))
+            .collect()
+    }
+
+    /// Run `index`, or None past the last run.
+    pub fn get(&self, index: usize) -> Option<Run> {
+        (index < self.len()).then(|| self.run(index))
+    }
+
+    /// (point, replication, arm) of run `index`.
+    pub fn place(&self, index: usize) -> (usize, u32, usize) {
+        let arm = index % self.arms;
+        let replication = ((index / self.arms) % self.replications as usize) as u32;
+        (
+            index / self.arms / self.replications as usize,
+            replication,
+            arm,
+        )
+    }
+
+    /// Factor `f`'s value at design point `p` (before its scale).
+    pub fn factor(&self, p: usize, f: usize) -> f64 {
+        let mut rest = p;
+        for d in self.dims.iter().rev() {
+            let l = rest % d.levels;
+            if let Some(j) = d.factors.iter().position(|&fi| fi == f) {
+                return d.level(l)[j];
+            }
+            rest /= d.levels;
+        }
+        panic!("no factor {f}")
+    }
+
+    /// The seed of the `j`th seed parameter in replication `r`.
+    pub fn seed(&self, r: u32, j: usize) -> i64 {
+        derived_seed(self.seed, &self.seed_params[j], r)
+    }
+
+    /// Run `index` (< [`Design::len`]).
+    pub fn run(&self, index: usize) -> Run {
+        assert!(index < self.len(), "run {index} of {}", self.len());
+        let (point, replication, arm) = self.place(index);
+        let factors = self.point(point);
+        let seeds = self.seeds(replication);
+        let sets = self.sets(&factors, &seeds, arm);
+        let key = self.key(&sets);
+        Run {
+            index,
+            point,
+            replication,
+            arm,
+            factors,
+            seeds,
+            sets,
+            key,
         }
     }
-    Ok(out)
+
+    /// Every variable some run sets (a variable may be named more than once).
+    pub fn variables(&self) -> impl Iterator<Item = &str> {
+        let common = self.common.iter().map(|(v, _)| v.as_str());
+        let factors = self.factors.iter().map(|(v, _)| v.as_str());
+        let arms = self.arm_sets.iter().flatten().map(|(v, _)| v.as_str());
+        common
+            .chain(factors)
+            .chain(self.seed_params.iter().map(String::as_str))
+            .chain(arms)
+    }
+
+    /// Every run, in index order, each made when the iterator reaches it.
+    pub fn iter(&self) -> impl ExactSizeIterator<Item = Run> + '_ {
+        (0..self.len()).map(|i| self.run(i))
+    }
+
+    /// Every value a run sets: common sets, factors (scaled), seeds, arm sets.
+    fn sets(&self, factors: &[f64], seeds: &[i64], arm: usize) -> Vec<(String, Value)> {
+        let mut sets = self.common.clone();
+        for ((variable, scale), x) in self.factors.iter().zip(factors) {
+            sets.push((variable.clone(), Value::Text(number_text(x * scale))));
+        }
+        for (p, s) in self.seed_params.iter().zip(seeds) {
+            sets.push((p.clone(), Value::Integer(*s)));
+        }
+        if let Some(a) = self.arm_sets.get(arm) {
+            sets.extend(a.iter().cloned());
+        }
+        sets
+    }
+
+    fn key(&self, sets: &[(String, Value)]) -> String {
+        let mut h = Sha256::new();
+        h.update(self.key_head.as_bytes());
+        for (k, v) in effective_sets(sets) {
+            h.update(format!("{k}={}\n", canonical(&v)).as_bytes());
+        }
+        hex(&h.finalize())
+    }
 }
 
 /// The sets with later values winning, sorted by variable.
@@ -272,15 +450,14 @@ pub fn effective_sets(sets: &[(String, Value)]) -> Vec<(String, Value)> {
     m.into_iter().collect()
 }
 
-fn run_key(spec: &CampaignSpec, base_hash: &str, sets: &[(String, Value)]) -> String {
-    let mut h = Sha256::new();
-    h.update(b"shipsim-run-v1\n");
-    h.update(base_hash.as_bytes());
-    h.update(format!("\nstop={:?}\nfork={:?}\n", spec.stop_time, spec.fork_at).as_bytes());
-    for (k, v) in effective_sets(sets) {
-        h.update(format!("{k}={}\n", canonical(&v)).as_bytes());
+/// A number as the text `--set` takes: whole numbers without a fraction (so that Integer,
+/// Enumeration and Boolean variables take them), others in shortest round-trip form.
+fn number_text(x: f64) -> String {
+    if x.fract() == 0.0 && x.abs() < 2f64.powi(53) {
+        format!("{}", x as i64)
+    } else {
+        format!("{x:?}")
     }
-    hex(&h.finalize())
 }
 
 /// A value's text for hashing: the same value always hashes the same, whatever its spelling.

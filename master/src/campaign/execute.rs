@@ -441,17 +441,26 @@ pub fn run(campaign: &Campaign, opts: &CampaignOptions) -> Result<CampaignOutcom
     let fork = fork_plan(campaign, &mds)?;
     let selected = select(campaign, fork.as_ref(), opts.shard);
     outcome.selected = selected.len();
-    let todo: Vec<&Run> = selected
+    // Each selected run's state in the journal (None: not done; Some(failed)), its key made once.
+    let state: Vec<(usize, Option<bool>)> = selected
+        .into_par_iter()
+        .map(|i| {
+            let done = journal.done(&campaign.runs.run(i).key);
+            (i, done.map(|r| r.status.failed()))
+        })
+        .collect();
+    let retry = opts.retry_failed;
+    let todo: Vec<usize> = state
         .iter()
-        .map(|&i| &campaign.runs[i])
-        .filter(|r| to_do(&journal, r, opts.retry_failed))
+        .filter(|(_, s)| s.is_none() || (retry && *s == Some(true)))
+        .map(|&(i, _)| i)
         .collect();
     outcome.skipped = outcome.selected - todo.len();
-    outcome.failed_before = selected
+    outcome.failed_before = state
         .iter()
-        .filter_map(|&i| journal.done(&campaign.runs[i].key))
-        .filter(|r| r.status.failed() && !opts.retry_failed)
+        .filter(|(_, s)| !retry && *s == Some(true))
         .count();
+    drop(state);
     let ctx = Context {
         progress: opts.progress.then(|| progress_bar(todo.len())),
         observer: opts.observer.clone(),
@@ -486,11 +495,12 @@ fn validate_first_runs(campaign: &Campaign, fmus: &[Arc<Fmu>]) -> Result<()> {
     let mds: Vec<&ModelDescription> = fmus.iter().map(|f| &f.model_description).collect();
     let mut first_error = None;
     for arm in 0..campaign.spec.arms.len().max(1) {
-        let Some(run) = campaign.runs.iter().find(|r| r.arm == arm) else {
+        // the first run of an arm is the arm's index (point 0, replication 0)
+        let Some(run) = campaign.runs.get(arm) else {
             continue;
         };
         match campaign
-            .system_for(run)
+            .system_for(&run)
             .and_then(|s| s.validate(&mds).map(drop))
         {
             Ok(()) => return Ok(()),
@@ -611,7 +621,7 @@ impl<'a> Context<'a> {
 fn execute_all(
     ctx: &Context,
     fork: Option<&Fork>,
-    todo: &[&Run],
+    todo: &[usize],
     jobs: usize,
 ) -> Result<Option<Vec<usize>>> {
     let pool = rayon::ThreadPoolBuilder::new()
@@ -626,9 +636,10 @@ fn execute_all(
     };
     let groups = pool.install(|| match fork {
         None => {
-            todo.par_iter().for_each(|r| {
+            todo.par_iter().for_each(|&i| {
                 if !ctx.stop() {
-                    keep(ctx.finish(r, ctx.cold(r)));
+                    let run = ctx.campaign.runs.run(i);
+                    keep(ctx.finish(&run, ctx.cold(&run)));
                 }
             });
             None
@@ -659,19 +670,14 @@ pub(super) fn run_collect(
     opts: &CampaignOptions,
     series_dir: PathBuf,
 ) -> Result<Vec<RunRecord>> {
-    let todo = indices
-        .iter()
-        .map(|&i| {
-            campaign.runs.get(i).ok_or_else(|| {
-                Error::Other(format!(
-                    "campaign {}: no run {i} (it has {})",
-                    campaign.spec.source.display(),
-                    campaign.runs.len()
-                ))
-            })
-        })
-        .collect::<Result<Vec<&Run>>>()?;
-    let (jobs, _) = jobs_for(fmus, opts.jobs, todo.len())?;
+    if let Some(i) = indices.iter().find(|&&i| i >= campaign.runs.len()) {
+        return Err(Error::Other(format!(
+            "campaign {}: no run {i} (it has {})",
+            campaign.spec.source.display(),
+            campaign.runs.len()
+        )));
+    }
+    let (jobs, _) = jobs_for(fmus, opts.jobs, indices.len())?;
     let mds: Vec<&ModelDescription> = fmus.iter().map(|f| &f.model_description).collect();
     let fork = fork_plan(campaign, &mds)?;
     let ctx = Context {
@@ -684,7 +690,7 @@ pub(super) fn run_collect(
             series_dir,
         )
     };
-    execute_all(&ctx, fork.as_ref(), &todo, jobs)?;
+    execute_all(&ctx, fork.as_ref(), indices, jobs)?;
     if ctx.interrupted.load(Ordering::Relaxed) || ctx.stop() {
         return Err(Error::Interrupted { time: f64::NAN });
     }
@@ -699,15 +705,11 @@ pub(super) fn run_collect(
 pub(super) fn work_units(
     campaign: &Campaign,
     mds: &[&ModelDescription],
-    todo: &[&Run],
+    todo: &[usize],
 ) -> Result<Vec<Vec<usize>>> {
     Ok(match fork_plan(campaign, mds)? {
-        Some(f) => f
-            .groups_of(todo)
-            .into_iter()
-            .map(|g| g.iter().map(|r| r.index).collect())
-            .collect(),
-        None => todo.iter().map(|r| vec![r.index]).collect(),
+        Some(f) => f.groups_of(todo),
+        None => todo.iter().map(|&i| vec![i]).collect(),
     })
 }
 
@@ -763,13 +765,12 @@ fn fork_plan(campaign: &Campaign, mds: &[&ModelDescription]) -> Result<Option<Fo
     }
     let changeable: std::collections::HashSet<String> = campaign
         .runs
-        .iter()
-        .flat_map(|r| r.sets.iter().map(|(v, _)| v))
+        .variables()
         .filter(|v| {
             crate::system::VarRef::parse(v)
                 .is_some_and(|r| super::changeable_in(&campaign.system, mds, &r))
         })
-        .cloned()
+        .map(str::to_string)
         .collect();
     let fork = Fork {
         at,
@@ -783,7 +784,7 @@ fn fork_plan(campaign: &Campaign, mds: &[&ModelDescription]) -> Result<Option<Fo
         .map(|r| {
             let n = keys.len();
             *keys
-                .entry(campaign.group_key(r, &|v| fork.is_changeable(v)))
+                .entry(campaign.group_key(&r, &|v| fork.is_changeable(v)))
                 .or_insert(n)
         })
         .collect();
@@ -801,21 +802,22 @@ impl Fork {
     }
 
     /// The runs to do, by warm-up group.
-    fn groups_of<'r>(&self, todo: &[&'r Run]) -> Vec<Vec<&'r Run>> {
-        let mut by: std::collections::BTreeMap<usize, Vec<&Run>> = Default::default();
-        for r in todo {
-            by.entry(self.group[r.index]).or_default().push(r);
+    fn groups_of(&self, todo: &[usize]) -> Vec<Vec<usize>> {
+        let mut by: std::collections::BTreeMap<usize, Vec<usize>> = Default::default();
+        for &i in todo {
+            by.entry(self.group[i]).or_default().push(i);
         }
         by.into_values().collect()
     }
 
     /// One group: its warm-up to T, then every run from the checkpoint.
-    fn run_group(&self, ctx: &Context, runs: &[&Run]) -> Result<()> {
+    fn run_group(&self, ctx: &Context, runs: &[usize]) -> Result<()> {
         if ctx.stop() {
             return Ok(());
         }
+        let design = &ctx.campaign.runs;
         let warm_up = || -> Result<run::Checkpoint> {
-            let (system, _) = self.systems(ctx.campaign, runs[0])?;
+            let (system, _) = self.systems(ctx.campaign, &design.run(runs[0]))?;
             let plan = system.validate(&ctx.mds())?;
             let k = run::checkpoint_step(&plan, self.at)
                 .map_err(|e| Error::Other(format!("fork_at: {e}")))?;
@@ -830,27 +832,28 @@ impl Fork {
                     Ok(Err(e)) => format!("warm-up: {e}"),
                     _ => "warm-up: panic".into(),
                 };
-                for r in runs {
+                for &i in runs {
                     let done = Outcome::Done {
                         status: Status::Error,
                         message: message.clone(),
                         kpis: missing_values(&ctx.campaign.spec.kpis),
                         wall: 0.0,
                     };
-                    ctx.finish(r, done)?;
+                    ctx.finish(&design.run(i), done)?;
                 }
                 return Ok(());
             }
         };
-        runs.par_iter().try_for_each(|r| {
+        runs.par_iter().try_for_each(|&i| {
             if ctx.stop() {
                 return Ok(());
             }
-            let outcome = ctx.execute(r, |rec| {
-                let plan = self.systems(ctx.campaign, r)?.1.validate(&ctx.mds())?;
+            let r = design.run(i);
+            let outcome = ctx.execute(&r, |rec| {
+                let plan = self.systems(ctx.campaign, &r)?.1.validate(&ctx.mds())?;
                 run::resume_into(&plan, &ctx.fmus, &cp, Some(rec), &ctx.run_opts)
             });
-            ctx.finish(r, outcome)
+            ctx.finish(&r, outcome)
         })
     }
 }

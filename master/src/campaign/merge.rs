@@ -4,7 +4,7 @@
 
 use super::journal::{Journal, RunRecord};
 use super::output::{self, write_atomic, Provenance};
-use super::{design, CampaignSpec};
+use super::{CampaignSpec, Design};
 use crate::error::{Error, Result};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -114,7 +114,7 @@ pub fn merge(inputs: &[PathBuf], out: &Path) -> Result<MergeReport> {
         .max_by_key(|p| p.runs)
         .expect("one input");
     let spec = CampaignSpec::parse(&newest.campaign_file, &newest.campaign_text)?;
-    let runs = design::runs(&spec, &newest.base_hash)?;
+    let runs = Design::new(&spec, &newest.base_hash)?;
     std::fs::create_dir_all(out)
         .map_err(|e| Error::io(format!("cannot create {}", out.display()), e))?;
     let mut merged_prov = newest.clone();
@@ -125,7 +125,7 @@ pub fn merge(inputs: &[PathBuf], out: &Path) -> Result<MergeReport> {
     write_atomic(&out.join("campaign.json"), text.as_bytes())?;
     let (mut found, mut present) = (0, 0);
     let mut missing = Vec::new();
-    for run in &runs {
+    for run in runs.iter() {
         let new = records.get(&run.key);
         // what the folder has stands, unless it failed and an input has the run done
         let kept = journal

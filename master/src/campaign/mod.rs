@@ -1,7 +1,8 @@
 //! Campaigns: many runs of one system over factors, seeds and arms, one KPI row per run.
 //!
 //! A campaign file ([`spec`]) names a base system and says what to vary and what to measure.
-//! [`Campaign::load`] reads it, reads the base system and expands the runs ([`design`]).
+//! [`Campaign::load`] reads it, reads the base system and lays out the runs ([`design`]: each
+//! run is made from its index when it is needed).
 //! [`execute::run`] runs them on a work-stealing pool, each with its own FMU
 //! instances (every FMU library loaded once per process), computing the KPIs on the fly
 //! ([`kpi`], [`manoeuvre`]) and appending each finished run durably to the journal
@@ -30,7 +31,7 @@ pub mod remote;
 pub mod spec;
 pub mod table;
 
-pub use design::Run;
+pub use design::{Design, Run};
 pub use execute::{CampaignOptions, CampaignOutcome};
 pub use spec::CampaignSpec;
 
@@ -42,7 +43,8 @@ pub struct Campaign {
     pub system: System,
     /// SHA-256 of the base system file and of every FMU file it uses.
     pub base_hash: String,
-    pub runs: Vec<Run>,
+    /// The runs, each made from its index when asked for.
+    pub runs: Design,
 }
 
 /// SHA-256 of a file's bytes, hex.
@@ -73,7 +75,7 @@ fn windows_fit(spec: &CampaignSpec, system: &System) -> Result<()> {
 }
 
 impl Campaign {
-    /// Reads a campaign file and its base system, and expands the runs.
+    /// Reads a campaign file and its base system, and lays out the runs.
     pub fn load(path: &Path) -> Result<Campaign> {
         Campaign::from_spec(CampaignSpec::load(path)?)
     }
@@ -90,7 +92,7 @@ impl Campaign {
     }
 
     /// A checked campaign file with its base system given (e.g. with the FMU paths pointed
-    /// elsewhere): records the KPI variables, hashes the system file and FMUs, expands the runs.
+    /// elsewhere): records the KPI variables, hashes the system file and FMUs, lays out the runs.
     pub fn new(spec: CampaignSpec, mut system: System) -> Result<Campaign> {
         system.apply_stop_time(spec.stop_time)?;
         system.apply_step_size(spec.step_size)?;
@@ -132,7 +134,7 @@ impl Campaign {
                 )));
             }
         }
-        let runs = design::runs(&spec, &base_hash)?;
+        let runs = Design::new(&spec, &base_hash)?;
         Ok(Campaign {
             spec,
             system,

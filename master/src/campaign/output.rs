@@ -13,10 +13,10 @@
 use super::derived::DerivedKpi;
 use super::journal::{Journal, RunRecord};
 use super::table::{ColumnData, Table};
-use super::{Campaign, CampaignSpec, Run};
+use super::{Campaign, CampaignSpec, Design};
 use crate::error::{Error, Result};
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
-use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 /// The file name of run `index`'s series in `series/`.
@@ -131,46 +131,43 @@ pub fn kpi_columns(spec: &CampaignSpec) -> Vec<String> {
     spec.kpis.iter().flat_map(|k| k.columns()).collect()
 }
 
-/// The finished runs of the campaign in index order (records of other campaigns' keys are
-/// left out).
+/// The finished runs of the campaign in index order, by index (records of other campaigns'
+/// keys are left out). Every run's key is computed (in parallel); none is kept.
 ///
 /// Runs are matched by key, not by index: a campaign extended with more points or
 /// replications keeps its finished runs (their keys do not change), under new indices.
-pub fn finished<'a>(
-    runs: &'a [Run],
-    records: impl Iterator<Item = &'a RunRecord>,
-) -> Vec<(&'a Run, &'a RunRecord)> {
-    let by_key: HashMap<&str, &RunRecord> = records.map(|r| (r.key.as_str(), r)).collect();
-    runs.iter()
-        .filter_map(|r| Some((r, *by_key.get(r.key.as_str())?)))
+pub fn finished<'a>(runs: &Design, journal: &'a Journal) -> Vec<(usize, &'a RunRecord)> {
+    if journal.records().next().is_none() {
+        return Vec::new();
+    }
+    (0..runs.len())
+        .into_par_iter()
+        .filter_map(|i| Some((i, journal.done(&runs.run(i).key)?)))
         .collect()
 }
 
 /// The run table of the finished runs.
-pub fn run_table(spec: &CampaignSpec, finished: &[(&Run, &RunRecord)]) -> Table {
-    let runs: Vec<&Run> = finished.iter().map(|f| f.0).collect();
+pub fn run_table(spec: &CampaignSpec, runs: &Design, finished: &[(usize, &RunRecord)]) -> Table {
     let done: Vec<&RunRecord> = finished.iter().map(|f| f.1).collect();
+    let places: Vec<(usize, u32, usize)> = finished.iter().map(|f| runs.place(f.0)).collect();
     let mut t = Table::default();
-    let int = |f: &dyn Fn(&Run) -> i64| ColumnData::Int(runs.iter().map(|r| f(r)).collect());
-    t.push("run", int(&|r| r.index as i64));
-    t.push("point", int(&|r| r.point as i64));
-    t.push("replication", int(&|r| r.replication as i64));
+    let int = |f: &dyn Fn(usize) -> i64| ColumnData::Int((0..done.len()).map(f).collect());
+    t.push("run", int(&|k| finished[k].0 as i64));
+    t.push("point", int(&|k| places[k].0 as i64));
+    t.push("replication", int(&|k| places[k].1 as i64));
     if !spec.arms.is_empty() {
-        let arm = runs.iter().map(|r| spec.arms[r.arm].name.clone()).collect();
+        let arm = places.iter().map(|p| spec.arms[p.2].name.clone()).collect();
         t.push("arm", ColumnData::Text(arm));
     }
     for (j, f) in spec.factors.iter().enumerate() {
-        t.push(
-            &f.name,
-            ColumnData::Float(runs.iter().map(|r| r.factors[j]).collect()),
-        );
+        let values = places.iter().map(|p| runs.factor(p.0, j)).collect();
+        t.push(&f.name, ColumnData::Float(values));
     }
     for (j, s) in spec.replications.seeds.iter().enumerate() {
-        t.push(
-            s,
-            ColumnData::Int(runs.iter().map(|r| r.seeds[j]).collect()),
-        );
+        let seeds = places.par_iter().map(|p| runs.seed(p.1, j)).collect();
+        t.push(s, ColumnData::Int(seeds));
     }
+    drop(places);
     let mut j = 0;
     for k in &spec.kpis {
         for (c, name) in k.columns().into_iter().enumerate() {
@@ -205,44 +202,41 @@ fn verdict(v: &super::journal::JsonKpi) -> String {
 /// The derived table: one row per design point and replication with any finished run.
 pub fn derived_table(
     spec: &CampaignSpec,
-    finished: &[(&Run, &RunRecord)],
+    runs: &Design,
+    finished: &[(usize, &RunRecord)],
 ) -> Result<Option<Table>> {
     if spec.derived.is_empty() {
         return Ok(None);
     }
     let kpis = DerivedKpi::compile(spec, &kpi_columns(spec))?;
     let arms = spec.arms.len().max(1);
-    // Per (point, replication): any run of the cell (it carries the factors and seeds), and
-    // the record of each arm.
-    type Cell<'a> = (&'a Run, Vec<Option<&'a RunRecord>>);
-    let mut cells: std::collections::BTreeMap<(usize, u32), Cell> = Default::default();
-    for (run, rec) in finished {
+    // Per (point, replication): the record of each arm.
+    type Cell<'a> = ((usize, u32), Vec<Option<&'a RunRecord>>);
+    let mut cells: std::collections::BTreeMap<(usize, u32), Vec<Option<&RunRecord>>> =
+        Default::default();
+    for (i, rec) in finished {
+        let (point, replication, arm) = runs.place(*i);
         cells
-            .entry((run.point, run.replication))
-            .or_insert_with(|| (run, vec![None; arms]))
-            .1[run.arm] = Some(rec);
+            .entry((point, replication))
+            .or_insert_with(|| vec![None; arms])[arm] = Some(rec);
     }
-    let rows: Vec<&Cell> = cells.values().collect();
+    let rows: Vec<Cell> = cells.into_iter().collect();
     let mut t = Table::default();
     t.push(
         "point",
-        ColumnData::Int(rows.iter().map(|c| c.0.point as i64).collect()),
+        ColumnData::Int(rows.iter().map(|c| c.0 .0 as i64).collect()),
     );
     t.push(
         "replication",
-        ColumnData::Int(rows.iter().map(|c| c.0.replication as i64).collect()),
+        ColumnData::Int(rows.iter().map(|c| c.0 .1 as i64).collect()),
     );
     for (j, f) in spec.factors.iter().enumerate() {
-        t.push(
-            &f.name,
-            ColumnData::Float(rows.iter().map(|c| c.0.factors[j]).collect()),
-        );
+        let values = rows.iter().map(|c| runs.factor(c.0 .0, j)).collect();
+        t.push(&f.name, ColumnData::Float(values));
     }
     for (j, s) in spec.replications.seeds.iter().enumerate() {
-        t.push(
-            s,
-            ColumnData::Int(rows.iter().map(|c| c.0.seeds[j]).collect()),
-        );
+        let seeds = rows.par_iter().map(|c| runs.seed(c.0 .1, j)).collect();
+        t.push(s, ColumnData::Int(seeds));
     }
     // values[row][arm][kpi column]
     let n_kpis = kpi_columns(spec).len();
@@ -287,11 +281,11 @@ pub fn derived_table(
 /// Writes the run table and the derived table (CSV and Parquet) from the journal.
 pub fn write_tables(
     spec: &CampaignSpec,
-    runs: &[Run],
+    runs: &Design,
     journal: &Journal,
     dir: &Path,
 ) -> Result<Vec<PathBuf>> {
-    let done = finished(runs, journal.records());
+    let done = finished(runs, journal);
     let mut files = Vec::new();
     let mut write = |name: &str, t: &Table| -> Result<()> {
         let csv = dir.join(format!("{name}.csv"));
@@ -302,8 +296,8 @@ pub fn write_tables(
         files.push(parquet);
         Ok(())
     };
-    write("runs", &run_table(spec, &done))?;
-    if let Some(t) = derived_table(spec, &done)? {
+    write("runs", &run_table(spec, runs, &done))?;
+    if let Some(t) = derived_table(spec, runs, &done)? {
         write("derived", &t)?;
     }
     Ok(files)

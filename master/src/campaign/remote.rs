@@ -26,6 +26,7 @@ use crate::error::{Error, Result};
 use crate::fmu::{Fmu, UnpackedFmu};
 use crate::model_description::ModelDescription;
 use crate::run;
+use rayon::prelude::*;
 use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -58,7 +59,15 @@ impl Collector {
 
     /// How many runs are not done yet.
     pub fn pending(&self, campaign: &Campaign) -> usize {
-        campaign.runs.iter().filter(|r| self.to_do(r)).count()
+        self.todo(campaign).len()
+    }
+
+    /// The runs not done yet, by index (every run's key is computed, in parallel).
+    fn todo(&self, campaign: &Campaign) -> Vec<usize> {
+        (0..campaign.runs.len())
+            .into_par_iter()
+            .filter(|&i| self.to_do(&campaign.runs.run(i)))
+            .collect()
     }
 
     /// Not in the journal (or failed there, with `retry_failed`), and not recorded since.
@@ -69,7 +78,7 @@ impl Collector {
     /// The runs not done yet, as chunks of about `per_chunk` runs in index order. The runs of
     /// a warm-up group (`fork_at`) stay in one chunk, so that each warm-up runs once.
     pub fn chunks(&self, campaign: &Campaign, per_chunk: usize) -> Result<Vec<Vec<usize>>> {
-        let todo: Vec<&Run> = campaign.runs.iter().filter(|r| self.to_do(r)).collect();
+        let todo = self.todo(campaign);
         // Grouping needs the model descriptions only when the campaign forks (which variables
         // are tunable); they are read without loading the binaries.
         let unpacked = match campaign.spec.fork_at {
@@ -103,8 +112,8 @@ impl Collector {
         record: RunRecord,
         series: Option<&[u8]>,
     ) -> Result<bool> {
-        let expected = campaign.runs.get(record.index).map(|r| r.key.as_str());
-        if expected != Some(record.key.as_str()) {
+        let expected = campaign.runs.get(record.index).map(|r| r.key);
+        if expected.as_deref() != Some(record.key.as_str()) {
             return Err(Error::Other(format!(
                 "campaign {}: a worker returned run {} with key {}, but this campaign's run {} \
                  has key {}: the worker reads a different campaign, base system or FMU (the \
@@ -113,7 +122,7 @@ impl Collector {
                 record.index,
                 record.key,
                 record.index,
-                expected.unwrap_or("(none)")
+                expected.as_deref().unwrap_or("(none)")
             )));
         }
         if !self.recorded.insert(record.key.clone()) {
@@ -139,8 +148,8 @@ impl Collector {
 
 /// The run table of the runs in `journal`: what `runs.parquet` holds.
 pub fn run_table(campaign: &Campaign, journal: &Journal) -> Table {
-    let done = output::finished(&campaign.runs, journal.records());
-    output::run_table(&campaign.spec, &done)
+    let done = output::finished(&campaign.runs, journal);
+    output::run_table(&campaign.spec, &campaign.runs, &done)
 }
 
 /// The run table of a campaign's output folder (from its journal).

@@ -69,9 +69,13 @@ pub const TABLE_COLUMNS: [&str; 8] = [
     "key",
 ];
 
-/// The most runs (and design points) a campaign file may expand to: every run is held in
-/// memory with the values it sets (about a kilobyte each).
-pub const MAX_RUNS: usize = 1_000_000;
+/// The most runs (and so design points) a campaign file may expand to. Runs are made from their
+/// index when needed, but the journal and the tables of a finished campaign hold every run
+/// (see the limits in docs/campaigns.md).
+pub const MAX_RUNS: usize = 10_000_000;
+
+/// The most samples of the random factors: each factor's samples are held in memory.
+pub const MAX_SAMPLES: usize = 1_000_000;
 
 /// A campaign file, checked.
 #[derive(Debug, Clone)]
@@ -613,12 +617,12 @@ impl Reader<'_> {
                 "[sampling] is given but no factor is uniform or normal".into(),
             );
         }
-        if s.samples == 0 || s.samples > MAX_RUNS {
+        if s.samples == 0 || s.samples > MAX_SAMPLES {
             self.error(
                 None,
                 format!(
                     "sampling: samples = {} must be 1 ..= {}",
-                    s.samples, MAX_RUNS
+                    s.samples, MAX_SAMPLES
                 ),
             );
         }

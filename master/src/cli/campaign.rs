@@ -123,11 +123,7 @@ pub fn dispatch(
             let c = Campaign::load(&file)?;
             println!("{}", describe(&c));
             if runs {
-                for r in &c.runs {
-                    let sets: Vec<String> =
-                        r.sets.iter().map(|(k, v)| format!("{k}={v}")).collect();
-                    println!("{:>6}  {}", r.index, sets.join(" "));
-                }
+                list_runs(&c)?;
             }
             Ok(())
         }
@@ -184,6 +180,18 @@ fn failures(outcome: &campaign::execute::CampaignOutcome) -> shipsim::Result<()>
         "{failed} of {} runs failed (status and message in runs.csv; --retry-failed runs them again)",
         outcome.selected
     )))
+}
+
+/// Every run with the values it sets, one line each, made as it is written.
+fn list_runs(c: &Campaign) -> shipsim::Result<()> {
+    use std::io::Write;
+    let mut out = std::io::BufWriter::new(std::io::stdout().lock());
+    let io = |e| Error::io("cannot write the runs to stdout", e);
+    for r in c.runs.iter() {
+        let sets: Vec<String> = r.sets.iter().map(|(k, v)| format!("{k}={v}")).collect();
+        writeln!(out, "{:>6}  {}", r.index, sets.join(" ")).map_err(io)?;
+    }
+    out.flush().map_err(io)
 }
 
 /// `I/N` with I < N.
