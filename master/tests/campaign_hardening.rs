@@ -364,3 +364,66 @@ fn failed_runs_make_the_exit_status_2() {
         .unwrap();
     assert_eq!(out.status.code(), Some(0), "{out:?}");
 }
+
+/// The first SIGTERM stops the phase after the runs (finding the finished runs, the tables,
+/// the derived KPIs) as promptly as it stops a run, with status 130 and the journal kept
+/// (issue 38, item 11: the phase ignored it, and `timeout` needed a SIGKILL). The journal of
+/// 300,000 finished runs is written here, so the campaign has only that phase to do.
+#[test]
+fn sigterm_stops_the_table_phase() {
+    let d = tempfile::tempdir().unwrap();
+    tiny_campaign(d.path(), "a", "[1]");
+    let text = "system = \"sys.toml\"\n[[factors]]\nvariable = \"m.k\"\nlinspace = [1, 2, 150000]\n\
+                [[arms]]\nname = \"lo\"\nset = { \"m.u\" = 1.0 }\n[[arms]]\nname = \"hi\"\nset = { \"m.u\" = 2.0 }\n\
+                [[kpis]]\nname = \"y_mean\"\nvariable = \"m.y\"\nstat = \"mean\"\n\
+                [[derived]]\nname = \"r\"\nexpr = \"(y_mean[hi] + 1) / (y_mean[lo] + 1) * 2 - 1\"\n";
+    let file = d.path().join("big.toml");
+    std::fs::write(&file, text).unwrap();
+    let c = shipsim::campaign::Campaign::load(&file).unwrap();
+    let out = d.path().join("out");
+    std::fs::create_dir_all(&out).unwrap();
+    let mut journal = String::new();
+    for i in 0..c.runs.len() {
+        let key = c.runs.run(i).key;
+        journal.push_str(&format!(
+            "{{\"index\":{i},\"key\":\"{key}\",\"status\":\"ok\",\"message\":\"\",\"kpis\":[{}],\"wall_time\":0.001}}\n",
+            i as f64 * 1e-6
+        ));
+    }
+    std::fs::write(out.join("runs.jsonl"), &journal).unwrap();
+    let run = || {
+        std::process::Command::new(env!("CARGO_BIN_EXE_shipsim"))
+            .current_dir(d.path())
+            .args(["campaign", "run", "big.toml", "-o", "out", "-q"])
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap()
+    };
+    // Undisturbed, the phase takes this long and writes the tables.
+    let begin = std::time::Instant::now();
+    let done = run().wait_with_output().unwrap();
+    let whole = begin.elapsed();
+    assert!(done.status.success(), "{done:?}");
+    assert!(out.join("derived.parquet").exists());
+    for f in ["runs.csv", "runs.parquet", "derived.csv", "derived.parquet"] {
+        std::fs::remove_file(out.join(f)).unwrap();
+    }
+    // SIGTERM at a third of it: the process ends soon after, interrupted, without tables.
+    let child = run();
+    std::thread::sleep(whole / 3);
+    let at = std::time::Instant::now();
+    unsafe { libc::kill(child.id() as i32, libc::SIGTERM) };
+    let stopped = child.wait_with_output().unwrap();
+    let after = at.elapsed();
+    let err = String::from_utf8_lossy(&stopped.stderr);
+    assert_eq!(stopped.status.code(), Some(130), "{err}");
+    assert!(err.contains("interrupted"), "{err}");
+    assert!(
+        after < whole / 2,
+        "stopped {after:?} after SIGTERM; the whole phase takes {whole:?}"
+    );
+    assert_eq!(
+        std::fs::read_to_string(out.join("runs.jsonl")).unwrap(),
+        journal
+    );
+}

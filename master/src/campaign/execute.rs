@@ -480,7 +480,15 @@ pub fn run(campaign: &Campaign, opts: &CampaignOptions) -> Result<CampaignOutcom
     let Sink::Journal(journal) = ctx.sink.into_inner().unwrap_or_else(|e| e.into_inner()) else {
         unreachable!("a local campaign records into its journal")
     };
-    outcome.files = output::write_tables(&campaign.spec, &campaign.runs, &journal, dir)?;
+    let stop = output::Stop(opts.interrupt.as_deref());
+    outcome.files = match output::write_tables(&campaign.spec, &campaign.runs, &journal, dir, stop)
+    {
+        Err(Error::Interrupted { .. }) => {
+            outcome.interrupted = true;
+            Vec::new()
+        }
+        other => other?,
+    };
     outcome.wall = begin.elapsed();
     Ok(outcome)
 }

@@ -143,7 +143,7 @@ pub fn merge(inputs: &[PathBuf], out: &Path) -> Result<MergeReport> {
             (false, None) => missing.push(run.index),
         }
     }
-    let files = output::write_tables(&spec, &runs, &journal, out)?;
+    let files = output::write_tables(&spec, &runs, &journal, out, output::Stop(None))?;
     Ok(MergeReport {
         total: runs.len(),
         found,

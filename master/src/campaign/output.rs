@@ -137,13 +137,45 @@ pub fn kpi_columns(spec: &CampaignSpec) -> Vec<String> {
 /// Runs are matched by key, not by index: a campaign extended with more points or
 /// replications keeps its finished runs (their keys do not change), under new indices.
 pub fn finished<'a>(runs: &Design, journal: &'a Journal) -> Vec<(usize, &'a RunRecord)> {
+    finished_until(runs, journal, Stop(None)).expect("never stopped")
+}
+
+/// [`finished`], given up when `stop` is set.
+fn finished_until<'a>(
+    runs: &Design,
+    journal: &'a Journal,
+    stop: Stop,
+) -> Result<Vec<(usize, &'a RunRecord)>> {
     if journal.records().next().is_none() {
-        return Vec::new();
+        return Ok(Vec::new());
     }
-    (0..runs.len())
-        .into_par_iter()
-        .filter_map(|i| Some((i, journal.done(&runs.run(i).key)?)))
-        .collect()
+    let found = (0..runs.len()).into_par_iter().map(|i| {
+        stop.check()?;
+        Ok(journal.done(&runs.run(i).key).map(|r| (i, r)))
+    });
+    Ok(found
+        .collect::<Result<Vec<_>>>()?
+        .into_iter()
+        .flatten()
+        .collect())
+}
+
+/// The interrupt flag of the table phase (the first SIGINT or SIGTERM): checked between
+/// tables and inside the long loops, so that the phase after the runs stops as promptly as a
+/// run does (issue 38, item 11). The journal has every finished run; the next `campaign run`
+/// writes the tables.
+#[derive(Clone, Copy)]
+pub struct Stop<'a>(pub Option<&'a std::sync::atomic::AtomicBool>);
+
+impl Stop<'_> {
+    fn check(self) -> Result<()> {
+        match self.0 {
+            Some(f) if f.load(std::sync::atomic::Ordering::Relaxed) => {
+                Err(Error::Interrupted { time: f64::NAN })
+            }
+            _ => Ok(()),
+        }
+    }
 }
 
 /// The run table of the finished runs.
@@ -205,6 +237,15 @@ pub fn derived_table(
     runs: &Design,
     finished: &[(usize, &RunRecord)],
 ) -> Result<Option<Table>> {
+    derived_table_until(spec, runs, finished, Stop(None))
+}
+
+fn derived_table_until(
+    spec: &CampaignSpec,
+    runs: &Design,
+    finished: &[(usize, &RunRecord)],
+    stop: Stop,
+) -> Result<Option<Table>> {
     if spec.derived.is_empty() {
         return Ok(None);
     }
@@ -253,8 +294,14 @@ pub fn derived_table(
         .collect();
     let derived: Vec<Vec<f64>> = kpis
         .iter()
-        .map(|d| values.iter().map(|v| d.eval(v)).collect())
-        .collect();
+        .map(|d| {
+            let column = values.chunks(4096).map(|rows| {
+                stop.check()?;
+                Ok(rows.iter().map(|v| d.eval(v)).collect::<Vec<f64>>())
+            });
+            Ok(column.collect::<Result<Vec<_>>>()?.concat())
+        })
+        .collect::<Result<_>>()?;
     for (d, column) in kpis.iter().zip(&derived) {
         t.push(&d.name, ColumnData::Float(column.clone()));
     }
@@ -279,25 +326,30 @@ pub fn derived_table(
 }
 
 /// Writes the run table and the derived table (CSV and Parquet) from the journal.
+/// Stops with [`Error::Interrupted`] when `stop` is set ([`Stop`]); each file is written
+/// whole or not at all.
 pub fn write_tables(
     spec: &CampaignSpec,
     runs: &Design,
     journal: &Journal,
     dir: &Path,
+    stop: Stop,
 ) -> Result<Vec<PathBuf>> {
-    let done = finished(runs, journal);
+    let done = finished_until(runs, journal, stop)?;
     let mut files = Vec::new();
     let mut write = |name: &str, t: &Table| -> Result<()> {
         let csv = dir.join(format!("{name}.csv"));
         let parquet = dir.join(format!("{name}.parquet"));
+        stop.check()?;
         t.write_csv(&csv)?;
+        stop.check()?;
         t.write_parquet(&parquet)?;
         files.push(csv);
         files.push(parquet);
         Ok(())
     };
     write("runs", &run_table(spec, runs, &done))?;
-    if let Some(t) = derived_table(spec, runs, &done)? {
+    if let Some(t) = derived_table_until(spec, runs, &done, stop)? {
         write("derived", &t)?;
     }
     Ok(files)

@@ -141,7 +141,13 @@ impl Collector {
     /// Writes the run table and the derived table from the journal; returns the files and
     /// the run table.
     pub fn finish(&self, campaign: &Campaign) -> Result<(Vec<PathBuf>, Table)> {
-        let files = output::write_tables(&campaign.spec, &campaign.runs, &self.journal, &self.dir)?;
+        let files = output::write_tables(
+            &campaign.spec,
+            &campaign.runs,
+            &self.journal,
+            &self.dir,
+            output::Stop(None),
+        )?;
         Ok((files, run_table(campaign, &self.journal)))
     }
 }
