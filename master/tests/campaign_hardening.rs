@@ -237,6 +237,23 @@ fn derived_expressions_are_bounded_and_checked_at_load() {
     );
     assert!(!ok && err.contains("no KPI 'y_maen'"), "{err}");
     assert!(!d.path().join("out").exists());
+    // an unknown function is named, with the functions there are (it was exmex's "wlog a
+    // number/variable cannot be on the right of a closing parenthesis, left: sqr; right: (")
+    std::fs::write(
+        d.path().join("fn.toml"),
+        format!("{base}[[derived]]\nname = \"root\"\nexpr = \"2 * sqr(y_mean)\"\n"),
+    )
+    .unwrap();
+    let (ok, err) =
+        common::shipsim_in(d.path(), &["campaign", "run", "fn.toml", "-o", "out", "-q"]);
+    assert!(
+        !ok && err.contains(
+            "derived kpi 'root' = \"2 * sqr(y_mean)\": unknown function 'sqr' (did you mean 'sqrt'"
+        ) && err.contains("; the functions are abs, acos, acosh, asin, ")
+            && err.contains(", sqrt, tan, tanh, trunc (and the operators + - * / ^)"),
+        "{err}"
+    );
+    assert!(!d.path().join("out").exists());
 }
 
 /// Column `name` of a CSV table.
