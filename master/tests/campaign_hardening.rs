@@ -96,7 +96,7 @@ fn a_refused_second_process_writes_nothing_into_the_folder() {
     tiny_campaign(d.path(), "b", "[1, 2, 3]");
     let (ok, err) = common::shipsim_in(d.path(), &["campaign", "run", "b.toml", "-o", "out", "-q"]);
     assert!(
-        !ok && err.contains("is in use by another shipsim process"),
+        !ok && err.contains("is in use: a campaign is running into out (in another process"),
         "{err}"
     );
     assert_eq!(

@@ -133,6 +133,11 @@ class Campaign:
         bar (default: in terminals and notebooks, when tqdm is installed).
 
         Ctrl-C stops cleanly: finished runs are kept, and ``KeyboardInterrupt`` is raised.
+
+        Threads: one output folder takes one run at a time (a lock on its journal, across
+        threads and processes); a second ``run`` into a folder in use raises
+        :class:`ShipsimError` saying so, before it writes anything. Runs into different
+        folders may go on at the same time.
         """
         out = os.fspath(output) if output is not None else self.default_output()
         if isinstance(client, str) and client == "local":

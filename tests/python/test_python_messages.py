@@ -2,6 +2,7 @@
 internal, a bare Python error or a pile of unrelated messages, and now says what is wrong and
 what to do.
 
+- (f) two threads running one Campaign into one folder: the second is told the folder is in use;
 - (h) a stop time out of range is one message about the stop time, not four (three about
   step_multiple)."""
 import pathlib
@@ -15,6 +16,31 @@ import shipsim
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 RRS = ROOT / "systems" / "rrs.toml"
+
+
+def test_two_threads_on_one_campaign_folder(tmp_path):
+    c = shipsim.Campaign.load(ROOT / "campaigns" / "rrs_polar_reduced.toml")
+    out = tmp_path / "out"
+    start = threading.Barrier(2)
+    outcomes = []
+
+    def run():
+        start.wait()
+        try:
+            outcomes.append(("ok", len(c.run(out, jobs=1, progress=False))))
+        except Exception as e:  # noqa: BLE001 (every failure is checked below)
+            outcomes.append((type(e).__name__, str(e)))
+
+    threads = [threading.Thread(target=run) for _ in range(2)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    outcomes.sort()
+    assert outcomes[0] == ("ShipsimError", f"{out / 'runs.jsonl'} is in use: a campaign is running "
+                           f"into {out} (in another process, or in another thread of this one); wait "
+                           "for it to end, or give another output folder"), outcomes
+    assert outcomes[1] == ("ok", 12), outcomes
 
 
 @pytest.mark.parametrize("stop, expect", [
