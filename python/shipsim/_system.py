@@ -198,7 +198,7 @@ class System:
     def run(
         self,
         stop_time: Optional[float] = None,
-        variables: Optional[Iterable[str]] = None,
+        variables: Union[str, Iterable[str], None] = None,
         *,
         start_time: Optional[float] = None,
         step_size: Optional[float] = None,
@@ -210,8 +210,9 @@ class System:
     ):
         """Runs the system and returns the recorded variables.
 
-        ``variables``: ``instance.variable`` or ``instance.*`` (every output of the instance);
-        default: the system file's ``[output]`` list, else every output. ``stop_time``,
+        ``variables``: a list of ``instance.variable`` or ``instance.*`` (every output of the
+        instance), or one of them as a str; default: the system file's ``[output]`` list, else
+        every output. ``stop_time``,
         ``start_time``, ``step_size`` [s] and ``algorithm`` override the file's.
         ``algorithm`` is read as in system files and by ``shipsim run --algorithm``, in any
         case: ``"jacobi"``, or ``"gauss-seidel"`` (also ``"gauss_seidel"``, ``"gauss seidel"``,
@@ -239,6 +240,8 @@ class System:
         communication point and raises ``KeyboardInterrupt``. FMU log messages go to the
         ``shipsim.fmu`` logger (warnings and worse; everything with ``verbose``).
         """
+        if isinstance(variables, str):
+            variables = [variables]  # one pattern, not its characters
         if isolate is True:
             isolate = "all"
         elif isolate is False:

@@ -8,6 +8,8 @@ what to do.
   3.5 is a VariableError naming variable and value;
 - (c) an int outside the Integer range (2**100) is a VariableError naming the range, not an
   OverflowError; a Real variable takes a big int as the nearest double;
+- (d) run(variables="ship.roll") is one pattern, not nine one-letter names;
+- (e) Campaign.run(client="bogus") says what a client must be, before the folder is touched;
 - (f) two threads running one Campaign into one folder: the second is told the folder is in use;
 - (h) a stop time out of range is one message about the stop time, not four (three about
   step_multiple)."""
@@ -109,6 +111,25 @@ def test_an_int_out_of_range_names_the_range():
     assert float(s.values["waves.significant_wave_height"]) == 2.0**100
     with pytest.raises(shipsim.VariableError, match="is a Real, and this number is beyond the largest double"):
         s.set("waves.significant_wave_height", 10**400)
+
+
+def test_variables_as_one_string():
+    s = shipsim.System.load(RRS)
+    df = s.run(stop_time=1, variables="ship.roll")
+    assert list(df.columns) == ["ship.roll"]
+    df = s.run(stop_time=1, variables="gear.*")
+    assert list(df.columns) == list(s.run(stop_time=1, variables=["gear.*"]).columns)
+
+
+def test_a_client_that_is_no_dask_client(tmp_path):
+    c = shipsim.Campaign.load(ROOT / "campaigns" / "rrs_polar_reduced.toml")
+    for bogus in ("bogus", 42):
+        with pytest.raises(TypeError) as e:
+            c.run(tmp_path / "out", client=bogus, progress=False)
+        assert str(e.value).startswith(f"client={bogus!r} ({type(bogus).__name__}): a client must "
+                                       "be a dask.distributed.Client"), e.value
+        assert '"local" for a LocalCluster on this machine' in str(e.value)
+    assert not (tmp_path / "out").exists()
 
 
 def test_two_threads_on_one_campaign_folder(tmp_path):
