@@ -1100,6 +1100,18 @@ fn worker_run<'py>(
         .collect()
 }
 
+/// Frees the workers of this process (the cache of [`worker_run`]): their FMUs are unloaded
+/// and their unpack folders removed. A static is never dropped, so without this every Dask
+/// worker process left its folders in `$TMPDIR`; `shipsim._dask` calls it at exit (`atexit`).
+/// A chunk still running keeps its worker until it ends. Returns how many were freed.
+#[pyfunction]
+fn release_workers(py: Python<'_>) -> usize {
+    py.detach(|| {
+        let workers = WORKERS.lock().unwrap_or_else(|e| e.into_inner()).take();
+        workers.map_or(0, |w| w.len())
+    })
+}
+
 /// How many FMU shared libraries this process has loaded (each distinct FMU once per
 /// System, Campaign or worker).
 #[pyfunction]
@@ -1120,6 +1132,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(inspect, m)?)?;
     m.add_function(wrap_pyfunction!(worker_run, m)?)?;
     m.add_function(wrap_pyfunction!(fmu_load_count, m)?)?;
+    m.add_function(wrap_pyfunction!(release_workers, m)?)?;
     m.add_function(wrap_pyfunction!(fmu_host, m)?)?;
     m.add_class::<PySystem>()?;
     m.add_class::<PyCampaign>()?;
