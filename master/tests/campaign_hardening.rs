@@ -96,7 +96,7 @@ fn a_refused_second_process_writes_nothing_into_the_folder() {
     tiny_campaign(d.path(), "b", "[1, 2, 3]");
     let (ok, err) = common::shipsim_in(d.path(), &["campaign", "run", "b.toml", "-o", "out", "-q"]);
     assert!(
-        !ok && err.contains("is in use by another shipsim process"),
+        !ok && err.contains("is in use: a campaign is running into out (in another process"),
         "{err}"
     );
     assert_eq!(
@@ -236,6 +236,23 @@ fn derived_expressions_are_bounded_and_checked_at_load() {
         &["campaign", "run", "typo.toml", "-o", "out", "-q"],
     );
     assert!(!ok && err.contains("no KPI 'y_maen'"), "{err}");
+    assert!(!d.path().join("out").exists());
+    // an unknown function is named, with the functions there are (it was exmex's "wlog a
+    // number/variable cannot be on the right of a closing parenthesis, left: sqr; right: (")
+    std::fs::write(
+        d.path().join("fn.toml"),
+        format!("{base}[[derived]]\nname = \"root\"\nexpr = \"2 * sqr(y_mean)\"\n"),
+    )
+    .unwrap();
+    let (ok, err) =
+        common::shipsim_in(d.path(), &["campaign", "run", "fn.toml", "-o", "out", "-q"]);
+    assert!(
+        !ok && err.contains(
+            "derived kpi 'root' = \"2 * sqr(y_mean)\": unknown function 'sqr' (did you mean 'sqrt'"
+        ) && err.contains("; the functions are abs, acos, acosh, asin, ")
+            && err.contains(", sqrt, tan, tanh, trunc (and the operators + - * / ^)"),
+        "{err}"
+    );
     assert!(!d.path().join("out").exists());
 }
 

@@ -129,12 +129,20 @@ class Campaign:
         it. ``jobs``: threads on this machine (default: every core). ``client``: a
         ``dask.distributed.Client``: the runs go to its workers in chunks (``chunk_size``
         runs, default about four chunks per worker; a warm-up group stays whole), and this
-        process records them, so that resume works as on one machine. ``progress``: a tqdm
+        process records them, so that resume works as on one machine; ``"local"``: a
+        ``LocalCluster`` of ``jobs`` worker processes for this call. Anything else raises
+        ``TypeError`` before the output folder is touched. ``progress``: a tqdm
         bar (default: in terminals and notebooks, when tqdm is installed).
 
         Ctrl-C stops cleanly: finished runs are kept, and ``KeyboardInterrupt`` is raised.
+
+        Threads: one output folder takes one run at a time (a lock on its journal, across
+        threads and processes); a second ``run`` into a folder in use raises
+        :class:`ShipsimError` saying so, before it writes anything. Runs into different
+        folders may go on at the same time.
         """
         out = os.fspath(output) if output is not None else self.default_output()
+        _check_client(client)
         if isinstance(client, str) and client == "local":
             from ._dask import local_client
 
@@ -162,6 +170,28 @@ class Campaign:
 
     def __repr__(self) -> str:
         return f"Campaign({self.name!r}: {len(self)} runs, {self.source!r})"
+
+
+def _check_client(client: Any) -> None:
+    """``client`` is None, ``"local"`` or a ``dask.distributed.Client``; else a TypeError that
+    says so (it failed deep in the Dask code with an AttributeError, after the output folder
+    was opened)."""
+    if client is None or (isinstance(client, str) and client == "local"):
+        return
+    try:
+        from distributed import Client
+    except ImportError:
+        raise TypeError(
+            f"client={client!r}: a client must be a dask.distributed.Client (or \"local\" for a "
+            "LocalCluster on this machine), and dask.distributed is not installed: "
+            "pip install distributed"
+        ) from None
+    if not isinstance(client, Client):
+        raise TypeError(
+            f"client={client!r} ({type(client).__name__}): a client must be a "
+            "dask.distributed.Client, e.g. Client(\"tcp://HEAD:8786\"), or \"local\" for a "
+            "LocalCluster on this machine; None runs on this machine's threads"
+        )
 
 
 def _chunk_size(pending: int, workers: int) -> int:

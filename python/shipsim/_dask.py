@@ -8,6 +8,9 @@ the chunk with the GIL released, and returns one JSON record per run. The client
 chunk's runs in the journal as the chunk completes (synced, a run recorded twice is kept
 once) and writes the tables at the end, as on one machine, so that running again resumes.
 
+Temporary files: each worker process unpacks the FMUs once into ``$TMPDIR`` and removes the
+folders when it exits (also on a normal ``LocalCluster`` close).
+
 Files: workers read the campaign file, its base system and the FMUs at the same absolute
 paths as the client (a shared file system, or the same checkout on every machine). A worker
 that sees other files (a different hash of the system and FMUs) fails its chunk with an
@@ -20,11 +23,17 @@ recorded once.
 
 from __future__ import annotations
 
+import atexit
 import contextlib
 import os
 from typing import Any, Dict, Iterator, List, Optional, Tuple
 
 from . import _native
+
+# A worker process keeps the campaigns and FMUs of its chunks loaded (one load per process); at
+# exit they are freed, which removes their unpack folders from $TMPDIR (a Dask worker left them
+# all behind). Workers import this module to run `run_chunk`; in the client it frees nothing.
+atexit.register(_native.release_workers)
 
 
 @contextlib.contextmanager

@@ -107,7 +107,13 @@ _DTYPES = {"Real": np.float64, "Integer": np.int32, "Enumeration": np.int32, "Bo
 
 class System:
     """A coupled system (native TOML or OSP ``OspSystemStructure.xml``) with its FMUs loaded
-    once; every :meth:`run` makes fresh instances, so runs are independent and repeatable."""
+    once; every :meth:`run` makes fresh instances, so runs are independent and repeatable.
+
+    Threads: several threads may call :meth:`run` on one System at the same time (each run has
+    its own instances and copy of the values; the GIL is released while it runs). Changing the
+    System (:meth:`set`, ``strict_units = ...``) while a run of it is in progress raises
+    :class:`ShipsimError` saying it is running, and changes nothing: set values before or
+    after the runs, or load one System per thread."""
 
     def __init__(self, native: "_native.System"):
         self._native = native
@@ -120,8 +126,13 @@ class System:
 
     def set(self, name: str, value: Union[bool, int, float, str]) -> "System":
         """Sets a parameter or start value, as ``shipsim run --set name=value`` does: ``name``
-        is ``instance.variable``; a str is parsed by the variable's type. Returns the system,
-        so calls chain. Raises :class:`VariableError` for an unknown instance or variable."""
+        is ``instance.variable``; a str is parsed by the variable's type. An Integer (or
+        Enumeration) variable takes an int or a whole float (``3.0``, ``numpy.float64(3.0)``),
+        as campaign factors do. Returns the system, so calls chain. Raises
+        :class:`VariableError` for an unknown instance or variable, and for a number the
+        variable cannot take (a float that is not whole, or an int outside the Integer range,
+        which the message names), and :class:`ShipsimError` while the system is running in
+        another thread (see the class's notes on threads)."""
         self._native.set(name, value)
         return self
 
@@ -187,7 +198,7 @@ class System:
     def run(
         self,
         stop_time: Optional[float] = None,
-        variables: Optional[Iterable[str]] = None,
+        variables: Union[str, Iterable[str], None] = None,
         *,
         start_time: Optional[float] = None,
         step_size: Optional[float] = None,
@@ -199,8 +210,9 @@ class System:
     ):
         """Runs the system and returns the recorded variables.
 
-        ``variables``: ``instance.variable`` or ``instance.*`` (every output of the instance);
-        default: the system file's ``[output]`` list, else every output. ``stop_time``,
+        ``variables``: a list of ``instance.variable`` or ``instance.*`` (every output of the
+        instance), or one of them as a str; default: the system file's ``[output]`` list, else
+        every output. ``stop_time``,
         ``start_time``, ``step_size`` [s] and ``algorithm`` override the file's.
         ``algorithm`` is read as in system files and by ``shipsim run --algorithm``, in any
         case: ``"jacobi"``, or ``"gauss-seidel"`` (also ``"gauss_seidel"``, ``"gauss seidel"``,
@@ -228,6 +240,8 @@ class System:
         communication point and raises ``KeyboardInterrupt``. FMU log messages go to the
         ``shipsim.fmu`` logger (warnings and worse; everything with ``verbose``).
         """
+        if isinstance(variables, str):
+            variables = [variables]  # one pattern, not its characters
         if isolate is True:
             isolate = "all"
         elif isolate is False:

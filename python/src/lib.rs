@@ -354,25 +354,93 @@ fn inspect<'py>(py: Python<'py>, path: PathBuf) -> PyResult<Bound<'py, PyDict>> 
     Ok(d)
 }
 
-/// A Python value as a system value: bool, int, float as themselves, str as text parsed by
-/// the variable's type (as `--set` does).
-fn to_value(value: &Bound<'_, PyAny>) -> PyResult<Value> {
+/// A Python value as the value of variable `name` (`sv`): bool, int and float as themselves,
+/// str as text parsed by the variable's type (as `--set` does). An Integer or Enumeration
+/// variable takes a whole float (3.0, numpy's float64(3.0)) as that integer, as campaign
+/// factors do; a float that is not whole, or a whole number outside fmi2Integer's 32 bits, is a
+/// [`VariableError`] naming the variable, the value and the range ([`refused`]); a value inside
+/// them but outside the declared min and max is the validation's error, as for `--set`. A Real
+/// variable takes an int of any size as the nearest double (an OverflowError of Python's int
+/// conversion before).
+fn to_value(name: &str, sv: &ScalarVariable, value: &Bound<'_, PyAny>) -> PyResult<Value> {
+    let t = sv.var_type();
+    let whole = matches!(t, Some(VarType::Integer | VarType::Enumeration));
     if let Ok(b) = value.cast::<pyo3::types::PyBool>() {
         return Ok(Value::Boolean(b.is_true()));
     }
-    if let Ok(i) = value.cast::<pyo3::types::PyInt>() {
-        return Ok(Value::Integer(i.extract()?));
+    let float = value.cast::<pyo3::types::PyFloat>().is_ok();
+    // int, and numpy's integers (which have __index__ but are no int)
+    if value.cast::<pyo3::types::PyInt>().is_ok() || (!float && value.hasattr("__index__")?) {
+        return match value.extract::<i64>() {
+            Ok(i) if whole && i32::try_from(i).is_err() => Err(refused(name, sv, value)),
+            Ok(i) => Ok(Value::Integer(i)),
+            Err(_) if t == Some(VarType::Real) => match value.extract::<f64>() {
+                Ok(x) => Ok(Value::Real(x)),
+                Err(_) => Err(VariableError::new_err(format!(
+                    "'{name}' = {}: variable '{}' is a Real, and this number is beyond the \
+                     largest double (about 1.8e308); give a smaller one",
+                    shown(value),
+                    sv.name
+                ))),
+            },
+            Err(_) => Err(refused(name, sv, value)),
+        };
     }
     if let Ok(f) = value.extract::<f64>() {
+        if whole {
+            if f.fract() == 0.0 && f >= f64::from(i32::MIN) && f <= f64::from(i32::MAX) {
+                return Ok(Value::Integer(f as i64));
+            }
+            return Err(refused(name, sv, value));
+        }
         return Ok(Value::Real(f));
     }
     if let Ok(s) = value.extract::<String>() {
         return Ok(Value::Text(s));
     }
     Err(pyo3::exceptions::PyTypeError::new_err(format!(
-        "a value must be a bool, int, float or str, not {}",
+        "'{name}': a value must be a bool, int, float or str, not {}",
         value.get_type().name()?
     )))
+}
+
+/// A value for a message: its `repr`, at most 40 characters (`10**1000` is not written out).
+fn shown(value: &Bound<'_, PyAny>) -> String {
+    let text = value
+        .repr()
+        .map(|r| r.to_string())
+        .unwrap_or_else(|_| "?".into());
+    match text.chars().count() {
+        n if n > 40 => format!(
+            "{}... ({n} characters)",
+            text.chars().take(24).collect::<String>()
+        ),
+        _ => text,
+    }
+}
+
+/// The [`VariableError`] of a number that variable `sv` cannot take, saying what it takes: an
+/// Integer or Enumeration a whole number in fmi2Integer's range narrowed by the declared min
+/// and max (a float that is not whole, an int beyond the range).
+fn refused(name: &str, sv: &ScalarVariable, value: &Bound<'_, PyAny>) -> PyErr {
+    let int = sv.integer.as_ref().or(sv.enumeration.as_ref());
+    let lo = int.and_then(|i| i.min).unwrap_or(i32::MIN);
+    let hi = int.and_then(|i| i.max).unwrap_or(i32::MAX);
+    let (a, give) = match sv.var_type() {
+        Some(VarType::Integer) => ("an Integer", format!("a whole number from {lo} to {hi}")),
+        Some(VarType::Enumeration) => (
+            "an Enumeration",
+            format!("a whole number from {lo} to {hi}"),
+        ),
+        Some(VarType::Boolean) => ("a Boolean", "True or False".to_string()),
+        Some(VarType::String) => ("a String", "a str".to_string()),
+        Some(VarType::Real) | None => ("a Real", "a float".to_string()),
+    };
+    VariableError::new_err(format!(
+        "'{name}' = {}: variable '{}' is {a}; give {give}",
+        shown(value),
+        sv.name
+    ))
 }
 
 /// A system with its FMUs, loaded once and reused by every run.
@@ -424,6 +492,12 @@ impl PySystem {
 
     /// Checks `instance.variable` (or `instance.*` when `wildcard`), with "did you mean".
     fn check_name(&self, name: &str, wildcard: bool) -> PyResult<()> {
+        self.variable(name, wildcard).map(|_| ())
+    }
+
+    /// The variable `instance.variable` names (None for `instance.*` when `wildcard`), or a
+    /// [`VariableError`] with close names.
+    fn variable(&self, name: &str, wildcard: bool) -> PyResult<Option<&ScalarVariable>> {
         let instances = || self.system.instances.iter().map(|i| i.name.as_str());
         let (inst, var) = match name.split_once('.') {
             Some(p) => p,
@@ -441,11 +515,11 @@ impl PySystem {
             )));
         };
         if wildcard && var == "*" {
-            return Ok(());
+            return Ok(None);
         }
         let md = &self.fmus[i].model_description;
-        if md.model_variables.variables.iter().any(|v| v.name == var) {
-            return Ok(());
+        if let Some(v) = md.model_variables.variables.iter().find(|v| v.name == var) {
+            return Ok(Some(v));
         }
         let names = md.model_variables.variables.iter().map(|v| v.name.as_str());
         Err(VariableError::new_err(format!(
@@ -454,6 +528,20 @@ impl PySystem {
             did_you_mean(var, names)
         )))
     }
+}
+
+/// The error of changing a System while a run of it is in progress in another thread (pyo3's
+/// own is a bare "Already borrowed").
+fn running(what: &str, system: &Bound<'_, PySystem>) -> PyErr {
+    let source = system
+        .try_borrow()
+        .map(|s| s.system.source.display().to_string())
+        .unwrap_or_default();
+    ShipsimError::new_err(format!(
+        "{what}: the System ({source}) is running in another thread; change it before or \
+         after its runs (threads may run one System at the same time, each run on its own \
+         instances), or load a System per thread"
+    ))
 }
 
 #[pymethods]
@@ -468,12 +556,19 @@ impl PySystem {
         Ok(PySystem { system, fmus })
     }
 
-    /// Sets a parameter or start value, like `--set instance.variable=value`.
-    fn set(&mut self, py: Python<'_>, name: &str, value: &Bound<'_, PyAny>) -> PyResult<()> {
-        self.check_name(name, false)?;
+    /// Sets a parameter or start value, like `--set instance.variable=value`. A System that
+    /// is running in another thread is not changed: an error says so.
+    fn set(slf: &Bound<'_, Self>, name: &str, value: &Bound<'_, PyAny>) -> PyResult<()> {
+        let py = slf.py();
+        let mut this = slf
+            .try_borrow_mut()
+            .map_err(|_| running(&format!("System.set('{name}')"), slf))?;
+        let v = match this.variable(name, false)? {
+            Some(sv) => to_value(name, sv, value)?,
+            None => unreachable!("no wildcard"),
+        };
         let r = VarRef::parse(name).expect("checked");
-        let v = to_value(value)?;
-        self.system.set_value(r, v).map_err(|e| py_err(py, e))
+        this.system.set_value(r, v).map_err(|e| py_err(py, e))
     }
 
     /// The values set on the instances (from the file and `set`), as `instance.variable` ->
@@ -513,8 +608,12 @@ impl PySystem {
         self.system.strict_units
     }
     #[setter]
-    fn set_strict_units(&mut self, strict: bool) {
-        self.system.strict_units = strict;
+    fn set_strict_units(slf: &Bound<'_, Self>, strict: bool) -> PyResult<()> {
+        let mut this = slf
+            .try_borrow_mut()
+            .map_err(|_| running("System.strict_units", slf))?;
+        this.system.strict_units = strict;
+        Ok(())
     }
     #[getter]
     fn algorithm(&self) -> String {
@@ -999,6 +1098,18 @@ fn worker_run<'py>(
         .collect()
 }
 
+/// Frees the workers of this process (the cache of [`worker_run`]): their FMUs are unloaded
+/// and their unpack folders removed. A static is never dropped, so without this every Dask
+/// worker process left its folders in `$TMPDIR`; `shipsim._dask` calls it at exit (`atexit`).
+/// A chunk still running keeps its worker until it ends. Returns how many were freed.
+#[pyfunction]
+fn release_workers(py: Python<'_>) -> usize {
+    py.detach(|| {
+        let workers = WORKERS.lock().unwrap_or_else(|e| e.into_inner()).take();
+        workers.map_or(0, |w| w.len())
+    })
+}
+
 /// How many FMU shared libraries this process has loaded (each distinct FMU once per
 /// System, Campaign or worker).
 #[pyfunction]
@@ -1019,6 +1130,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(inspect, m)?)?;
     m.add_function(wrap_pyfunction!(worker_run, m)?)?;
     m.add_function(wrap_pyfunction!(fmu_load_count, m)?)?;
+    m.add_function(wrap_pyfunction!(release_workers, m)?)?;
     m.add_function(wrap_pyfunction!(fmu_host, m)?)?;
     m.add_class::<PySystem>()?;
     m.add_class::<PyCampaign>()?;

@@ -6,11 +6,13 @@
   with its series files, and each worker loads each FMU once (load counter);
 - a worker killed at its k-th completed chunk: Dask runs the chunk again, and every run is
   recorded exactly once (journal lines and table);
-- resume: a second run of the same folder runs nothing and returns the same table."""
+- resume: a second run of the same folder runs nothing and returns the same table;
+- the worker processes of a LocalCluster remove their FMU unpack folders when it closes."""
 import json
 import os
 import pathlib
 import subprocess
+import sys
 
 import pandas as pd
 import pytest
@@ -245,3 +247,64 @@ def test_jobs_below_one_are_a_clear_error(forked, tmp_path, jobs):
     with pytest.raises(ValueError, match=f"jobs = {jobs}: a campaign needs at least one job"):
         c.run(tmp_path / "out", jobs=jobs, progress=False)
     assert not (tmp_path / "out" / "campaign.json").exists()
+
+
+SMALL = f"""
+name = "py_small"
+system = "{ROOT / 'systems' / 'rrs.toml'}"
+stop_time = 20.0
+[[factors]]
+name = "hs"
+variable = "waves.significant_wave_height"
+values = [2.0, 3.0, 4.0, 5.0]
+[[kpis]]
+name = "roll_var"
+variable = "ship.roll"
+stat = "variance"
+"""
+
+CLEANUP_SCRIPT = """
+import gc, json, os, sys
+from distributed import Client, LocalCluster
+import shipsim
+
+def unpacked():
+    return sorted(p for p in os.listdir(os.environ["TMPDIR"]) if p.startswith("shipsim"))
+
+if __name__ == "__main__":
+    campaign, out = sys.argv[1:]
+    c = shipsim.Campaign.load(campaign)
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                      dashboard_address=":0", silence_logs=40) as cluster, Client(cluster) as client:
+        table = c.run(out, client=client, chunk_size=1, progress=False)
+        during = max(len(v) for v in client.run(unpacked).values())
+        workers = len(client.run(os.getpid))
+    del c
+    gc.collect()
+    print(json.dumps({"runs": len(table), "workers": workers, "during": during,
+                      "left": unpacked()}), flush=True)
+"""
+
+
+def test_dask_workers_remove_their_fmu_folders_at_exit(tmp_path):
+    """Each worker process unpacks the FMUs once and keeps them; a normal LocalCluster close
+    used to leave every worker's folders in $TMPDIR (issue 38, item 13: 15 folders, 11 MB per
+    session). Now the workers free them at exit."""
+    pytest.importorskip("distributed")
+    tmp = tmp_path / "tmp"
+    tmp.mkdir()
+    campaign = tmp_path / "small.toml"
+    campaign.write_text(SMALL)
+    script = tmp_path / "cleanup.py"
+    script.write_text(CLEANUP_SCRIPT)
+    env = dict(os.environ, TMPDIR=str(tmp))
+    p = subprocess.run([sys.executable, str(script), str(campaign), str(tmp_path / "out")],
+                       capture_output=True, text=True, env=env, timeout=300)
+    assert p.returncode == 0, p.stderr
+    got = json.loads(p.stdout.splitlines()[-1])
+    assert got["runs"] == 4 and got["workers"] == 2, got
+    # the workers did unpack their FMUs into this TMPDIR (one folder per FMU and process)
+    fmus = len(set(shipsim.System.load(ROOT / "systems" / "rrs.toml").instances.values()))
+    assert got["during"] >= fmus, got
+    assert got["left"] == [], got
+    assert [x.name for x in tmp.iterdir() if x.name.startswith("shipsim")] == []

@@ -8,7 +8,7 @@
 
 use super::spec::CampaignSpec;
 use crate::error::{Error, Result};
-use exmex::{Express, FlatEx};
+use exmex::{Express, FlatEx, FloatOpsFactory, MakeOperators};
 
 /// The longest derived expression [characters] and its deepest nesting of parentheses: real
 /// expressions are a line; the parser's time grows faster than the length (`2^2^...^2` with
@@ -41,6 +41,52 @@ fn bounded(expr: &str) -> std::result::Result<(), String> {
             "parentheses nested {deepest} deep, more than the {MAX_EXPRESSION_DEPTH} a derived \
              expression may have"
         ));
+    }
+    Ok(())
+}
+
+/// The functions a derived expression may call: exmex's named operators (`sqrt`, `abs`, `ln`,
+/// `log10`, `atan2`, `min`, ...), without its constants (`PI`, `E`).
+/// Sorted by name.
+pub fn functions() -> Vec<&'static str> {
+    let mut names: Vec<&'static str> = FloatOpsFactory::<f64>::make()
+        .iter()
+        .filter(|op| op.constant().is_none())
+        .map(|op| op.repr())
+        .filter(|r| r.starts_with(|c: char| c.is_ascii_alphabetic()))
+        .collect();
+    names.sort_unstable();
+    names
+}
+
+/// A name called like a function (`name(`) that is no function and no KPI column: exmex read it
+/// as a variable and the message was "no KPI 'name'", or a parse error that did not say which
+/// name was wrong. The message names it and lists the functions there are.
+fn unknown_function(expr: &str, kpi_columns: &[String]) -> std::result::Result<(), String> {
+    let known = functions();
+    let chars: Vec<char> = expr.chars().collect();
+    let mut i = 0;
+    while i < chars.len() {
+        let word_start = chars[i].is_ascii_alphabetic() || chars[i] == '_';
+        // a letter after a digit or a point belongs to a number (1e5)
+        let in_number = i > 0 && (chars[i - 1].is_ascii_alphanumeric() || chars[i - 1] == '.');
+        if !word_start || in_number {
+            i += 1;
+            continue;
+        }
+        let start = i;
+        while i < chars.len() && (chars[i].is_ascii_alphanumeric() || chars[i] == '_') {
+            i += 1;
+        }
+        let word: String = chars[start..i].iter().collect();
+        let called = chars[i..].iter().find(|c| !c.is_whitespace()) == Some(&'(');
+        if called && !known.contains(&word.as_str()) && !kpi_columns.contains(&word) {
+            return Err(format!(
+                "unknown function '{word}'{}; the functions are {} (and the operators + - * / ^)",
+                crate::error::did_you_mean(&word, known.iter().copied()),
+                known.join(", ")
+            ));
+        }
     }
     Ok(())
 }
@@ -105,6 +151,7 @@ impl DerivedKpi {
                     ))
                 };
                 bounded(&d.expr).map_err(err)?;
+                unknown_function(&d.expr, kpi_columns).map_err(err)?;
                 let text = braced(&d.expr);
                 let expr = FlatEx::<f64>::parse(&text).map_err(|e| err(e.to_string()))?;
                 let mut inputs = Vec::new();
@@ -164,6 +211,32 @@ mod tests {
         assert!(bounded(&deep)
             .unwrap_err()
             .contains("nested 40 deep, more than the 32"));
+    }
+
+    #[test]
+    fn an_unknown_function_is_named_with_the_functions_there_are() {
+        let kpis = ["roll_var".to_string(), "y_mean".to_string()];
+        for ok in [
+            "100 * (1 - roll_var[on] / roll_var[off])",
+            "sqrt(roll_var[on]) + abs (y_mean) + atan2(1, 2) + log10(2) + 1e5 * 2.5e-3",
+            "y_mean * (2)",
+        ] {
+            assert_eq!(unknown_function(ok, &kpis), Ok(()), "{ok}");
+        }
+        let e = unknown_function("100 * sqr(roll_var[on])", &kpis).unwrap_err();
+        assert!(
+            e.starts_with("unknown function 'sqr' (did you mean 'sqrt'")
+                && e.contains("; the functions are abs, acos, acosh, asin,")
+                && e.contains("atan2")
+                && e.contains("sqrt")
+                && !e.contains("PI"),
+            "{e}"
+        );
+        // the two-argument functions, as docs/campaigns.md writes them
+        let two = FlatEx::<f64>::parse("min(1, 2) + max(3, 4) + atan2(0, 1)").unwrap();
+        assert_eq!(two.eval(&[]).unwrap(), 5.0);
+        let e = unknown_function("mean (y_mean)", &kpis).unwrap_err();
+        assert!(e.starts_with("unknown function 'mean'"), "{e}");
     }
 
     #[test]

@@ -146,12 +146,15 @@ impl Journal {
             .map_err(|e| io("cannot open the run journal", e))?;
         // One process at a time per output folder: a second `campaign run` on the same folder
         // would run the same runs and write them twice. The lock goes with the process (also
-        // on SIGKILL).
+        // on SIGKILL). It is flock's, held by this open file: a second open in another thread
+        // of the same process (two Python threads running one Campaign) is refused too.
         match file.try_lock() {
             Ok(()) => {}
             Err(std::fs::TryLockError::WouldBlock) => {
                 return Err(Error::Other(format!(
-                    "{} is in use by another shipsim process (a campaign is running into {})",
+                    "{} is in use: a campaign is running into {} (in another process, or in \
+                     another thread of this one); wait for it to end, or give another output \
+                     folder",
                     path.display(),
                     dir.display()
                 )))

@@ -50,6 +50,9 @@ fn short(x: f64) -> String {
 
 /// The base-step grid of a run.
 struct Grid {
+    /// The times and step make a grid; when not (an error was reported), `n_steps` is a
+    /// stand-in of one step that lets the other checks go on, and no check compares with it.
+    ok: bool,
     /// Number of base steps: the run ends at t0 + n_steps*h.
     n_steps: u64,
     /// t0 + n_steps*h, or the stop time after a short last step.
@@ -90,7 +93,9 @@ impl System {
         let outputs = c.outputs();
         let order = c.order(&connections);
         c.step_multiple_range(&grid);
-        c.step_multiples(grid.n_steps);
+        if grid.ok {
+            c.step_multiples(grid.n_steps);
+        }
         c.shared_guids();
         c.invalid_variability();
         c.ineffective_couplings(&instances, &connections);
@@ -172,7 +177,7 @@ impl<'a> Checker<'a> {
                 self,
                 format!("start_time = {}; it must be a finite number", short(t0)),
             );
-        } else if !stop.is_finite() && !stop.is_nan() {
+        } else if !stop.is_finite() {
             fail(
                 self,
                 format!("stop_time = {}; it must be a finite number", short(stop)),
@@ -195,7 +200,8 @@ impl<'a> Checker<'a> {
                 Err(m) => fail(self, m),
             }
         }
-        if n_steps == 0 {
+        let ok = n_steps > 0;
+        if !ok {
             // An error was reported; a grid of one step lets the other checks go on.
             n_steps = 1;
         }
@@ -203,6 +209,7 @@ impl<'a> Checker<'a> {
         let off =
             self.errors.is_empty() && (stop_on_grid - stop).abs() > 1e-9 * stop.abs().max(1.0);
         let grid = Grid {
+            ok,
             n_steps,
             stop_on_grid,
             off_grid: off.then_some(OffGrid {
@@ -301,12 +308,13 @@ impl<'a> Checker<'a> {
     /// Every instance steps every m base steps with 1 <= m <= the run's steps: a reader that
     /// makes m from a step size (OSP `stepSize` / `BaseStepSize`) gives 0 for NaN and the
     /// largest u32 for an infinite or huge one, and an instance whose step is longer than the
-    /// run would never step.
+    /// run would never step. Without a grid (a stop time that is negative, not a number or
+    /// too far: its own error) only m = 0 is reported, not every step multiple above 1.
     fn step_multiple_range(&mut self, grid: &Grid) {
         let sys = self.sys;
         for inst in &sys.instances {
             let m = inst.step_multiple;
-            if m == 0 || u64::from(m) > grid.n_steps {
+            if m == 0 || (grid.ok && u64::from(m) > grid.n_steps) {
                 let step = f64::from(m) * sys.step_size;
                 let e = self.err(
                     inst.line,
