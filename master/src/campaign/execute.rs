@@ -472,15 +472,20 @@ pub fn run(campaign: &Campaign, opts: &CampaignOptions) -> Result<CampaignOutcom
             dir.join("series"),
         )
     };
+    let stopped_before = ctx.stop();
     outcome.groups = execute_all(&ctx, fork.as_ref(), &todo, jobs)?;
     outcome.ran = ctx.done.load(Ordering::Relaxed);
     outcome.interrupted = ctx.interrupted.load(Ordering::Relaxed) || ctx.stop();
+    let stopped_runs = outcome.interrupted && !stopped_before;
     outcome.failed = ctx.failed.load(Ordering::Relaxed);
     outcome.slowest = *ctx.slowest.lock().unwrap_or_else(|e| e.into_inner());
     let Sink::Journal(journal) = ctx.sink.into_inner().unwrap_or_else(|e| e.into_inner()) else {
         unreachable!("a local campaign records into its journal")
     };
-    let stop = output::Stop(opts.interrupt.as_deref());
+    // A signal during the runs stopped them, and the tables of the finished runs are written on
+    // the way out (a second signal exits at once); a first signal before the runs, or during
+    // this phase, stops it.
+    let stop = output::Stop(opts.interrupt.as_deref().filter(|_| !stopped_runs));
     outcome.files = match output::write_tables(&campaign.spec, &campaign.runs, &journal, dir, stop)
     {
         Err(Error::Interrupted { .. }) => {
