@@ -444,3 +444,30 @@ fn sigterm_stops_the_table_phase() {
         journal
     );
 }
+
+/// `campaign show --runs | head` ends quietly with status 0 when the reader stops early (it
+/// panicked with "failed printing to stdout: Broken pipe").
+#[test]
+fn campaign_show_into_a_closed_pipe_is_quiet() {
+    let d = tempfile::tempdir().unwrap();
+    tiny_campaign(d.path(), "a", "[1]");
+    std::fs::write(
+        d.path().join("big.toml"),
+        "system = \"sys.toml\"\n[[factors]]\nvariable = \"m.k\"\nlinspace = [1, 2, 100000]\n\
+         [[kpis]]\nname = \"y_mean\"\nvariable = \"m.y\"\nstat = \"mean\"\n",
+    )
+    .unwrap();
+    let out = std::process::Command::new("bash")
+        .current_dir(d.path())
+        .arg("-c")
+        .arg(format!(
+            "set -o pipefail; '{}' campaign show --runs big.toml | head -3",
+            env!("CARGO_BIN_EXE_shipsim")
+        ))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(err.is_empty(), "{err}");
+    assert_eq!(String::from_utf8_lossy(&out.stdout).lines().count(), 3);
+}

@@ -121,11 +121,7 @@ pub fn dispatch(
         }
         CampaignCommand::Show { file, runs } => {
             let c = Campaign::load(&file)?;
-            println!("{}", describe(&c));
-            if runs {
-                list_runs(&c)?;
-            }
-            Ok(())
+            show(&c, runs)
         }
         CampaignCommand::Merge { inputs, output } => {
             let report = campaign::merge::merge(&inputs, &output)?;
@@ -182,16 +178,23 @@ fn failures(outcome: &campaign::execute::CampaignOutcome) -> shipsim::Result<()>
     )))
 }
 
-/// Every run with the values it sets, one line each, made as it is written.
-fn list_runs(c: &Campaign) -> shipsim::Result<()> {
+/// `campaign show`: the description and, with `runs`, every run with the values it sets, one
+/// line each, made as it is written. A reader that stops early (`| head`) ends it quietly.
+fn show(c: &Campaign, runs: bool) -> shipsim::Result<()> {
     use std::io::Write;
     let mut out = std::io::BufWriter::new(std::io::stdout().lock());
-    let io = |e| Error::io("cannot write the runs to stdout", e);
-    for r in c.runs.iter() {
-        let sets: Vec<String> = r.sets.iter().map(|(k, v)| format!("{k}={v}")).collect();
-        writeln!(out, "{:>6}  {}", r.index, sets.join(" ")).map_err(io)?;
+    let mut write = || -> std::io::Result<()> {
+        writeln!(out, "{}", describe(c))?;
+        for r in c.runs.iter().filter(|_| runs) {
+            let sets: Vec<String> = r.sets.iter().map(|(k, v)| format!("{k}={v}")).collect();
+            writeln!(out, "{:>6}  {}", r.index, sets.join(" "))?;
+        }
+        out.flush()
+    };
+    match write() {
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
+        other => other.map_err(|e| Error::io("cannot write to stdout", e)),
     }
-    out.flush().map_err(io)
 }
 
 /// `I/N` with I < N.
