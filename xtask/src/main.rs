@@ -178,14 +178,7 @@ fn test(extra: &[String]) -> Result<()> {
     let started = std::time::Instant::now();
     let fmu_dir = fmu::build_fmus(&root)?;
     // The binaries first: system tests run the release master and the reference generator.
-    run(cargo().current_dir(&root).args([
-        "build",
-        "--release",
-        "--workspace",
-        "--exclude",
-        "xtask",
-        "--bins",
-    ]))?;
+    build_binaries(&root)?;
     lint(&root)?;
     eprintln!("xtask: Rust tests (release, sharing the FMU build)");
     run(cargo()
@@ -463,17 +456,25 @@ fn bench(extra: &[String]) -> Result<()> {
 
 /// The built-in default system: rudder roll stabilization (systems/rrs.toml) with RRS off and
 /// on, through the shipsim master; a table on stdout, CSVs and a plot in target/demo/.
+/// Every binary of the workspace, release. `demo` and `test` build them with this one command,
+/// so that they share one feature resolution and one build: `-p system-tests --bin demo`
+/// resolved the FMU crates' features differently and recompiled all 25 of them after a test
+/// (issue 36, item 4).
+fn build_binaries(root: &Path) -> Result<()> {
+    run(cargo().current_dir(root).args([
+        "build",
+        "--release",
+        "--workspace",
+        "--exclude",
+        "xtask",
+        "--bins",
+    ]))
+}
+
 fn demo() -> Result<()> {
     let root = workspace_root();
     let fmu_dir = fmu::build_fmus(&root)?;
-    run(cargo().current_dir(&root).args([
-        "build",
-        "--release",
-        "-p",
-        "system-tests",
-        "--bin",
-        "demo",
-    ]))?;
+    build_binaries(&root)?;
     run(Command::new(root.join("target/release/demo"))
         .current_dir(&root)
         .env("SHIPSIM_FMU_DIR", fmu_dir))
