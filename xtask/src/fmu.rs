@@ -268,8 +268,15 @@ fn build_fmus_for(root: &Path, win64: Win64) -> Result<PathBuf> {
     if crates.is_empty() {
         bail!("no FMU crates found (packages with [package.metadata.fmu])");
     }
+    // In a target folder of their own: `cargo test --workspace` resolves the shared crates'
+    // features with the dev-dependencies (serde on fmi2, libc's extra_traits, ...), and in
+    // target/ the FMU crates' library units would be rebuilt by each command in turn, so
+    // `cargo xtask demo` after `cargo xtask test` recompiled all 25 (issue 36, item 4).
+    let build_dir = root.join("target/fmu-build");
     let mut cmd = cargo();
-    cmd.current_dir(root).args(["build", "--release", "--lib"]);
+    cmd.current_dir(root)
+        .env("CARGO_TARGET_DIR", &build_dir)
+        .args(["build", "--release", "--lib"]);
     for c in &crates {
         cmd.args(["-p", &c.package]);
     }
@@ -278,7 +285,7 @@ fn build_fmus_for(root: &Path, win64: Win64) -> Result<PathBuf> {
     let out_dir = root.join("target/fmu");
     package(
         &crates,
-        &root.join("target/release"),
+        &build_dir.join("release"),
         windows.as_deref(),
         &out_dir,
         &root.join("target/fmu-examples"),
