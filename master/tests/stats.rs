@@ -214,3 +214,181 @@ fn quoted_fields_and_text_columns_are_read() {
         &["column 'm.mode' is text (a String variable)"],
     );
 }
+
+/// An FMU archive with only a model description (no binaries: `stats --system` reads the
+/// descriptions and loads nothing): Real variables with units, one through a declaredType, one
+/// without a unit, and an Integer.
+fn description_only_fmu(path: &Path, name: &str, variables: &str) {
+    let xml = format!(
+        r#"<?xml version="1.0" encoding="UTF-8"?>
+<fmiModelDescription fmiVersion="2.0" modelName="{name}" guid="{{stats-{name}}}">
+  <CoSimulation modelIdentifier="{name}"/>
+  <UnitDefinitions>
+    <Unit name="m"><BaseUnit m="1"/></Unit>
+    <Unit name="m/s"><BaseUnit m="1" s="-1"/></Unit>
+  </UnitDefinitions>
+  <TypeDefinitions>
+    <SimpleType name="Speed"><Real quantity="Velocity" unit="m/s"/></SimpleType>
+  </TypeDefinitions>
+  <ModelVariables>
+{variables}
+  </ModelVariables>
+  <ModelStructure/>
+</fmiModelDescription>"#
+    );
+    let f = std::fs::File::create(path).unwrap();
+    let mut z = zip::ZipWriter::new(f);
+    z.start_file(
+        "modelDescription.xml",
+        zip::write::SimpleFileOptions::default(),
+    )
+    .unwrap();
+    std::io::Write::write_all(&mut z, xml.as_bytes()).unwrap();
+    z.finish().unwrap();
+}
+
+/// The system that "wrote" x.csv: `ship` (a in m, b a Speed: m/s through its declaredType) and
+/// `gear` (c without a unit), two instances of one FMU for `ship`.
+fn write_system(dir: &Path) -> std::path::PathBuf {
+    description_only_fmu(
+        &dir.join("Ship.fmu"),
+        "Ship",
+        r#"    <ScalarVariable name="a" valueReference="0" causality="output"><Real unit="m"/></ScalarVariable>
+    <ScalarVariable name="b" valueReference="1" causality="output"><Real declaredType="Speed"/></ScalarVariable>"#,
+    );
+    description_only_fmu(
+        &dir.join("Gear.fmu"),
+        "Gear",
+        r#"    <ScalarVariable name="c" valueReference="0" causality="output"><Real/></ScalarVariable>
+    <ScalarVariable name="n" valueReference="1" causality="output"><Integer/></ScalarVariable>"#,
+    );
+    let system = dir.join("sys.toml");
+    std::fs::write(
+        &system,
+        r#"[simulation]
+stop_time = 10.0
+step_size = 0.01
+[[instances]]
+name = "ship"
+fmu = "Ship.fmu"
+[[instances]]
+name = "other_ship"
+fmu = "Ship.fmu"
+[[instances]]
+name = "gear"
+fmu = "Gear.fmu"
+"#,
+    )
+    .unwrap();
+    system
+}
+
+/// `--system FILE`: every column gets the unit its FMU declares (following declaredType; "-"
+/// for none), the variance its square; without `--system`, the header says how to get units.
+/// (Before, `stats` printed no units and had no --system.)
+#[test]
+fn units_from_the_system_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("x.csv");
+    write_csv(&csv);
+    let system = write_system(dir.path());
+    let sys = system.to_str().unwrap();
+
+    let j = json(&csv, &["--system", sys]);
+    assert_eq!(j["system"], sys);
+    let units = |name: &str| {
+        let c = column(&j, name);
+        (c["unit"].clone(), c["variance_unit"].clone())
+    };
+    assert_eq!(units("ship.a"), ("m".into(), "m^2".into()));
+    assert_eq!(units("ship.b"), ("m/s".into(), "(m/s)^2".into()));
+    assert_eq!(
+        units("gear.c"),
+        (serde_json::Value::Null, serde_json::Value::Null)
+    );
+    // the statistics themselves do not change
+    assert_eq!(
+        column(&j, "ship.a")["mean"],
+        column(&json(&csv, &[]), "ship.a")["mean"]
+    );
+
+    // The table: a unit column after the name, the header says the variance is in unit^2.
+    let out = stats(&csv, &["--system", sys, "--window", "2:4.99"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8(out.stdout).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    assert!(
+        lines[0].contains("300 samples, t = 2 .. 4.99 s")
+            && lines[0].contains(&format!(
+                "units from the FMUs of {sys} (variance in unit^2)"
+            )),
+        "{text}"
+    );
+    let header: Vec<&str> = lines[1].split_whitespace().collect();
+    assert_eq!(
+        header,
+        ["column", "unit", "mean", "variance", "std", "rms", "min", "max", "max_abs"]
+    );
+    let row = |name: &str| -> Vec<&str> {
+        lines
+            .iter()
+            .find(|l| l.starts_with(name))
+            .unwrap_or_else(|| panic!("no {name} in {text}"))
+            .split_whitespace()
+            .collect()
+    };
+    assert_eq!(row("ship.a")[1], "m");
+    assert_eq!(row("ship.b")[1], "m/s");
+    assert_eq!(row("gear.c")[1], "-");
+    assert_eq!(row("ship.a").len(), header.len(), "{text}");
+    assert!(
+        lines[1..].iter().all(|l| l.len() == lines[1].len()),
+        "not aligned:\n{text}"
+    );
+
+    // Without --system: no unit column, and the header says how to get units.
+    let out = stats(&csv, &[]);
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(
+        text.lines().next().unwrap().contains(
+            "no units (a CSV has none): give --system FILE, the system file that wrote it"
+        ),
+        "{text}"
+    );
+    assert_eq!(
+        text.lines().nth(1).unwrap().split_whitespace().nth(1),
+        Some("mean")
+    );
+    let j = json(&csv, &[]);
+    assert_eq!(j["system"], serde_json::Value::Null);
+    assert_eq!(column(&j, "ship.a")["unit"], serde_json::Value::Null);
+
+    // A column the system does not have: "?" and a warning; none of them: an error.
+    let other = dir.path().join("other.csv");
+    std::fs::write(&other, "time,ship.a,tug.x\n0,1,2\n1,3,4\n").unwrap();
+    let out = stats(&other, &["--system", sys]);
+    assert!(out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("column 'tug.x' is not a variable of") && err.contains("unit is unknown"),
+        "{err}"
+    );
+    let text = String::from_utf8(out.stdout).unwrap();
+    let tug: Vec<&str> = text.lines().last().unwrap().split_whitespace().collect();
+    assert_eq!(tug[..2], ["tug.x", "?"], "{text}");
+    refused(
+        &other,
+        &["--system", sys, "--columns", "tug.x"],
+        &[
+            "none of the columns is a variable of its instances",
+            "'tug.x'",
+        ],
+    );
+    // A system whose FMU is missing: the system file's error.
+    std::fs::remove_file(dir.path().join("Gear.fmu")).unwrap();
+    refused(&csv, &["--system", sys], &["Gear.fmu", "not found"]);
+}

@@ -168,6 +168,16 @@ class Campaign:
         out = os.fspath(output) if output is not None else self.default_output()
         return _table(self._native.table(out), as_frame)
 
+    def derived_table(self, output: Optional[PathLike] = None, *, as_frame: Optional[bool] = None):
+        """The derived table of an output folder of this campaign (what is done so far): one row
+        per design point and replication (``point, replication,`` factors, seeds, the
+        ``[[derived]]`` KPIs, ``status``), the table ``derived.parquet`` holds; a row whose
+        runs are not all done or failed has NaN and says so in ``status``. ``output`` and
+        ``as_frame`` as for :meth:`table`. None when the campaign has no ``[[derived]]`` KPIs."""
+        out = os.fspath(output) if output is not None else self.default_output()
+        raw = self._native.derived_table(out)
+        return None if raw is None else _table(raw, as_frame)
+
     def __repr__(self) -> str:
         return f"Campaign({self.name!r}: {len(self)} runs, {self.source!r})"
 

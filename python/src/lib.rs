@@ -950,6 +950,17 @@ impl PyCampaign {
         table_dict(py, &t)
     }
 
+    /// The derived table of an output folder of this campaign (from its journal); None when
+    /// the campaign has no `[[derived]]` KPIs.
+    fn derived_table<'py>(
+        &self,
+        py: Python<'py>,
+        output: PathBuf,
+    ) -> PyResult<Option<Bound<'py, PyDict>>> {
+        let t = remote::read_derived_table(&self.campaign, &output).map_err(|e| py_err(py, e))?;
+        t.map(|t| table_dict(py, &t)).transpose()
+    }
+
     /// Opens the output folder for recording results computed elsewhere (the Dask mode).
     #[pyo3(signature = (output, retry_failed=false))]
     fn collector(

@@ -7,6 +7,7 @@
 - a worker killed at its k-th completed chunk: Dask runs the chunk again, and every run is
   recorded exactly once (journal lines and table);
 - resume: a second run of the same folder runs nothing and returns the same table;
+- Campaign.derived_table equals the CLI's derived.parquet (None without [[derived]]);
 - the worker processes of a LocalCluster remove their FMU unpack folders when it closes."""
 import json
 import os
@@ -103,15 +104,49 @@ def test_local_run_equals_the_cli(local, forked, tmp_path):
         assert (out / "series" / name).read_bytes() == (cli_out / "series" / name).read_bytes()
 
 
-def test_reduced_polar_equals_the_cli(tmp_path):
+@pytest.fixture(scope="module")
+def reduced(tmp_path_factory):
+    """The reduced RRS polar (one derived KPI) run from Python and by the CLI."""
+    tmp_path = tmp_path_factory.mktemp("reduced")
     c = shipsim.Campaign.load(ROOT / "campaigns" / "rrs_polar_reduced.toml")
-    assert len(c) == 12 and c.name == "rrs_polar_reduced"
     table = c.run(tmp_path / "py", progress=False)
     subprocess.run([BIN, "campaign", "run", str(c.source), "-o", str(tmp_path / "cli"), "-q"], check=True)
+    return c, tmp_path, table
+
+
+def test_reduced_polar_equals_the_cli(reduced):
+    c, tmp_path, table = reduced
+    assert len(c) == 12 and c.name == "rrs_polar_reduced"
     same_table(table, pd.read_parquet(tmp_path / "cli" / "runs.parquet"))
     # resume: nothing left to run, the same table
     again = c.run(tmp_path / "py", progress=False)
     pd.testing.assert_frame_equal(table, again, check_exact=True)
+
+
+def test_derived_table_equals_the_cli(reduced, local, forked):
+    """Campaign.derived_table: the derived KPIs of an output folder, equal to the CLI's
+    derived.parquet (and to the one the Python run wrote); None for a campaign without
+    [[derived]]."""
+    c, tmp_path, _ = reduced
+    derived = c.derived_table(tmp_path / "py")
+    assert isinstance(derived, pd.DataFrame)
+    assert list(derived.columns) == ["point", "replication", "direction_deg", "waves.seed",
+                                     "wind.seed", "sensors.seed", "roll_reduction", "status"]
+    # 12 runs in 2 arms: 6 rows, every one complete
+    assert len(derived) == len(c) // 2 and set(derived["status"]) == {"ok"}
+    assert derived["roll_reduction"].notna().all()
+    for folder in ("cli", "py"):
+        expected = pd.read_parquet(tmp_path / folder / "derived.parquet")
+        pd.testing.assert_frame_equal(derived, expected, check_exact=True, check_dtype=False)
+    # the CLI's folder read from Python gives the same table
+    pd.testing.assert_frame_equal(derived, c.derived_table(tmp_path / "cli"), check_exact=True)
+    # as_frame=False: a dict of numpy arrays, as table() gives
+    raw = c.derived_table(tmp_path / "py", as_frame=False)
+    assert list(raw) == list(derived.columns)
+    assert (raw["roll_reduction"] == derived["roll_reduction"].to_numpy()).all()
+    # a campaign without [[derived]]
+    out, _ = local
+    assert shipsim.Campaign.load(forked).derived_table(out) is None
 
 
 @pytest.fixture(scope="module")

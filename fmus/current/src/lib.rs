@@ -72,64 +72,64 @@ fmi2_export::fmu! {
         tunable real "current_speed_initial" ["m/s"] (params.speed_initial),
             "Current speed before current_start_time";
         tunable real "current_speed_final" ["m/s"] (params.speed_final),
-            "Current speed after the ramp (000: 5 kn = 2.5722 m/s)";
+            "Current speed after the ramp ([Taylor2000]: 5 kn = 2.5722 m/s)";
         tunable real "current_direction" ["rad"] (params.direction),
             "Direction the current flows towards (earth frame of heading; pi/2: onto the port beam of a ship heading 0)";
         tunable real "current_start_time" ["s"] (params.t_start),
             "Start of the change from the initial to the final speed";
         tunable real "current_ramp_duration" ["s"] (params.ramp_duration).min(0.0),
-            "Duration of the linear change (0: step, 000's 'current gust')";
+            "Duration of the linear change (0: step, the 'current gust' of [Taylor2000])";
         fixed real "reference_speed" ["m/s"] (params.ship_speed).min(1e-3),
-            "Ship speed U of the 004 nondimensionalisation t' = tU/L, N = N' rho L^3 U^2/2 (Tokyo Maru 12 kn)";
+            "Ship speed U of the [Parsons1980] nondimensionalisation t' = tU/L, N = N' rho L^3 U^2/2 (Tokyo Maru 12 kn)";
         fixed real "ship_length" ["m"] (params.ship_length).min(1e-3),
-            "Ship length L of the 004 nondimensionalisation (Tokyo Maru 290 m)";
+            "Ship length L of the [Parsons1980] nondimensionalisation (Tokyo Maru 290 m)";
         fixed real "water_density" (params.density).min(1.0),
-            "Water density rho [kg/m3] for the dimensional N, Y (not given in 004: 1025)";
+            "Water density rho [kg/m3] for the dimensional N, Y (not given in [Parsons1980]: 1025)";
         fixed bool "design_current" (params.design_current),
-            "004 Fig. 4 design lateral current: N' = design_n s(t'), Y' = design_y s(t')";
+            "[Parsons1980, Fig. 4] design lateral current: N' = design_n s(t'), Y' = design_y s(t')";
         fixed real "design_n" (params.design_n),
-            "N' of the 1-kn lateral current at H/T = 1.89 (004 Tables 12-13: 0.10262e-2)";
+            "N' of the 1-kn lateral current at H/T = 1.89 ([Parsons1980, Tables 12-13]: 0.10262e-2)";
         fixed real "design_y" (params.design_y),
-            "Y' of the 1-kn lateral current (004 Tables 12-13: 0.23277e-2)";
+            "Y' of the 1-kn lateral current ([Parsons1980, Tables 12-13]: 0.23277e-2)";
         fixed real "design_t_constant" (params.design_t_constant),
-            "End of the constant part, ship lengths t' (004: 15; 18 in the WLS runs)";
+            "End of the constant part, ship lengths t' ([Parsons1980]: 15; 18 in the WLS runs)";
         fixed real "design_t_ramp" (params.design_t_ramp),
-            "End of the linear ramp, ship lengths t' (004: 20)";
+            "End of the linear ramp, ship lengths t' ([Parsons1980]: 20)";
         fixed real "design_final_fraction" (params.design_final_fraction),
-            "Level after the ramp as a fraction (004: 0.5)";
+            "Level after the ramp as a fraction ([Parsons1980]: 0.5)";
         fixed real "passing_ship_factor" (params.passing_factor),
-            "Magnitude factor of the 004 Fig. 3 passing-ship surrogate (0 off, 1, or 4 as in Figs. 6-7, 11-12)";
+            "Magnitude factor of the [Parsons1980, Fig. 3] passing-ship surrogate (0 off, 1, or 4 as in [Parsons1980, Figs. 6-7, 11-12])";
         fixed real "passing_ship_time" (params.passing_time),
-            "Beam-to-beam instant t'_p in ship lengths (004: 7, or 20 in Figs. 6-7)";
+            "Beam-to-beam instant t'_p in ship lengths ([Parsons1980]: 7, or 20 in [Parsons1980, Figs. 6-7])";
         fixed real "white_sigma_n" (params.white_sigma[0]).min(0.0),
-            "Per-sample std of white N' on the internal grid (004 L 1664: 2e-5)";
+            "Per-sample std of white N' on the internal grid ([Parsons1980, sec. 5.3]: 2e-5)";
         fixed real "white_sigma_y" (params.white_sigma[1]).min(0.0),
-            "Per-sample std of white Y' on the internal grid (004 L 1664: 5e-5)";
+            "Per-sample std of white Y' on the internal grid ([Parsons1980, sec. 5.3]: 5e-5)";
         fixed real "shaping_sigma_n" (params.shaping_sigma[0]).min(0.0),
-            "Stationary std of the first-order shaping-filter N' (004 eq. 53: 8.798e-5)";
+            "Stationary std of the first-order shaping-filter N' ([Parsons1980, eq. (53)]: 8.798e-5)";
         fixed real "shaping_sigma_y" (params.shaping_sigma[1]).min(0.0),
-            "Stationary std of the shaping-filter Y' (004 eq. 54: 21.178e-5)";
+            "Stationary std of the shaping-filter Y' ([Parsons1980, eq. (54)]: 21.178e-5)";
         fixed real "shaping_time_constant" (params.shaping_time_constant).min(1e-6),
-            "T_N = T_Y in ship lengths (004 eqs. 39-40: 1)";
+            "T_N = T_Y in ship lengths ([Parsons1980, eqs. (39)-(40)]: 1)";
         fixed real "walk_q_n" (params.walk_q[0]).min(0.0),
-            "Random-walk intensity q of N' per unit t' (004 eq. 67: 2e-8)";
+            "Random-walk intensity q of N' per unit t' ([Parsons1980, eq. (67)]: 2e-8)";
         fixed real "walk_q_y" (params.walk_q[1]).min(0.0),
-            "Random-walk intensity q of Y' per unit t' (004 eq. 68: 1.25e-7)";
+            "Random-walk intensity q of Y' per unit t' ([Parsons1980, eq. (68)]: 1.25e-7)";
         fixed real "bias_time_constant" ["s"] (params.bias_time_constant).min(1e-6),
-            "001 bias time constant T (001 eq. 58: 1000 s)";
+            "[Fossen1999] bias time constant T ([Fossen1999, eq. (58)]: 1000 s)";
         fixed real "bias_psi_x" (params.bias_psi[0]).min(0.0),
-            "001 bias noise amplitude Psi, surge [N/sqrt(s)]; not given in 001";
+            "[Fossen1999] bias noise amplitude Psi, surge, in N/sqrt(s); not given in [Fossen1999]";
         fixed real "bias_psi_y" (params.bias_psi[1]).min(0.0),
-            "001 bias noise amplitude Psi, sway [N/sqrt(s)]";
+            "[Fossen1999] bias noise amplitude Psi, sway, in N/sqrt(s)";
         fixed real "bias_psi_n" (params.bias_psi[2]).min(0.0),
-            "001 bias noise amplitude Psi, yaw [N.m/sqrt(s)]";
+            "[Fossen1999] bias noise amplitude Psi, yaw, in N.m/sqrt(s)";
         fixed real "bias_initial_x" ["N"] (params.bias_initial[0]),
             "Initial earth-fixed bias force, x";
         fixed real "bias_initial_y" ["N"] (params.bias_initial[1]),
             "Initial earth-fixed bias force, y";
         fixed real "bias_initial_n" ["N.m"] (params.bias_initial[2]), "Initial bias yaw moment";
         fixed real "internal_step" ["s"] (params.internal_step).min(1e-6),
-            "Fixed grid of the random processes (default dt' = 0.005 = 0.2349 s of 004)";
+            "Fixed grid of the random processes (default dt' = 0.005 = 0.2349 s of [Parsons1980])";
         input real "heading" ["rad"] (heading), "Ship heading psi (for the body-frame outputs)";
         output real "current_north" ["m/s"] (|m| m.model.current_velocity()[0]),
             "Earth-fixed current velocity, first axis";
@@ -140,20 +140,20 @@ fmi2_export::fmu! {
         output real "current_sway" ["m/s"] (|m| m.model.current_body()[1]),
             "Current velocity to starboard, V sin(direction - heading)";
         output real "n_prime" (|m| m.disturbance()[0]),
-            "Total 004 nondimensional yaw moment N'";
+            "Total [Parsons1980] nondimensional yaw moment N'";
         output real "y_prime" (|m| m.disturbance()[1]),
-            "Total 004 nondimensional side force Y'";
+            "Total [Parsons1980] nondimensional side force Y'";
         output real "yaw_moment" ["N.m"] (|m| m.model.dimensional(m.disturbance())[0]),
             "N = N' rho L^3 U^2/2";
         output real "side_force" ["N"] (|m| m.model.dimensional(m.disturbance())[1]),
             "Y = Y' rho L^2 U^2/2";
-        output real "bias_x" ["N"] (|m| m.bias()[0]), "001 earth-fixed bias force, x";
-        output real "bias_y" ["N"] (|m| m.bias()[1]), "001 earth-fixed bias force, y";
-        output real "bias_n" ["N.m"] (|m| m.bias()[2]), "001 bias yaw moment";
+        output real "bias_x" ["N"] (|m| m.bias()[0]), "[Fossen1999] earth-fixed bias force, x";
+        output real "bias_y" ["N"] (|m| m.bias()[1]), "[Fossen1999] earth-fixed bias force, y";
+        output real "bias_n" ["N.m"] (|m| m.bias()[2]), "[Fossen1999] bias yaw moment";
         output real "bias_surge" ["N"] (|m| m.model.body(m.bias())[0]),
-            "001 bias in the body frame, J(psi)^T b, surge";
+            "[Fossen1999] bias in the body frame, J(psi)^T b, surge";
         output real "bias_sway" ["N"] (|m| m.model.body(m.bias())[1]),
-            "001 bias in the body frame, sway";
+            "[Fossen1999] bias in the body frame, sway";
         output real "nondimensional_time" (|m| m.model.nondimensional_time()),
             "t' = (t - t0) U/L in ship lengths";
     }

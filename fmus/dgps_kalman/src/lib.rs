@@ -50,11 +50,11 @@ fmi2_export::fmu! {
     documentation: "documentation.html",
     variables: {
         fixed real "time_step" ["s"] (params.dt).min(0.0),
-            "Filter time-update step dt (002: 1 s); a communication step h is ceil(h/dt) cycles";
+            "Filter time-update step dt ([Artyszuk2003]: 1 s); a communication step h is ceil(h/dt) cycles";
         fixed real "process_noise_level" (params.sp).min(0.0),
             "S_p, spectral amplitude of the PV random-walk model (m2/s3 implied; 0.001 low, 0.01 optimal, 0.1 high)";
         fixed real "measurement_variance" ["m2"] (params.r).min(0.0),
-            "R per axis (002: 4 m2, i.e. 2 m DGPS standard deviation)";
+            "R per axis ([Artyszuk2003]: 4 m2, i.e. 2 m DGPS standard deviation)";
         fixed bool "full_recursion" (params.full_recursion),
             "true: time-varying Kalman recursion from P0 = p0 I; false: the steady-state form of eq. 5 (the paper's results)";
         fixed real "initial_covariance" (params.p0).min(0.0), "p0 of P0 = p0 I for the full recursion";
@@ -84,7 +84,7 @@ fmi2_export::fmu! {
         output real "gain_position" (|m| m.filter.steady_gain()[(2, 0)]).depends_on(&[]),
             "Steady-state position gain k_p of K_inf (S_p = 0.01: 0.271106)";
         input real "current_speed" ["m/s"] (current[0]),
-            "Sea-current speed |v_c| for the ground-to-water correction (section 1 of 002)";
+            "Sea-current speed |v_c| for the ground-to-water correction ([Artyszuk2003, sec. 1])";
         input real "current_direction" ["rad"] (current[1]),
             "Direction the current flows toward, gamma_c (0: a north current moving the ship north)";
         output real "surge_velocity_ground" ["m/s"] (|m| m.filter.body_velocity_over_ground(m.heading)[0])
@@ -94,13 +94,13 @@ fmi2_export::fmu! {
             .depends_on(&["heading"]),
             "Ground-related body velocity v_y (sway, to starboard)";
         output real "surge_velocity_water" ["m/s"] (|m| m.through_water()[0]).depends_on(WATER),
-            "Water-related surge v_x - [D^T(psi) v_c]_x (current correction, 002 line 34)";
+            "Water-related surge v_x - [D^T(psi) v_c]_x (current correction, [Artyszuk2003, sec. 1])";
         output real "sway_velocity_water" ["m/s"] (|m| m.through_water()[1]).depends_on(WATER),
             "Water-related sway v_y - [D^T(psi) v_c]_y";
         output real "drift_angle_water" ["rad"]
             (|m| m.filter.drift_angle_through_water(m.heading, m.current[0], m.current[1]))
             .depends_on(WATER),
-            "Water-related drift angle atan2(-v_y_water, v_x_water) (002 line 44)";
+            "Water-related drift angle atan2(-v_y_water, v_x_water) ([Artyszuk2003, sec. 1])";
     }
 }
 

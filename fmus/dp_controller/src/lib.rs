@@ -67,17 +67,17 @@ fmi2_export::fmu! {
     documentation: "documentation.html",
     variables: {
         fixed real "mass_surge" ["kg"] (params.mass[0]).min(0.0),
-            "m11 = m - X_udot used for the surge gains (001 Eq. 56: 5.3122e6)";
+            "m11 = m - X_udot used for the surge gains ([Fossen1999, eq. (56)]: 5.3122e6)";
         fixed real "mass_sway" ["kg"] (params.mass[1]).min(0.0),
-            "m22 = m - Y_vdot used for the sway gains (001 Eq. 56: 8.2831e6)";
+            "m22 = m - Y_vdot used for the sway gains ([Fossen1999, eq. (56)]: 8.2831e6)";
         fixed real "inertia_yaw" (params.mass[2]).min(0.0),
-            "m33 = I_z - N_rdot [kg m2] used for the yaw gains (001 Eq. 56: 3.7454e9)";
+            "m33 = I_z - N_rdot [kg m2] used for the yaw gains ([Fossen1999, eq. (56)]: 3.7454e9)";
         fixed real "damping_surge" (params.damping[0]).min(0.0),
-            "d11 = -X_u [N s/m] used for the surge gains (001 Eq. 57: 5.0242e4)";
+            "d11 = -X_u [N s/m] used for the surge gains ([Fossen1999, eq. (57)]: 5.0242e4)";
         fixed real "damping_sway" (params.damping[1]).min(0.0),
-            "d22 = -Y_v [N s/m] used for the sway gains (001 Eq. 57: 2.7229e5)";
+            "d22 = -Y_v [N s/m] used for the sway gains ([Fossen1999, eq. (57)]: 2.7229e5)";
         fixed real "damping_yaw" (params.damping[2]).min(0.0),
-            "d33 = -N_r [N m s] used for the yaw gains (001 Eq. 57: 4.1894e8)";
+            "d33 = -N_r [N m s] used for the yaw gains ([Fossen1999, eq. (57)]: 4.1894e8)";
         fixed real "bandwidth_surge" ["rad/s"] (params.bandwidth[0]).min(0.0),
             "Desired closed-loop bandwidth omega_b in surge; 0: no feedback";
         fixed real "bandwidth_sway" ["rad/s"] (params.bandwidth[1]).min(0.0),
@@ -89,17 +89,17 @@ fmi2_export::fmu! {
         fixed real "integral_ratio" (params.integral_ratio).min(0.0),
             "r in Ki = Kp wn / r (Fossen's rule r = 10); 0: no integral action";
         tunable real "test_amplitude_surge" ["N"] (params.test_amplitude[0]),
-            "Amplitude A of the feed-forward test input A sin(w t) in surge (001 Eq. 61: 1000)";
+            "Amplitude A of the feed-forward test input A sin(w t) in surge ([Fossen1999, eq. (61)]: 1000)";
         tunable real "test_amplitude_sway" ["N"] (params.test_amplitude[1]),
-            "Amplitude of the feed-forward test input in sway (001 Eq. 61: 1000)";
+            "Amplitude of the feed-forward test input in sway ([Fossen1999, eq. (61)]: 1000)";
         tunable real "test_amplitude_yaw" ["N.m"] (params.test_amplitude[2]),
-            "Amplitude of the feed-forward test input in yaw (001 Eq. 61: 1000)";
+            "Amplitude of the feed-forward test input in yaw ([Fossen1999, eq. (61)]: 1000)";
         tunable real "test_frequency_surge" ["rad/s"] (params.test_frequency[0]),
-            "Frequency w of the surge test input (001 Eq. 61: 0.05)";
+            "Frequency w of the surge test input ([Fossen1999, eq. (61)]: 0.05)";
         tunable real "test_frequency_sway" ["rad/s"] (params.test_frequency[1]),
-            "Frequency of the sway test input (001 Eq. 61: 0.1)";
+            "Frequency of the sway test input ([Fossen1999, eq. (61)]: 0.1)";
         tunable real "test_frequency_yaw" ["rad/s"] (params.test_frequency[2]),
-            "Frequency of the yaw test input (001 Eq. 61: 0.07)";
+            "Frequency of the yaw test input ([Fossen1999, eq. (61)]: 0.07)";
         input real "north_estimate" ["m"] (inputs.eta[0]),
             "LF north position estimate (observer eta_hat, not the measurement)";
         input real "east_estimate" ["m"] (inputs.eta[1]), "LF east position estimate";

@@ -961,9 +961,73 @@ pub fn check_state_rollback<M: FmuModel>(functions: Fmi2Functions) {
     h.free_state(restored);
 }
 
+/// The bare source numbers `000` to `004` in `text`, each with the text around it: the
+/// project's first names of the five sources, which users cannot look up (docs/sources.md
+/// gives their citation keys: `[Klugt1987, Fig. 2.8]`, not `003 Fig. 2.8`). A run of three
+/// digits inside a longer number (`0.001`, `1,000`, `2003`, `1.004e3`) or a word is not one.
+pub fn bare_source_numbers(text: &str) -> Vec<String> {
+    let b = text.as_bytes();
+    let word = |c: u8| c.is_ascii_alphanumeric() || c == b'_';
+    let mut found = Vec::new();
+    for i in 0..b.len().saturating_sub(2) {
+        if !(b[i] == b'0' && b[i + 1] == b'0' && (b'0'..=b'4').contains(&b[i + 2])) {
+            continue;
+        }
+        let before = i.checked_sub(1).map(|k| b[k]);
+        let before2 = i.checked_sub(2).map(|k| b[k]);
+        let after = b.get(i + 3).copied();
+        let after2 = b.get(i + 4).copied();
+        let in_number_before = match before {
+            Some(c) if word(c) || c == b'.' => true,
+            Some(b',') => before2.is_some_and(|c| c.is_ascii_digit()),
+            _ => false,
+        };
+        let in_number_after = match after {
+            Some(c) if word(c) => true,
+            Some(b'.' | b',') => after2.is_some_and(|c| c.is_ascii_digit()),
+            _ => false,
+        };
+        if !in_number_before && !in_number_after {
+            let (mut from, mut to) = (i.saturating_sub(40), (i + 43).min(text.len()));
+            while !text.is_char_boundary(from) {
+                from -= 1;
+            }
+            while !text.is_char_boundary(to) {
+                to += 1;
+            }
+            found.push(text[from..to].to_string());
+        }
+    }
+    found
+}
+
+/// The FMU's documentation page and model description (variable descriptions included) cite
+/// the sources by their keys of docs/sources.md, never by a bare number `000` to `004`.
+pub fn check_sources_cited_by_key<M: FmuModel>() {
+    let texts = [
+        (
+            "documentation/index.html",
+            crate::xml::documentation_html::<M>(),
+        ),
+        ("modelDescription.xml", crate::xml::model_description::<M>()),
+    ];
+    for (file, text) in texts {
+        let bare = bare_source_numbers(&text);
+        assert!(
+            bare.is_empty(),
+            "{}: {file} cites sources by number; use the keys of docs/sources.md \
+             ([Taylor2000, ...], [Fossen1999, ...], [Artyszuk2003, ...], [Klugt1987, ...], \
+             [Parsons1980, ...]):\n{}",
+            M::MODEL_IDENTIFIER,
+            bare.join("\n")
+        );
+    }
+}
+
 /// The checks every FMU crate runs, as `#[test]` functions: the table rules, the model
 /// description read back through the master's parser (`shipsim`, a dev-dependency of the FMU
-/// crate) equal to the table, every variable by name, and an exact rollback. Also declares the
+/// crate) equal to the table, every variable by name, an exact rollback, and sources cited by
+/// their keys in the documentation and the model description. Also declares the
 /// FMI symbols the crate exports and `fn fmu() -> Harness<M>` over them, for the crate's own
 /// tests. Use once per test file: `fmi2_export::fmu_tests!(my_fmu::MyFmu);`.
 #[macro_export]
@@ -1068,5 +1132,47 @@ macro_rules! fmu_tests {
         fn state_rollback_is_exact() {
             $crate::testing::check_state_rollback::<$model>(linked_fmi2_functions());
         }
+
+        #[test]
+        fn sources_are_cited_by_key() {
+            $crate::testing::check_sources_cited_by_key::<$model>();
+        }
     };
+}
+
+#[cfg(test)]
+mod tests {
+    use super::bare_source_numbers;
+
+    #[test]
+    fn bare_source_numbers_are_found_and_numbers_are_not() {
+        let found = |t: &str| bare_source_numbers(t).len();
+        for cited in [
+            "(003 Fig. 2.8, eq. 6.33)",
+            "The OCR original of 003 (L 742-754)",
+            "000's track tests",
+            "(2000, source 000)",
+            "seed 001.",
+            "004: 0.5",
+            "<td>002 DGPS</td>",
+            "002",
+        ] {
+            assert_eq!(found(cited), 1, "{cited}");
+        }
+        assert_eq!(found("(003 and 000 give no levels)"), 2);
+        for number in [
+            "0.001",
+            "lambda = 0.001)",
+            "1,000 lines",
+            "2003",
+            "1.000e12",
+            "0.0004",
+            "x004",
+            "004a",
+            "[Klugt1987, Fig. 2.8]",
+            "{3c0b1e52-0003-5004-a004-000000000042}",
+        ] {
+            assert_eq!(found(number), 0, "{number}");
+        }
+    }
 }

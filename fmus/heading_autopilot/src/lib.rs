@@ -111,9 +111,9 @@ fmi2_export::fmu! {
             (reference => { 0: HeadingReference::External, 1: HeadingReference::TrackChange }),
             "0: heading_reference input; 1: track-change generator (turn by turn_angle at turn_rate from turn_start, leg_time, turn back), relative to the initial heading";
         fixed real "turn_angle" ["rad"] (track_change.angle),
-            "Track change angle (negative: to port; 000 section 4.8: -90 deg)";
+            "Track change angle (negative: to port; [Taylor2000, sec. 4.8]: -90 deg)";
         fixed real "turn_rate" ["rad/s"] (track_change.turn_rate).min(0.0),
-            "Heading-command rate during the turns (not given in 000)";
+            "Heading-command rate during the turns (not given in [Taylor2000])";
         fixed real "leg_time" ["s"] (track_change.leg).min(0.0), "Time on the new leg before turning back";
         fixed real "turn_start" ["s"] (track_change.start).min(0.0),
             "Start of the first turn after the start time";

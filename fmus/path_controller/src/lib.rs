@@ -95,11 +95,11 @@ fmi2_export::fmu! {
         tunable int(1, 2) "disturbance_model" (disturbance_model),
             "Design model of N', Y': 1 first-order shaping filter (eqs. 39-41, Table 4), 2 random walk (eqs. 56-59, Tables 5/6/8)";
         tunable real "epsilon" (epsilon).min(0.0),
-            "Random-walk regulariser epsilon on F_e(6,6), F_e(7,7) (line 768: 1e-4)";
+            "Random-walk regulariser epsilon on F_e(6,6), F_e(7,7) ([Parsons1980, sec. 3.3]: 1e-4)";
         tunable real "shaping_time_constant" (shaping_time_constant).min(0.0),
             "Shaping-filter time constant T_N = T_Y in ship lengths (eqs. 39-40: 1)";
         tunable real "steering_time_constant" ["s"] (steering_time_constant).min(0.0),
-            "Steering-gear time constant of the design model (eq. 10; not printed in 004, 10 s derived from Table 4)";
+            "Steering-gear time constant of the design model ([Parsons1980, eq. (10)]; not printed there, 10 s derived from [Parsons1980, Table 4])";
         tunable real "a44" (params.design.a44).min(0.0),
             "Weight on eta'^2 = (eta'_0)^-2 (eq. 31: 772.463, eta_0 = 10.43 m)";
         tunable real "a55" (params.design.a55).min(0.0),
@@ -128,7 +128,7 @@ fmi2_export::fmu! {
         tunable real "schedule_tolerance" (params.schedule_tolerance).min(0.0),
             "Re-design when the measured T/H moved by more than this since the current design";
         fixed bool "dither_enabled" (params.dither.enabled),
-            "Open-loop dither windows with the control loop off (section 4-5 of 004)";
+            "Open-loop dither windows with the control loop off ([Parsons1980, secs. 4-5])";
         fixed real "dither_amplitude" ["rad"] (params.dither.amplitude),
             "Square-wave rudder command amplitude (0.5 rad)";
         fixed real "dither_period" (params.dither.period).min(0.0),
@@ -148,7 +148,7 @@ fmi2_export::fmu! {
         input real "cross_track" ["m"] (inputs.cross_track),
             "Estimated lateral offset eta from the track";
         input real "rudder_angle" ["rad"] (inputs.rudder),
-            "Actual rudder angle delta (known exactly in 004)";
+            "Actual rudder angle delta (known exactly in [Parsons1980])";
         input real "yaw_moment_prime" (inputs.yaw_moment_prime),
             "Estimated external yaw moment N' = 2N/(rho L^3 U^2)";
         input real "sway_force_prime" (inputs.sway_force_prime),

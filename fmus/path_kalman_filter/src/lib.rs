@@ -100,29 +100,29 @@ fmi2_export::fmu! {
     documentation: "documentation.html",
     variables: {
         tunable real "design_depth_ratio" (config.design_depth_ratio).min(0.0),
-            "Design (assumed) water depth / draft H/T of the Table 2 coefficients in the filter model (004 Table 2; 1.89 = Table 5 design; a very large value gives deep water); changing it in step mode is a gain-update event";
+            "Design (assumed) water depth / draft H/T of the Table 2 coefficients in the filter model ([Parsons1980, Table 2]; 1.89 = [Parsons1980, Table 5] design; a very large value gives deep water); changing it in step mode is a gain-update event";
         tunable real "adapted_depth_ratio" (config.adapted_depth_ratio),
-            "If > 0: f23 and f25 are taken at this H/T (004 Table 8 partial adaptation); 0: not used";
+            "If > 0: f23 and f25 are taken at this H/T ([Parsons1980, Table 8] partial adaptation); 0: not used";
         tunable int "disturbance_model" (config.random_walk => { 1: false, 2: true }),
-            "N', Y' model in the filter: 1 first-order shaping filter (004 eqs. 39-41, Table 4); 2 random walk (eqs. 56-59, Tables 5, 6, 8)";
+            "N', Y' model in the filter: 1 first-order shaping filter ([Parsons1980, eqs. (39)-(41), Table 4]); 2 random walk ([Parsons1980, eqs. (56)-(59), Tables 5, 6, 8])";
         tunable real "steering_time_constant" ["s"] (steering_time_constant).min(0.0),
             "Steering-gear time constant of eq. 10 (T_r' = T U/L; 10 s = 0.212874 is the value derived in the spec, the report does not print it)";
         tunable real "shaping_time_constant" (config.shaping_time_constant).min(0.0),
-            "Shaping-filter time constant T_N = T_Y in ship lengths (t' units) (004 eqs. 39-40)";
+            "Shaping-filter time constant T_N = T_Y in ship lengths (t' units) ([Parsons1980, eqs. (39)-(40)])";
         tunable real "epsilon" (config.epsilon).min(0.0),
-            "Random-walk design regulariser: -epsilon on the N', Y' diagonal for the gain design only (004 line 768)";
+            "Random-walk design regulariser: -epsilon on the N', Y' diagonal for the gain design only ([Parsons1980, sec. 3.3])";
         tunable real "q_yaw_moment" (config.q[0]),
             "Intensity q11 of the N' driving noise (nondimensional); <= 0: the report's value (1.548e-8 shaping filter, eq. 53; 2e-8 random walk, eq. 67)";
         tunable real "q_sway_force" (config.q[1]),
             "Intensity q22 of the Y' driving noise (nondimensional); <= 0: the report's value (8.970e-8, eq. 54; 1.25e-7, eq. 68)";
         tunable real "r_heading" (config.r[0]).min(0.0),
-            "Heading measurement noise intensity r11 (nondimensional PSD, 004 Table 3: 1.298e-8)";
+            "Heading measurement noise intensity r11 (nondimensional PSD, [Parsons1980, Table 3]: 1.298e-8)";
         tunable real "r_yaw_rate" (config.r[1]).min(0.0),
-            "Yaw-rate measurement noise intensity r22 (nondimensional PSD, 004 Table 3: 2.860e-7)";
+            "Yaw-rate measurement noise intensity r22 (nondimensional PSD, [Parsons1980, Table 3]: 2.860e-7)";
         tunable real "r_cross_track" (config.r[2]).min(0.0),
-            "Cross-track measurement noise intensity r33 (nondimensional PSD, 004 Table 3: 4.559e-7)";
+            "Cross-track measurement noise intensity r33 (nondimensional PSD, [Parsons1980, Table 3]: 4.559e-7)";
         fixed real "euler_step_prime" (euler_step_prime).min(0.0),
-            "Largest forward-Euler sub-step dt' of the filter (004: 0.005 = 0.2349 s); a communication step is covered by ceil(h'/dt') equal sub-steps";
+            "Largest forward-Euler sub-step dt' of the filter ([Parsons1980]: 0.005 = 0.2349 s); a communication step is covered by ceil(h'/dt') equal sub-steps";
         tunable real "innovation_window" (innovation_window).min(0.0),
             "Forgetting time (ship lengths) of the innovation mean square";
         fixed real "initial_heading" ["rad"] (initial_estimate[0]), "Initial heading estimate";
@@ -146,7 +146,7 @@ fmi2_export::fmu! {
         output real "yaw_rate_estimate" ["rad/s"] (|m| m.x(1) * UL), "Estimated yaw rate r = r' U/L";
         output real "drift_angle_estimate" ["rad"] (|m| m.x(2)), "Estimated drift angle beta";
         output real "sway_velocity_estimate" ["m/s"] (|m| -U * m.x(2)),
-            "Estimated sway velocity v = -U beta (004 eq. 5)";
+            "Estimated sway velocity v = -U beta ([Parsons1980, eq. (5)])";
         output real "cross_track_estimate" ["m"] (|m| m.x(3) * L),
             "Estimated lateral deviation eta = eta' L";
         output real "rudder_estimate" ["rad"] (|m| m.x(4)),
@@ -170,7 +170,7 @@ fmi2_export::fmu! {
         output real "innovation_rms_cross_track" ["m"] (|m| m.nu_rms(2) * L),
             "Exponentially weighted RMS of the cross-track innovation";
         output real "gain_heading_heading" (|m| m.filter.gain()[(0, 0)]),
-            "Kalman gain K(psi', psi') in use (004 Tables 4-6, 8)";
+            "Kalman gain K(psi', psi') in use ([Parsons1980, Tables 4-6, 8])";
         output real "gain_cross_track_cross_track" (|m| m.filter.gain()[(3, 2)]),
             "Kalman gain K(eta', eta') in use";
         output real "gain_yaw_moment_cross_track" (|m| m.filter.gain()[(5, 2)]),
@@ -182,7 +182,7 @@ fmi2_export::fmu! {
         output real "time_scale" ["1/s"] (|_m| UL), "U/L of Tokyo Maru at 12 kn (t' = t U/L)";
         // ---- gain update from an adaptive controller (appended: earlier value references unchanged)
         fixed bool "follow_design_inputs" (follow_design_inputs),
-            "Re-design the filter model F_e and gain K whenever the f*_design inputs change (004 Fig. 1: the gain \
+            "Re-design the filter model F_e and gain K whenever the f*_design inputs change ([Parsons1980, Fig. 1]: the gain \
              calculation updates C, K and the filter model together; connect all six from the PathController's design_f* \
              outputs); the gammas stay those of the design depth";
         input real "f22_design" (design_inputs[0]), "f22 of the design to follow (follow_design_inputs)";

@@ -58,7 +58,7 @@ fmi2_export::fmu! {
     documentation: "documentation.html",
     variables: {
         tunable bool "agc_enabled" (params.agc_enabled),
-            "Automatic Gain Controller on (003 section 5.3)";
+            "Automatic Gain Controller on ([Klugt1987, sec. 5.3])";
         tunable int "agc_target" (params.agc_target => { 1: AgcTarget::Total, 2: AgcTarget::RollOnly }),
             "1: A*(delta_psi + delta_phi) (literal Fig. 5.5); 2: delta_psi + A*delta_phi (default, course changes do not attenuate the course loop)";
         tunable int "roll_mode" (params.roll_mode => { 0: RollMode::Off, 1: RollMode::On, 2: RollMode::Forced }),
@@ -70,9 +70,9 @@ fmi2_export::fmu! {
         tunable real "lambda" (params.lambda).min(0.0),
             "Course criterion weight lambda of J = E[psi^2]/lambda + E[delta^2] (1 accurate ... 10 economic)";
         tunable real "angle_max" ["rad"] (params.angle_max).min(0.0),
-            "Allowed maximum rudder angle delta_max (operator; 003 RRS gear 22 deg)";
+            "Allowed maximum rudder angle delta_max (operator; the RRS gear of [Klugt1987]: 22 deg)";
         tunable real "rate_max" ["rad/s"] (params.rate_max).min(0.0),
-            "Maximum rudder rate of the steering machine for the AGC (003: 15 deg/s)";
+            "Maximum rudder rate of the steering machine for the AGC ([Klugt1987]: 15 deg/s)";
         tunable real "agc_memory_time" ["s"] (params.agc_memory_time).min(0.0),
             "AGC memory forgetting time constant [interpretation; thesis gives none]";
         tunable real "q_phi_initial" (params.adaptation.q_initial).min(0.0),

@@ -85,7 +85,7 @@ fmi2_export::fmu! {
     documentation: "documentation.html",
     variables: {
         fixed real "sample_time" ["s"] (sample_time).min(0.0),
-            "Filter sample time T of the Euler discretisation (003 eqs. 6.1-6.4; not given in the thesis); a step h is ceil(h/T) samples";
+            "Filter sample time T of the Euler discretisation ([Klugt1987, eqs. (6.1)-(6.4)]; not given in the thesis); a step h is ceil(h/T) samples";
         tunable real "design_speed" ["m/s"] (design_speed).min(0.0),
             "Ship speed at which the Table 2.4 control model (omega_n, z_n, k_dp, k_vp, k_dv, tau_v, tau_r, k_dr) is evaluated for the filters";
         tunable real "roll_q1" (roll_q[0]).min(0.0),

@@ -120,7 +120,7 @@ fmi2_export::fmu! {
         fixed real "max_substep" ["s"] (max_substep).min(0.0),
             "Largest RK4 sub-step (default 0.05 s; the fastest pole is about 1.2 rad/s)";
         input real "rudder_angle" ["rad"] (inputs.rudder),
-            "Actual rudder angle delta_w (from SteeringGear.rudder_angle); sign convention of 003: \
+            "Actual rudder angle delta_w (from SteeringGear.rudder_angle); sign convention of [Klugt1987]: \
              r/delta < 0 at DC; start value 5 deg";
         input real "speed" ["m/s"] (inputs.speed),
             "Ship speed U: evaluates the control-model speed laws (held over the step) and drives the \

@@ -38,19 +38,19 @@ fmi2_export::fmu! {
     documentation: "documentation.html",
     variables: {
         tunable real "angle_max" ["rad"] (params.angle_max).range(0.0, PI),
-            "Rudder-angle limit delta_max on the set point and the actual angle (003 Fig. 2.8)";
+            "Rudder-angle limit delta_max on the set point and the actual angle ([Klugt1987, Fig. 2.8])";
         tunable real "rate_max" ["rad/s"] (params.rate_max).min(0.0),
-            "Rudder-rate limit (max rudder speed), used when rate_limited (003 Fig. 2.8, eq. 6.33)";
+            "Rudder-rate limit (max rudder speed), used when rate_limited ([Klugt1987, Fig. 2.8, eq. (6.33)])";
         tunable bool "rate_limited" (params.rate_limited),
-            "Rate limiter present (true: 003 RRS gear; false: the 000 and 004 first-order gears)";
+            "Rate limiter present (true: the RRS gear of [Klugt1987]; false: the first-order gears of [Taylor2000] and [Parsons1980])";
         tunable real "time_constant" ["s"] (params.time_constant).min(0.0),
-            "Servo time constant tau_delta of the first-order servo (003 eq. 6.35; 000: L/(6U); 004: T_r = 10 s)";
+            "Servo time constant tau_delta of the first-order servo ([Klugt1987, eq. (6.35)]; [Taylor2000]: L/(6U); [Parsons1980]: T_r = 10 s)";
         fixed int "servo_order" (params.order => { 1: ServoOrder::First, 2: ServoOrder::Second }),
-            "1: first-order servo (003 Fig. 2.8, eq. 6.35); 2: second-order main servo (003 eqs. 6.41-6.42)";
+            "1: first-order servo ([Klugt1987, Fig. 2.8, eq. (6.35)]); 2: second-order main servo ([Klugt1987, eqs. (6.41)-(6.42)])";
         tunable real "omega0" ["rad/s"] (params.omega0).min(0.0),
-            "Natural frequency omega0 of the second-order servo (003 eq. 6.42; >= 10 omega_n, eq. 6.43)";
+            "Natural frequency omega0 of the second-order servo ([Klugt1987, eq. (6.42)]; >= 10 omega_n, [Klugt1987, eq. (6.43)])";
         tunable real "zeta0" (params.zeta0).min(0.0),
-            "Relative damping z0 of the second-order servo (003 eq. 6.44: z0 >= 1)";
+            "Relative damping z0 of the second-order servo ([Klugt1987, eq. (6.44)]: z0 >= 1)";
         fixed real "max_substep" ["s"] (params.max_substep).min(0.0),
             "Largest RK4 sub-step of the second-order servo (the first-order servo is integrated exactly)";
         fixed real "initial_angle" ["rad"] (initial_angle), "Rudder angle at the start time";
@@ -67,7 +67,7 @@ fmi2_export::fmu! {
         output bool "rate_saturated" (|m| m.gear.rate_saturated()).depends_on(&["rudder_command"]),
             "The rate limiter is active";
         output real "rate_saturated_time" ["s"] (|m| m.gear.rate_saturated_time()),
-            "Total time the rate limiter has been active since the start (exact, for the RRS statistics of 003)";
+            "Total time the rate limiter has been active since the start (exact, for the RRS statistics of [Klugt1987])";
     }
 }
 

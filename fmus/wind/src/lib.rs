@@ -71,7 +71,7 @@ fmi2_export::fmu! {
         fixed int(0, i32::MAX) "seed" (params.seed as u64),
             "Seed of this instance's ChaCha8 streams";
         tunable real "mean_wind_speed" ["m/s"] (params.mean_speed).min(0.0),
-            "Mean true wind speed (the constant component of 003 section 2.4.2)";
+            "Mean true wind speed (the constant component of [Klugt1987, sec. 2.4.2])";
         tunable real "wind_direction" ["rad"] (params.direction),
             "Mean direction the wind blows towards, earth frame of the heading";
         fixed real "gust_std" ["m/s"] (params.gust_std).min(0.0),
@@ -83,9 +83,9 @@ fmi2_export::fmu! {
         fixed real "direction_time_constant" ["s"] (params.direction_time_constant).min(1e-6),
             "Correlation time of the direction variation";
         tunable real "roll_coefficient" (params.roll_coefficient),
-            "c_w_phi of 003 eq. 2.19 [N.m/(m/s)^2]; not given in 003";
+            "c_w_phi of [Klugt1987, eq. (2.19)], in N.m/(m/s)^2; not given in [Klugt1987]";
         tunable real "yaw_coefficient" (params.yaw_coefficient),
-            "c_wR of 003 eq. 2.20 [N.m/(m/s)^2]; not given in 003";
+            "c_wR of [Klugt1987, eq. (2.20)], in N.m/(m/s)^2; not given in [Klugt1987]";
         fixed real "internal_step" ["s"] (params.internal_step).min(1e-6),
             "Fixed grid of the gust processes (linear interpolation in between)";
         input real "ship_speed" ["m/s"] (speed), "Ship speed along the heading";
@@ -99,9 +99,9 @@ fmi2_export::fmu! {
         output real "relative_wind_angle" ["rad"] (|m| m.out().wind.1),
             "gamma in (-pi, pi]: 0 wind from astern, +pi/2 blowing towards starboard, pi head wind";
         output real "roll_moment" ["N.m"] (|m| m.out().roll_moment),
-            "K = c_w_phi V_w^2 sin(gamma) (003 eq. 2.19)";
+            "K = c_w_phi V_w^2 sin(gamma) ([Klugt1987, eq. (2.19)])";
         output real "yaw_moment" ["N.m"] (|m| m.out().yaw_moment),
-            "N = c_wR V_w^2 sin(2 gamma) (003 eq. 2.20)";
+            "N = c_wR V_w^2 sin(2 gamma) ([Klugt1987, eq. (2.20)])";
     }
 }
 

@@ -164,6 +164,15 @@ pub fn read_run_table(campaign: &Campaign, dir: &Path) -> Result<Table> {
     Ok(run_table(campaign, &Journal::open(dir, kpis)?))
 }
 
+/// The derived table of a campaign's output folder (from its journal): what `derived.parquet`
+/// holds, None when the campaign has no `[[derived]]` KPIs.
+pub fn read_derived_table(campaign: &Campaign, dir: &Path) -> Result<Option<Table>> {
+    let kpis = output::kpi_columns(&campaign.spec).len();
+    let journal = Journal::open(dir, kpis)?;
+    let done = output::finished(&campaign.runs, &journal);
+    output::derived_table(&campaign.spec, &campaign.runs, &done)
+}
+
 /// A worker's side: the campaign and its FMUs, each loaded once for the life of the worker.
 pub struct Worker {
     pub campaign: Campaign,

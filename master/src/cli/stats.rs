@@ -1,14 +1,22 @@
-//! `shipsim stats FILE.csv [--window T0:T1] [--columns a,b,...] [--json]`: window statistics of
-//! the columns of a recorded CSV, with the campaigns' accumulator
+//! `shipsim stats FILE.csv [--window T0:T1] [--columns a,b,...] [--system FILE] [--json]`:
+//! window statistics of the columns of a recorded CSV, with the campaigns' accumulator
 //! ([`shipsim::campaign::kpi::StatAccumulator`]: Welford mean and population variance,
 //! RMS, extremes), so that a single run's numbers equal a campaign KPI over the same window.
+//!
+//! Units: a CSV has none, and names no system file, so `stats` cannot find them by itself.
+//! With `--system FILE` (the system file that wrote the CSV) each column `instance.variable`
+//! is looked up in the model description of that instance's FMU (unpacked, the binaries not
+//! loaded) and printed with its unit (the variance in unit^2); without it the header says how
+//! to get them.
 
 use clap::Args;
 use shipsim::campaign::kpi::{Stat, StatAccumulator};
 use shipsim::error::{Error, Result};
 use shipsim::plot::parse_window;
 use shipsim::results::ResultsTable;
-use std::path::PathBuf;
+use shipsim::system::{System, VarRef};
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
 
 /// The statistics printed, in order, with their column titles.
 const STATS: [(Stat, &str); 7] = [
@@ -32,6 +40,10 @@ pub struct StatsArgs {
     /// `ship.*,gear.rudder_angle`). Default: every column but time.
     #[arg(long, value_name = "A,B,...")]
     pub columns: Option<String>,
+    /// The system file that wrote the CSV (TOML, OSP XML, SSP or FMU): the units of the
+    /// columns are read from its FMUs' model descriptions (a CSV has none).
+    #[arg(long, value_name = "FILE")]
+    pub system: Option<PathBuf>,
     /// One JSON object instead of the table (NaN as null).
     #[arg(long)]
     pub json: bool,
@@ -42,6 +54,58 @@ struct ColumnStats {
     name: String,
     n: usize,
     values: [f64; 7],
+    unit: Unit,
+}
+
+/// A column's unit, as the system file's FMUs declare it.
+#[derive(Clone, Debug, PartialEq)]
+enum Unit {
+    /// No `--system`: not looked up.
+    NotAsked,
+    /// The variable's unit (of a Real variable, following its declaredType).
+    Of(String),
+    /// The variable declares none (or is an Integer or Boolean).
+    None,
+    /// The column is not a variable of the system's instances.
+    NotFound,
+}
+
+impl Unit {
+    /// The cell of the table's `unit` column.
+    fn cell(&self) -> &str {
+        match self {
+            Unit::Of(u) => u,
+            Unit::None => "-",
+            Unit::NotFound | Unit::NotAsked => "?",
+        }
+    }
+
+    fn json(&self) -> serde_json::Value {
+        match self {
+            Unit::Of(u) => serde_json::json!(u),
+            _ => serde_json::Value::Null,
+        }
+    }
+
+    /// The unit of the variance: the square (`m^2`, `(m/s)^2`).
+    fn squared(&self) -> serde_json::Value {
+        match self {
+            Unit::Of(u) => serde_json::json!(squared(u)),
+            _ => serde_json::Value::Null,
+        }
+    }
+}
+
+/// `unit^2`, parenthesised unless the unit is one name (`m^2`, `rad^2`, `(m/s)^2`, `(N.m)^2`);
+/// the dimensionless `1` stays `1`.
+fn squared(unit: &str) -> String {
+    if unit == "1" {
+        unit.to_string()
+    } else if unit.chars().all(char::is_alphabetic) {
+        format!("{unit}^2")
+    } else {
+        format!("({unit})^2")
+    }
 }
 
 /// `shipsim stats`.
@@ -56,6 +120,13 @@ pub fn run(args: &StatsArgs) -> Result<()> {
         .column("time")
         .map_err(|_| Error::Other(format!("{file}: no column 'time'")))?;
     let selected = select(&table, args.columns.as_deref(), &file)?;
+    let units = match &args.system {
+        Some(system) => {
+            let names: Vec<&str> = selected.iter().map(|&c| table.names[c].as_str()).collect();
+            units(system, &names)?
+        }
+        None => vec![Unit::NotAsked; selected.len()],
+    };
     let inside: Vec<usize> = (0..time.len())
         .filter(|&k| time[k] >= window.0 && time[k] <= window.1)
         .collect();
@@ -71,7 +142,8 @@ pub fn run(args: &StatsArgs) -> Result<()> {
     };
     let stats: Vec<ColumnStats> = selected
         .iter()
-        .map(|&c| {
+        .zip(units)
+        .map(|(&c, unit)| {
             let mut acc = StatAccumulator::new(Stat::Mean, window, 1.0);
             for &k in &inside {
                 acc.push(time[k], table.columns[c][k]);
@@ -84,16 +156,70 @@ pub fn run(args: &StatsArgs) -> Result<()> {
                     a.stat = s;
                     a.value()
                 }),
+                unit,
             }
         })
         .collect();
     let span = (time[first], time[last]);
+    let system = args.system.as_ref().map(|s| s.display().to_string());
     if args.json {
-        println!("{}", json(&file, span, &stats));
+        println!("{}", json(&file, span, &stats, system.as_deref()));
     } else {
-        print!("{}", table_text(&file, span, &stats));
+        print!("{}", table_text(&file, span, &stats, system.as_deref()));
     }
     Ok(())
+}
+
+/// The units of the columns `names` (`instance.variable`) in the system file `system`: each
+/// instance's FMU unpacked once (model description read, binaries not loaded). A column that
+/// is not a variable of the system gets [`Unit::NotFound`] and a warning; a system that has
+/// none of the columns is an error (it is not the system that wrote the CSV).
+fn units(system: &Path, names: &[&str]) -> Result<Vec<Unit>> {
+    let sys = System::load(system)?;
+    let mut unpacked: HashMap<&Path, shipsim::fmu::UnpackedFmu> = HashMap::new();
+    for inst in &sys.instances {
+        if !unpacked.contains_key(inst.fmu.as_path()) {
+            sys.require_fmu(inst)?;
+            let fmu = shipsim::fmu::UnpackedFmu::open(&inst.fmu)?;
+            unpacked.insert(inst.fmu.as_path(), fmu);
+        }
+    }
+    let unit = |name: &str| -> Unit {
+        let Some(r) = VarRef::parse(name) else {
+            return Unit::NotFound;
+        };
+        let Some(inst) = sys.instances.iter().find(|i| i.name == r.instance) else {
+            return Unit::NotFound;
+        };
+        let md = &unpacked[inst.fmu.as_path()].model_description;
+        let variables = &md.model_variables.variables;
+        match variables.iter().find(|v| v.name == r.variable) {
+            None => Unit::NotFound,
+            Some(v) => match md.real_unit(v) {
+                Some(u) if !u.is_empty() => Unit::Of(u.to_string()),
+                _ => Unit::None,
+            },
+        }
+    };
+    let units: Vec<Unit> = names.iter().map(|n| unit(n)).collect();
+    let missing: Vec<&str> = names
+        .iter()
+        .zip(&units)
+        .filter(|(_, u)| **u == Unit::NotFound)
+        .map(|(n, _)| *n)
+        .collect();
+    let system = system.display();
+    if !names.is_empty() && missing.len() == names.len() {
+        return Err(Error::Other(format!(
+            "{system}: none of the columns is a variable of its instances (e.g. '{}'): is it \
+             the system file that wrote the CSV?",
+            missing[0]
+        )));
+    }
+    for n in missing {
+        eprintln!("warning: column '{n}' is not a variable of {system}: its unit is unknown (?)");
+    }
+    Ok(units)
 }
 
 /// The indices of the selected columns, in the order of the pattern list (each column once).
@@ -177,9 +303,20 @@ fn number(x: f64) -> String {
 }
 
 /// The aligned table: a header line, then one row per column.
-fn table_text(file: &str, span: (f64, f64), stats: &[ColumnStats]) -> String {
+/// With a system file, a `unit` column after the name (the unit of the mean, std, rms, min,
+/// max and max_abs; the variance is in its square, as the first line says); without one, the
+/// first line says how to get units.
+fn table_text(file: &str, span: (f64, f64), stats: &[ColumnStats], system: Option<&str>) -> String {
     let n = stats.first().map_or(0, |s| s.n);
-    let mut out = format!("{file}: {n} samples, t = {} .. {} s\n", span.0, span.1);
+    let mut out = format!("{file}: {n} samples, t = {} .. {} s; ", span.0, span.1);
+    match system {
+        Some(system) => out.push_str(&format!(
+            "units from the FMUs of {system} (variance in unit^2)\n"
+        )),
+        None => out.push_str(
+            "no units (a CSV has none): give --system FILE, the system file that wrote it\n",
+        ),
+    }
     let cells: Vec<Vec<String>> = stats
         .iter()
         .map(|s| s.values.iter().map(|&x| number(x)).collect())
@@ -191,13 +328,25 @@ fn table_text(file: &str, span: (f64, f64), stats: &[ColumnStats]) -> String {
             w.max(STATS[j].1.len())
         })
         .collect();
+    let unit_w = stats
+        .iter()
+        .map(|s| s.unit.cell().chars().count())
+        .max()
+        .unwrap_or(0)
+        .max(4);
     out.push_str(&format!("{:<name_w$}", "column"));
+    if system.is_some() {
+        out.push_str(&format!("  {:<unit_w$}", "unit"));
+    }
     for (j, (_, title)) in STATS.iter().enumerate() {
         out.push_str(&format!("  {title:>w$}", w = widths[j]));
     }
     out.push('\n');
     for (s, row) in stats.iter().zip(&cells) {
         out.push_str(&format!("{:<name_w$}", s.name));
+        if system.is_some() {
+            out.push_str(&format!("  {:<unit_w$}", s.unit.cell()));
+        }
         for (j, cell) in row.iter().enumerate() {
             out.push_str(&format!("  {cell:>w$}", w = widths[j]));
         }
@@ -206,13 +355,21 @@ fn table_text(file: &str, span: (f64, f64), stats: &[ColumnStats]) -> String {
     out
 }
 
-/// `{"file", "samples", "t0", "t1", "columns": [{"name", "mean", "variance", ...}, ...]}`,
-/// the columns in the order of the table.
-fn json(file: &str, span: (f64, f64), stats: &[ColumnStats]) -> serde_json::Value {
+/// `{"file", "samples", "t0", "t1", "system", "columns": [{"name", "unit", "variance_unit",
+/// "mean", "variance", ...}, ...]}`, the columns in the order of the table; `system` and the
+/// units are null without `--system` (and a unit is null where the system declares none).
+fn json(
+    file: &str,
+    span: (f64, f64),
+    stats: &[ColumnStats],
+    system: Option<&str>,
+) -> serde_json::Value {
     let mut columns = Vec::new();
     for s in stats {
         let mut m = serde_json::Map::new();
         m.insert("name".into(), serde_json::json!(s.name));
+        m.insert("unit".into(), s.unit.json());
+        m.insert("variance_unit".into(), s.unit.squared());
         for ((_, title), x) in STATS.iter().zip(s.values) {
             m.insert(title.to_string(), serde_json::json!(x));
         }
@@ -223,13 +380,23 @@ fn json(file: &str, span: (f64, f64), stats: &[ColumnStats]) -> serde_json::Valu
         "samples": stats.first().map_or(0, |s| s.n),
         "t0": span.0,
         "t1": span.1,
+        "system": system,
         "columns": columns,
     })
 }
 
 #[cfg(test)]
 mod tests {
-    use super::glob;
+    use super::{glob, squared};
+
+    #[test]
+    fn squared_units() {
+        assert_eq!(squared("m"), "m^2");
+        assert_eq!(squared("rad"), "rad^2");
+        assert_eq!(squared("m/s"), "(m/s)^2");
+        assert_eq!(squared("N.m"), "(N.m)^2");
+        assert_eq!(squared("1"), "1");
+    }
 
     #[test]
     fn globs() {
