@@ -238,6 +238,8 @@ def test_readme_python_snippet(tmp_path):
     assert 'c.run(jobs=2)' in code and "campaigns/rrs_polar.toml" in code
     code = code.replace("campaigns/rrs_polar.toml", "campaigns/rrs_polar_reduced.toml")
     code = code.replace("c.run(jobs=2)", f"c.run({str(tmp_path / 'out')!r}, jobs=2, progress=False)")
+    assert "c.derived_table()" in code
+    code = code.replace("c.derived_table()", f"c.derived_table({str(tmp_path / 'out')!r})")
     cwd = os.getcwd()
     os.chdir(ROOT)
     try:
