@@ -354,7 +354,8 @@ fn inspect<'py>(py: Python<'py>, path: PathBuf) -> PyResult<Bound<'py, PyDict>> 
     Ok(d)
 }
 
-/// A Python value as the value of variable `name` (`sv`): bool, int and float as themselves,
+/// A Python value as the value of variable `name` (`sv`): bool (and numpy's bool for a Boolean
+/// variable), int and float as themselves,
 /// str as text parsed by the variable's type (as `--set` does). An Integer or Enumeration
 /// variable takes a whole float (3.0, numpy's float64(3.0)) as that integer, as campaign
 /// factors do; a float that is not whole, or a whole number outside fmi2Integer's 32 bits, is a
@@ -367,6 +368,11 @@ fn to_value(name: &str, sv: &ScalarVariable, value: &Bound<'_, PyAny>) -> PyResu
     let whole = matches!(t, Some(VarType::Integer | VarType::Enumeration));
     if let Ok(b) = value.cast::<pyo3::types::PyBool>() {
         return Ok(Value::Boolean(b.is_true()));
+    }
+    // numpy's bool (`np.True_`, an element of a boolean array) is no bool, and its __float__
+    // would make it a Real: a Boolean variable takes it as what it is.
+    if t == Some(VarType::Boolean) && is_numpy_bool(value)? {
+        return Ok(Value::Boolean(value.is_truthy()?));
     }
     let float = value.cast::<pyo3::types::PyFloat>().is_ok();
     // int, and numpy's integers (which have __index__ but are no int)
@@ -402,6 +408,14 @@ fn to_value(name: &str, sv: &ScalarVariable, value: &Bound<'_, PyAny>) -> PyResu
         "'{name}': a value must be a bool, int, float or str, not {}",
         value.get_type().name()?
     )))
+}
+
+/// `numpy.bool_` (named `numpy.bool` since numpy 2).
+fn is_numpy_bool(value: &Bound<'_, PyAny>) -> PyResult<bool> {
+    let ty = value.get_type();
+    let module = ty.module()?.to_string();
+    let name = ty.name()?.to_string();
+    Ok(module == "numpy" && (name == "bool_" || name == "bool"))
 }
 
 /// A value for a message: its `repr`, at most 40 characters (`10**1000` is not written out).

@@ -13,6 +13,7 @@ what to do.
 - (f) two threads running one Campaign into one folder: the second is told the folder is in use;
 - (h) a stop time out of range is one message about the stop time, not four (three about
   step_multiple)."""
+import os
 import pathlib
 import threading
 import time
@@ -91,6 +92,22 @@ def test_an_integer_variable_takes_whole_floats():
             "0 to 2147483647"
         )
     assert s.values["waves.seed"] == "3"  # a refused value changes nothing
+
+
+def test_a_boolean_variable_takes_numpy_bools():
+    """np.True_ and np.False_ (what a boolean array holds) were taken as the Reals 1.0 and 0.0
+    and refused when the system ran. The steering gear alone, a large command: its rate limit
+    acts from the first step."""
+    fmu = pathlib.Path(os.environ.get("SHIPSIM_FMU_DIR", ROOT / "target" / "fmu")) / "SteeringGear.fmu"
+    s = shipsim.System.load(fmu).set("SteeringGear.rudder_command", 0.3)
+    angle = ["SteeringGear.rudder_angle"]
+    ref = s.set("SteeringGear.rate_limited", False).run(stop_time=2, variables=angle)
+    on = s.set("SteeringGear.rate_limited", True).run(stop_time=2, variables=angle)
+    assert not np.array_equal(on[angle[0]].to_numpy(), ref[angle[0]].to_numpy())
+    for value, expect in ((np.False_, ref), (np.array([True, False])[1], ref), (np.True_, on)):
+        s.set("SteeringGear.rate_limited", value)
+        df = s.run(stop_time=2, variables=angle)
+        assert np.array_equal(df[angle[0]].to_numpy(), expect[angle[0]].to_numpy()), value
 
 
 def test_an_int_out_of_range_names_the_range():
