@@ -62,13 +62,7 @@ fn factor_seed_and_kpi_names_cannot_be_table_columns_or_each_other() {
 
 /// A campaign of the C test FMU in `dir`: `sys.toml` and `NAME.toml` with the factor values.
 fn tiny_campaign(dir: &Path, name: &str, values: &str) -> std::path::PathBuf {
-    common::test_fmu(dir);
-    common::write_system(
-        dir,
-        "sys.toml",
-        "[simulation]\nstop_time = 0.2\nstep_size = 0.1\n[[instances]]\nname = \"m\"\n\
-         fmu = \"testfmu.fmu\"\nparameters = { u = 1.0 }\n",
-    );
+    common::tiny_system(dir);
     common::write_system(
         dir,
         &format!("{name}.toml"),

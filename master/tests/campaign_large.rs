@@ -16,13 +16,7 @@ const LIMIT: &str = "--as=1073741824";
 /// values), `reps` replications and two arms.
 fn campaign(dir: &Path, name: &str, a: &str, b: &str, reps: u32) -> PathBuf {
     if !dir.join("testfmu.fmu").exists() {
-        common::test_fmu(dir);
-        common::write_system(
-            dir,
-            "sys.toml",
-            "[simulation]\nstop_time = 0.2\nstep_size = 0.1\n[[instances]]\nname = \"m\"\n\
-             fmu = \"testfmu.fmu\"\nparameters = { u = 1.0 }\n",
-        );
+        common::tiny_system(dir);
     }
     common::write_system(
         dir,

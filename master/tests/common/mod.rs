@@ -100,6 +100,18 @@ pub fn test_fmu(dir: &Path) -> PathBuf {
     build_fmu(dir, "testfmu", Variant::default())
 }
 
+/// The standard test FMU in `dir` and `dir/sys.toml`: one instance `m` of it, u = 1, 0.2 s in
+/// steps of 0.1 s (the base system of the small test campaigns).
+pub fn tiny_system(dir: &Path) -> PathBuf {
+    test_fmu(dir);
+    write_system(
+        dir,
+        "sys.toml",
+        "[simulation]\nstop_time = 0.2\nstep_size = 0.1\n[[instances]]\nname = \"m\"\n\
+         fmu = \"testfmu.fmu\"\nparameters = { u = 1.0 }\n",
+    )
+}
+
 /// Writes a system file into `dir` and returns its path.
 pub fn write_system(dir: &Path, name: &str, text: &str) -> PathBuf {
     let p = dir.join(name);
