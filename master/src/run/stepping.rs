@@ -76,24 +76,30 @@ impl Stepper<'_> {
         let mut next_event = self.events.partition_point(|e| e.step < k);
         // The next sampled step (none without a profile): one comparison per step.
         let mut next_sample = profile.as_ref().map_or(u64::MAX, |a| a.sampling.next(k));
-        while k < until && count.terminated_by.is_none() {
-            let (next_event, count) = (&mut next_event, &mut count);
-            match profile.as_mut().filter(|_| k == next_sample) {
-                Some(acc) => {
-                    let mut timer = acc.start();
-                    self.macro_step(algorithm, k, &grid, next_event, count, &mut timer)?;
-                    timer.lap(Lap::Master);
-                    next_sample += acc.sampling.every.max(1);
+        let mut steps = || -> Result<()> {
+            while k < until && count.terminated_by.is_none() {
+                let (next_event, count) = (&mut next_event, &mut count);
+                match profile.as_mut().filter(|_| k == next_sample) {
+                    Some(acc) => {
+                        let mut timer = acc.start();
+                        self.macro_step(algorithm, k, &grid, next_event, count, &mut timer)?;
+                        timer.lap(Lap::Master);
+                        next_sample += acc.sampling.every.max(1);
+                    }
+                    None => self.macro_step(algorithm, k, &grid, next_event, count, &mut Off)?,
                 }
-                None => self.macro_step(algorithm, k, &grid, next_event, count, &mut Off)?,
+                k += 1;
             }
-            k += 1;
-        }
+            Ok(())
+        };
+        let result = steps();
+        // Also on an error: an interrupted stepping session stays at t_k, where it stopped,
+        // with its count ([`super::Session`]).
         self.k = k;
         self.count = count;
         self.profile = profile;
         self.wall += start.elapsed();
-        Ok(())
+        result
     }
 
     /// Macro step k (with the next event's index and the count): the interruption check, the

@@ -79,3 +79,43 @@ impl Checker<'_> {
         })
     }
 }
+
+impl super::System {
+    /// One value set from outside a running system, at time `e.time`, in a run of `n_steps`
+    /// base steps ending at `stop` (a stepping session's `set`, [`crate::run::Session::set`]), checked and resolved as an
+    /// event at t_step of the system file would be: the same name, type, unit, range and
+    /// causality rules, and the same messages. A connected input is accepted (the connection
+    /// drives it again at the next exchange, as for an event).
+    pub fn resolve_event(
+        &self,
+        mds: &[&crate::model_description::ModelDescription],
+        e: &EventSpec,
+        n_steps: u64,
+        stop: f64,
+    ) -> crate::error::Result<PlanEvent> {
+        let mut c = Checker {
+            sys: self,
+            mds,
+            index: self
+                .instances
+                .iter()
+                .enumerate()
+                .map(|(i, inst)| (inst.name.as_str(), i))
+                .collect(),
+            errors: Vec::new(),
+            warnings: Vec::new(),
+        };
+        let grid = Grid {
+            ok: true,
+            n_steps,
+            stop_on_grid: stop,
+            off_grid: None,
+        };
+        match c.event(e, &grid, &Driven::new()) {
+            Some(ev) => Ok(ev),
+            None => Err(c.errors.pop().unwrap_or_else(|| {
+                crate::error::Error::Other(format!("'{}' cannot be set", e.target))
+            })),
+        }
+    }
+}
