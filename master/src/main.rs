@@ -155,6 +155,9 @@ enum Command {
     /// Plot recorded columns of one CSV, or of several overlaid, against time (and x-y tracks
     /// with equal axes) into a PNG.
     Plot(PlotArgs),
+    /// Replay the journal of a stepping session (Python's `System.start(journal=...)`):
+    /// the same rows as the session, bit for bit, as a CSV.
+    Replay(cli::replay::ReplayArgs),
     /// Campaigns: many runs over factors, seeds and arms, one KPI row per run.
     Campaign {
         #[command(subcommand)]
@@ -378,6 +381,7 @@ fn dispatch(cmd: Command, session: &Session) -> shipsim::Result<()> {
             cli::campaign::dispatch(command, || session.interrupt.clone())
         }
         Command::Stats(args) => cli::stats::run(&args),
+        Command::Replay(args) => cli::replay::run(&args, session.interrupt.clone()),
         Command::FmuHost { .. } => Ok(()),
     }
 }

@@ -8,7 +8,9 @@
 mod common;
 use common::*;
 use shipsim::fmu::Fmu;
-use shipsim::run::{load_fmus, run_into, MemoryRecorder, RunOptions, Session, SessionOptions, State};
+use shipsim::run::{
+    load_fmus, run_into, MemoryRecorder, RunOptions, Session, SessionOptions, State,
+};
 use shipsim::system::{Algorithm, EventSpec, System, TypedValue, Value, VarRef};
 use std::path::Path;
 use std::sync::Arc;
@@ -90,7 +92,10 @@ fn advance_to_reaches_the_time_and_refuses_points_off_the_grid() {
     assert_eq!(s.advance_to(2.5).unwrap(), 2.5);
     assert_eq!(s.step_index(), 50);
     let e = s.advance_to(2.525).unwrap_err().to_string();
-    assert!(e.contains("communication point") && e.contains("h = 0.05 s"), "{e}");
+    assert!(
+        e.contains("communication point") && e.contains("h = 0.05 s"),
+        "{e}"
+    );
     let e = s.advance_to(1.0).unwrap_err().to_string();
     assert!(e.contains("from the session's time 2.5 s"), "{e}");
     assert_eq!(s.advance_to(10.0).unwrap(), 10.0);
@@ -105,14 +110,20 @@ fn a_value_set_between_steps_is_the_same_change_as_an_event() {
     let (sys, fmus) = rrs(40.0, Algorithm::Jacobi);
     // A tunable Integer, and a tunable Real given with a unit (deg into the FMU's rad).
     let evented = with_event(&sys, 12.5, "autopilot.roll_mode", Value::Integer(0));
-    let evented = with_event(&evented, 20.0, "autopilot.angle_max", Value::Text("20 deg".into()));
+    let evented = with_event(
+        &evented,
+        20.0,
+        "autopilot.angle_max",
+        Value::Text("20 deg".into()),
+    );
     let expected = run_rows(&evented, &fmus);
     let mut s = start(&sys, &fmus);
     s.advance_to(12.5).unwrap();
     s.set("autopilot.roll_mode", Value::Integer(0)).unwrap();
     s.step(150).unwrap();
     assert_eq!(s.time(), 20.0);
-    s.set("autopilot.angle_max", Value::Text("20 deg".into())).unwrap();
+    s.set("autopilot.angle_max", Value::Text("20 deg".into()))
+        .unwrap();
     s.step(1).unwrap();
     assert_eq!(
         s.get("autopilot.angle_max").unwrap(),
@@ -128,7 +139,10 @@ fn a_value_set_between_steps_is_the_same_change_as_an_event() {
 fn a_restored_checkpoint_rewinds_the_session() {
     let (sys, fmus) = rrs(30.0, Algorithm::Jacobi);
     let plain = run_rows(&sys, &fmus);
-    let changed = run_rows(&with_event(&sys, 10.0, "autopilot.roll_mode", Value::Integer(0)), &fmus);
+    let changed = run_rows(
+        &with_event(&sys, 10.0, "autopilot.roll_mode", Value::Integer(0)),
+        &fmus,
+    );
     let mut s = start(&sys, &fmus);
     s.advance_to(10.0).unwrap();
     let cp = s.checkpoint().unwrap();
@@ -155,32 +169,48 @@ fn the_journal_replays_the_session_bit_for_bit() {
     let dir = tempfile::tempdir().unwrap();
     let journal = dir.path().join("session.jsonl");
     let (mut sys, fmus) = rrs(30.0, Algorithm::GaussSeidel);
-    sys.set_value(VarRef::parse("waves.seed").unwrap(), Value::Integer(7)).unwrap();
+    sys.set_value(VarRef::parse("waves.seed").unwrap(), Value::Integer(7))
+        .unwrap();
     let opts = SessionOptions {
         journal: Some(journal.clone()),
         ..Default::default()
     };
     let mut s = Session::start(sys.clone(), fmus.clone(), opts).unwrap();
     s.advance_to(5.0).unwrap();
-    s.set("autopilot.angle_max", Value::Text("25 deg".into())).unwrap();
+    s.set("autopilot.angle_max", Value::Text("25 deg".into()))
+        .unwrap();
     s.advance_to(10.0).unwrap();
     let cp = s.checkpoint().unwrap();
     s.set("autopilot.roll_mode", Value::Integer(0)).unwrap();
     s.advance_to(20.0).unwrap();
     s.restore(&cp).unwrap();
     s.step(3).unwrap();
-    s.set("autopilot.lambda", Value::Real(std::f64::consts::PI)).unwrap();
+    s.set("autopilot.lambda", Value::Real(std::f64::consts::PI))
+        .unwrap();
     s.advance_to(25.0).unwrap();
     s.close().unwrap();
     let text = std::fs::read_to_string(&journal).unwrap();
     assert_eq!(text.lines().count(), 1 + 6, "{text}");
-    assert!(text.contains(r#""variable":"autopilot.angle_max","value":{"Real":0.4363323129985824}"#), "{text}");
+    assert!(
+        text.contains(r#""variable":"autopilot.angle_max","value":{"Real":0.4363323129985824}"#),
+        "{text}"
+    );
     let replayed = Session::replay(&journal, RunOptions::default()).unwrap();
     assert_eq!(replayed.time(), 25.0);
     assert_eq!(rows(replayed.rows()), rows(s.rows()));
     // The same history as a plain run: the undone set is not in it.
-    let mut evented = with_event(&sys, 5.0, "autopilot.angle_max", Value::Text("25 deg".into()));
-    evented = with_event(&evented, 10.15, "autopilot.lambda", Value::Real(std::f64::consts::PI));
+    let mut evented = with_event(
+        &sys,
+        5.0,
+        "autopilot.angle_max",
+        Value::Text("25 deg".into()),
+    );
+    evented = with_event(
+        &evented,
+        10.15,
+        "autopilot.lambda",
+        Value::Real(std::f64::consts::PI),
+    );
     evented.stop_time = Some(30.0);
     let full = run_rows(&evented, &fmus);
     assert_eq!(rows(s.rows())[..], full[..rows(s.rows()).len()]);
@@ -189,8 +219,14 @@ fn the_journal_replays_the_session_bit_for_bit() {
     let edited = text.replace(&format!("{:?}", first.sha256), "\"0000\"");
     let other = dir.path().join("other.jsonl");
     std::fs::write(&other, edited).unwrap();
-    let e = Session::replay(&other, RunOptions::default()).err().unwrap().to_string();
-    assert!(e.contains(&format!("instance '{}'", first.instance)) && e.contains("SHA-256"), "{e}");
+    let e = Session::replay(&other, RunOptions::default())
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(
+        e.contains(&format!("instance '{}'", first.instance)) && e.contains("SHA-256"),
+        "{e}"
+    );
 }
 
 #[test]
@@ -198,16 +234,35 @@ fn misuse_is_a_clear_error() {
     let (sys, fmus) = rrs(5.0, Algorithm::Jacobi);
     let mut s = start(&sys, &fmus);
     s.step(2).unwrap();
-    let e = s.set("autopilot.k_dp0", Value::Real(0.0)).unwrap_err().to_string();
-    assert!(e.contains("'autopilot.k_dp0' is fixed parameter") && e.contains("only inputs and tunable parameters"), "{e}");
-    let e = s.set("autopilot.roll_mode", Value::Real(0.5)).unwrap_err().to_string();
+    let e = s
+        .set("autopilot.k_dp0", Value::Real(0.0))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("'autopilot.k_dp0' is fixed parameter")
+            && e.contains("only inputs and tunable parameters"),
+        "{e}"
+    );
+    let e = s
+        .set("autopilot.roll_mode", Value::Real(0.5))
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("does not fit a Integer variable"), "{e}");
-    let e = s.set("autopilot.angle_max", Value::Text("3 m".into())).unwrap_err().to_string();
+    let e = s
+        .set("autopilot.angle_max", Value::Text("3 m".into()))
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("autopilot.angle_max") && e.contains("m"), "{e}");
     let e = s.get("autopilot.rol_mode").unwrap_err().to_string();
-    assert!(e.contains("has no variable 'rol_mode'") && e.contains("roll_mode"), "{e}");
+    assert!(
+        e.contains("has no variable 'rol_mode'") && e.contains("roll_mode"),
+        "{e}"
+    );
     let e = s.get("autopiloot.roll_mode").unwrap_err().to_string();
-    assert!(e.contains("no instance 'autopiloot'") && e.contains("autopilot"), "{e}");
+    assert!(
+        e.contains("no instance 'autopiloot'") && e.contains("autopilot"),
+        "{e}"
+    );
     let mut other = start(&sys, &fmus);
     let cp = other.checkpoint().unwrap();
     let e = s.restore(&cp).unwrap_err().to_string();

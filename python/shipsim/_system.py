@@ -242,13 +242,7 @@ class System:
         """
         if isinstance(variables, str):
             variables = [variables]  # one pattern, not its characters
-        if isolate is True:
-            isolate = "all"
-        elif isolate is False:
-            isolate = None
-        names = None
-        if isolate is not None and not isinstance(isolate, str):
-            names, isolate = [str(n) for n in isolate], None
+        isolate, names = _isolation(isolate)
         raw = self._native.run(
             stop_time=stop_time,
             variables=None if variables is None else list(variables),
@@ -262,28 +256,96 @@ class System:
         )
         for w in raw["warnings"]:
             warnings.warn(w, ShipsimWarning, stacklevel=2)
-        time = np.frombuffer(raw["time"], dtype="<f8")
-        arrays = {}
-        for name, kind, buf in zip(raw["columns"], raw["types"], raw["data"]):
-            values = np.frombuffer(buf, dtype="<f8")
-            dtype = _DTYPES.get(kind, np.float64)
-            arrays[name] = values if dtype is np.float64 else values.astype(dtype)
-        units = dict(zip(raw["columns"], raw["units"]))
-        if as_frame is None:
-            as_frame = _have_pandas()
-        if as_frame:
-            import pandas as pd
+        return _frame(raw, as_frame, raw["summary"])
 
-            df = pd.DataFrame(arrays, index=pd.Index(time, name="time"))
-            df.attrs["units"] = units
-            df.attrs["summary"] = raw["summary"]
-            df.attrs["warnings"] = list(raw["warnings"])
-            return df
-        out = Columns(time=time, **arrays)
-        out.units = units
-        out.summary = raw["summary"]
-        return out
+    def start(
+        self,
+        stop_time: Optional[float] = None,
+        variables: Union[str, Iterable[str], None] = None,
+        *,
+        start_time: Optional[float] = None,
+        step_size: Optional[float] = None,
+        algorithm: Optional[str] = None,
+        verbose: bool = False,
+        isolate=None,
+        call_timeout: Optional[float] = None,
+        journal: Optional[PathLike] = None,
+    ) -> "Session":
+        """Starts a stepping session: the instances are made and initialized, and the session
+        is at the start time, ready to :meth:`Session.step`. The options are :meth:`run`'s;
+        ``journal`` names a file that the session writes every value set from outside to (JSON
+        Lines; :meth:`replay` replays it bit for bit). See :class:`Session`."""
+        from ._session import Session
+
+        if isinstance(variables, str):
+            variables = [variables]
+        isolate, names = _isolation(isolate)
+        native = self._native.start(
+            stop_time=stop_time,
+            variables=None if variables is None else list(variables),
+            start_time=start_time,
+            step_size=step_size,
+            algorithm=algorithm,
+            verbose=verbose,
+            isolate=isolate,
+            isolate_instances=names,
+            call_timeout=call_timeout,
+            journal=None if journal is None else os.fspath(journal),
+        )
+        for w in native.warnings:
+            warnings.warn(w, ShipsimWarning, stacklevel=2)
+        return Session(native)
+
+    @staticmethod
+    def replay(journal: PathLike, *, verbose: bool = False, as_frame: Optional[bool] = None):
+        """Replays a session's journal (written by ``System.start(journal=...)`` or
+        :meth:`Session.save_journal`): loads the system file it names, checks that the file
+        and every FMU have the SHA-256 the journal gives (else :class:`ShipsimError` naming
+        the difference), applies the start values and options the session had and the values
+        set from outside in the session's final history (a restored checkpoint drops those
+        set after it), and runs to the session's last time. Returns the rows as
+        :meth:`run` does; they equal the session's bit for bit. ``shipsim replay JOURNAL``
+        does the same from the command line."""
+        raw = _native.replay(os.fspath(journal), verbose=verbose)
+        return _frame(raw, as_frame, {})
 
     def __repr__(self) -> str:
         names = ", ".join(self.instances)
         return f"System({self.source!r}: {names}; step {self.step_size} s, stop {self.stop_time} s)"
+
+
+def _isolation(isolate):
+    """``isolate=`` of :meth:`System.run` as (value, instance names) for the native call."""
+    if isolate is True:
+        return "all", None
+    if isolate is False or isolate is None:
+        return None, None
+    if not isinstance(isolate, str):
+        return None, [str(n) for n in isolate]
+    return isolate, None
+
+
+def _frame(raw, as_frame: Optional[bool], summary):
+    """Recorded rows from the native layer (``time`` and ``data`` as little-endian f64
+    buffers) as a DataFrame indexed by time, or a :class:`Columns` dict without pandas."""
+    time = np.frombuffer(raw["time"], dtype="<f8")
+    arrays = {}
+    for name, kind, buf in zip(raw["columns"], raw["types"], raw["data"]):
+        values = np.frombuffer(buf, dtype="<f8")
+        dtype = _DTYPES.get(kind, np.float64)
+        arrays[name] = values if dtype is np.float64 else values.astype(dtype)
+    units = dict(zip(raw["columns"], raw["units"]))
+    if as_frame is None:
+        as_frame = _have_pandas()
+    if as_frame:
+        import pandas as pd
+
+        df = pd.DataFrame(arrays, index=pd.Index(time, name="time"))
+        df.attrs["units"] = units
+        df.attrs["summary"] = summary
+        df.attrs["warnings"] = list(raw["warnings"])
+        return df
+    out = Columns(time=time, **arrays)
+    out.units = units
+    out.summary = summary
+    return out

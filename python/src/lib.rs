@@ -33,6 +33,8 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
+mod session;
+
 create_exception!(
     shipsim,
     ShipsimError,
@@ -68,6 +70,14 @@ create_exception!(
     CheckpointError,
     ShipsimError,
     "A checkpoint file cannot be used."
+);
+
+create_exception!(
+    shipsim,
+    SessionError,
+    ShipsimError,
+    "A stepping session cannot do what was asked in its state: it is closed, it failed, it \
+     is at its end, or another thread is stepping it."
 );
 
 /// A shipsim error as the Python exception of its kind, with the same message as the CLI
@@ -678,25 +688,7 @@ impl PySystem {
         call_timeout: Option<f64>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let isolation = self.isolation(isolate, isolate_instances, call_timeout)?;
-        let mut sys = self.system.clone();
-        if let Some(v) = &variables {
-            for name in v {
-                self.check_name(name, true)?;
-            }
-            sys.output.variables = Some(v.clone());
-        }
-        sys.output.file = None;
-        sys.apply_stop_time(stop_time).map_err(|e| py_err(py, e))?;
-        if let Some(t) = start_time {
-            sys.start_time = t;
-        }
-        sys.apply_step_size(step_size).map_err(|e| py_err(py, e))?;
-        if let Some(a) = algorithm {
-            // The library's parser, as for system files and `shipsim run --algorithm`.
-            sys.algorithm = a.parse().map_err(|e: shipsim::system::UnknownAlgorithm| {
-                pyo3::exceptions::PyValueError::new_err(e.to_string())
-            })?;
-        }
+        let sys = self.configured(py, stop_time, variables, start_time, step_size, algorithm)?;
         let plan = sys.validate(&self.mds()).map_err(|e| py_err(py, e))?;
         let interrupt = Arc::new(AtomicBool::new(false));
         let logs = Logs::default();
@@ -723,48 +715,118 @@ impl PySystem {
         );
         logs.emit(py)?;
         let summary = result?.map_err(|e| py_err(py, e))?;
-        let out = PyDict::new(py);
+        let out = rows_dict(py, &plan, &sys, &self.mds(), &rec)?;
         out.set_item("warnings", plan.warnings.clone())?;
         out.set_item("summary", summary_dict(py, &summary)?)?;
-        let mds = self.mds();
-        let units: Vec<Option<String>> = plan
-            .outputs
-            .iter()
-            .map(|o| {
-                let md = mds[o.instance];
-                let prefix = format!("{}.", sys.instances[o.instance].name);
-                let name = o.header.strip_prefix(&prefix)?;
-                let v = md
-                    .model_variables
-                    .variables
-                    .iter()
-                    .find(|v| v.name == name)?;
-                md.real_unit(v).map(str::to_string)
-            })
-            .collect();
-        out.set_item("units", units)?;
-        out.set_item(
-            "columns",
-            rec.columns
-                .iter()
-                .map(|c| c.name.clone())
-                .collect::<Vec<_>>(),
-        )?;
-        out.set_item(
-            "types",
-            rec.columns
-                .iter()
-                .map(|c| c.var_type.name())
-                .collect::<Vec<_>>(),
-        )?;
-        out.set_item("time", le_bytes(py, &rec.time, f64::to_le_bytes)?)?;
-        let data = PyList::empty(py);
-        for col in &rec.data {
-            data.append(le_bytes(py, col, f64::to_le_bytes)?)?;
-        }
-        out.set_item("data", data)?;
         Ok(out)
     }
+
+    /// Starts a stepping session; see the Python `System.start`.
+    #[pyo3(signature = (stop_time=None, variables=None, start_time=None, step_size=None, algorithm=None, verbose=false, isolate=None, isolate_instances=None, call_timeout=None, journal=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn start(
+        &self,
+        py: Python<'_>,
+        stop_time: Option<f64>,
+        variables: Option<Vec<String>>,
+        start_time: Option<f64>,
+        step_size: Option<f64>,
+        algorithm: Option<String>,
+        verbose: bool,
+        isolate: Option<String>,
+        isolate_instances: Option<Vec<String>>,
+        call_timeout: Option<f64>,
+        journal: Option<PathBuf>,
+    ) -> PyResult<session::PySession> {
+        let isolation = self.isolation(isolate, isolate_instances, call_timeout)?;
+        let sys = self.configured(py, stop_time, variables, start_time, step_size, algorithm)?;
+        session::PySession::start(py, sys, self.fmus.clone(), verbose, isolation, journal)
+    }
+}
+
+impl PySystem {
+    /// A copy of the system with a run's options applied (`System.run` and `System.start`):
+    /// the recorded variables (checked, with close names), the times, step size and algorithm;
+    /// no output file.
+    fn configured(
+        &self,
+        py: Python<'_>,
+        stop_time: Option<f64>,
+        variables: Option<Vec<String>>,
+        start_time: Option<f64>,
+        step_size: Option<f64>,
+        algorithm: Option<String>,
+    ) -> PyResult<System> {
+        let mut sys = self.system.clone();
+        if let Some(v) = &variables {
+            for name in v {
+                self.check_name(name, true)?;
+            }
+            sys.output.variables = Some(v.clone());
+        }
+        sys.output.file = None;
+        sys.apply_stop_time(stop_time).map_err(|e| py_err(py, e))?;
+        if let Some(t) = start_time {
+            sys.start_time = t;
+        }
+        sys.apply_step_size(step_size).map_err(|e| py_err(py, e))?;
+        if let Some(a) = algorithm {
+            // The library's parser, as for system files and `shipsim run --algorithm`.
+            sys.algorithm = a.parse().map_err(|e: shipsim::system::UnknownAlgorithm| {
+                pyo3::exceptions::PyValueError::new_err(e.to_string())
+            })?;
+        }
+        Ok(sys)
+    }
+}
+
+/// The recorded rows as the Python layer reads them: `columns`, `types`, `units`, and `time`
+/// and `data` as bytearrays of little-endian f64.
+fn rows_dict<'py>(
+    py: Python<'py>,
+    plan: &shipsim::system::Plan,
+    sys: &System,
+    mds: &[&ModelDescription],
+    rec: &MemoryRecorder,
+) -> PyResult<Bound<'py, PyDict>> {
+    let out = PyDict::new(py);
+    let units: Vec<Option<String>> = plan
+        .outputs
+        .iter()
+        .map(|o| {
+            let md = mds[o.instance];
+            let prefix = format!("{}.", sys.instances[o.instance].name);
+            let name = o.header.strip_prefix(&prefix)?;
+            let v = md
+                .model_variables
+                .variables
+                .iter()
+                .find(|v| v.name == name)?;
+            md.real_unit(v).map(str::to_string)
+        })
+        .collect();
+    out.set_item("units", units)?;
+    out.set_item(
+        "columns",
+        rec.columns
+            .iter()
+            .map(|c| c.name.clone())
+            .collect::<Vec<_>>(),
+    )?;
+    out.set_item(
+        "types",
+        rec.columns
+            .iter()
+            .map(|c| c.var_type.name())
+            .collect::<Vec<_>>(),
+    )?;
+    out.set_item("time", le_bytes(py, &rec.time, f64::to_le_bytes)?)?;
+    let data = PyList::empty(py);
+    for col in &rec.data {
+        data.append(le_bytes(py, col, f64::to_le_bytes)?)?;
+    }
+    out.set_item("data", data)?;
+    Ok(out)
 }
 
 /// A bytearray of the values' little-endian bytes, written in place (numpy reads it without a
@@ -1152,6 +1214,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("VariableError", py.get_type::<VariableError>())?;
     m.add("SimulationError", py.get_type::<SimulationError>())?;
     m.add("CheckpointError", py.get_type::<CheckpointError>())?;
+    m.add("SessionError", py.get_type::<SessionError>())?;
     m.add_function(wrap_pyfunction!(inspect, m)?)?;
     m.add_function(wrap_pyfunction!(worker_run, m)?)?;
     m.add_function(wrap_pyfunction!(fmu_load_count, m)?)?;
@@ -1160,6 +1223,9 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PySystem>()?;
     m.add_class::<PyCampaign>()?;
     m.add_class::<PyCollector>()?;
+    m.add_class::<session::PySession>()?;
+    m.add_class::<session::PyCheckpoint>()?;
+    m.add_function(wrap_pyfunction!(session::replay, m)?)?;
     // Isolated FMU instances (`isolate=`, `isolate = true`, campaigns' foreign FMUs) run in
     // processes of this interpreter: `python -m shipsim._fmu_host fmu-host FMU`.
     let executable: Option<PathBuf> = py.import("sys")?.getattr("executable")?.extract().ok();

@@ -1,3 +1,4 @@
 pub mod campaign;
 pub mod isolate;
+pub mod replay;
 pub mod stats;

@@ -52,8 +52,10 @@ use checkpoint::Fingerprint;
 pub use checkpoint::{checkpoint_step, Checkpoint};
 use exchange::Exchange;
 pub use profile::{Profile, Sampling};
-pub use session::{Journal, JournalHeader, Replay, Session, SessionCheckpoint, SessionOptions, Set, State};
 pub use recorder::{write_real, ColumnInfo, CsvRecorder, MemoryRecorder, Recorder, Row, Sample};
+pub use session::{
+    Journal, JournalHeader, Replay, Session, SessionCheckpoint, SessionOptions, Set, State,
+};
 use stepping::{Recording, Stepper};
 pub use time_grid::TimeGrid;
 

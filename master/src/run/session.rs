@@ -25,7 +25,9 @@ use crate::error::{Error, Result};
 use crate::fmu::Fmu;
 use crate::instance::Stepping;
 use crate::model_description::{ModelDescription, VarType};
-use crate::system::{Algorithm as AlgorithmChoice, EventSpec, Plan, PlanEvent, System, TypedValue, Value, VarRef};
+use crate::system::{
+    Algorithm as AlgorithmChoice, EventSpec, Plan, PlanEvent, System, TypedValue, Value, VarRef,
+};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
@@ -195,6 +197,15 @@ impl Session {
     pub fn journal(&self) -> &Journal {
         &self.journal
     }
+    /// The journal as JSON Lines, ending with the session's step if it is not closed yet (a
+    /// replay of it reaches the session's time).
+    pub fn journal_text(&self) -> String {
+        let mut text = self.journal.to_text();
+        if self.state != State::Closed {
+            text.push_str(&journal::end_line(self.k));
+        }
+        text
+    }
     /// fmi2DoStep calls so far, and the wall time spent stepping.
     pub fn counts(&self) -> (u64, Duration) {
         (self.count.fmu_steps, self.wall)
@@ -202,9 +213,14 @@ impl Session {
     pub fn system(&self) -> &System {
         &self.system
     }
+    /// The FMUs, `fmus()[i]` for instance i.
+    pub fn fmus(&self) -> &[Arc<Fmu>] {
+        &self.fmus
+    }
 
-    /// The error of a session that cannot do `what` in its state, or None when it is open.
-    fn unusable(&self, what: &str) -> Option<Error> {
+    /// The error of a session that cannot do `what` in its state (closed, failed, at its
+    /// end), or None when it is open.
+    pub fn unusable(&self, what: &str) -> Option<Error> {
         let why = match &self.state {
             State::Open => return None,
             State::Ended(None) => format!(
@@ -272,7 +288,11 @@ impl Session {
 
     /// The step loop of a run from t_k to t_`until`, on the session's instances and values
     /// (moved into a [`Stepper`] and back, which allocates nothing).
-    fn run_stepper<A: super::algorithm::Algorithm>(&mut self, algorithm: &A, until: u64) -> Result<()> {
+    fn run_stepper<A: super::algorithm::Algorithm>(
+        &mut self,
+        algorithm: &A,
+        until: u64,
+    ) -> Result<()> {
         let mut stepper = Stepper {
             grid: self.grid,
             events: &self.plan.events,
@@ -305,11 +325,20 @@ impl Session {
         result
     }
 
-    /// The variable `instance.variable` of the system, with its instance index.
-    fn variable(&self, name: &str) -> Result<(usize, &crate::model_description::ScalarVariable)> {
+    /// The variable `instance.variable` of the system, with its instance index; an unknown
+    /// name is an error with close names.
+    pub fn variable(
+        &self,
+        name: &str,
+    ) -> Result<(usize, &crate::model_description::ScalarVariable)> {
         let r = VarRef::parse(name)
             .ok_or_else(|| Error::Other(format!("'{name}' is not instance.variable")))?;
-        let Some(i) = self.plan.instances.iter().position(|p| p.name == r.instance) else {
+        let Some(i) = self
+            .plan
+            .instances
+            .iter()
+            .position(|p| p.name == r.instance)
+        else {
             return Err(Error::Other(format!(
                 "'{name}': no instance '{}' in {}{}",
                 r.instance,
@@ -368,7 +397,7 @@ impl Session {
     }
 
     /// Reading needs live instances: open or at the end, not failed or closed.
-    fn unusable_to_read(&self) -> Option<Error> {
+    pub fn unusable_to_read(&self) -> Option<Error> {
         match self.state {
             State::Open | State::Ended(_) => None,
             _ => self.unusable("read"),
@@ -393,7 +422,9 @@ impl Session {
         };
         let mds: Vec<&ModelDescription> = self.fmus.iter().map(|f| &f.model_description).collect();
         let end = self.grid.at(self.plan.n_steps);
-        let event = self.system.resolve_event(&mds, &spec, self.plan.n_steps, end)?;
+        let event = self
+            .system
+            .resolve_event(&mds, &spec, self.plan.n_steps, end)?;
         self.journal.set(self.k, self.time(), &event)?;
         self.push(Set {
             step: self.k,
@@ -505,11 +536,7 @@ impl Session {
     pub fn replay(path: &Path, run: RunOptions) -> Result<Session> {
         let replay = Replay::read(path)?;
         let (system, fmus) = replay.system(&run)?;
-        let mut session = Session::start(
-            system,
-            fmus,
-            SessionOptions { run, journal: None },
-        )?;
+        let mut session = Session::start(system, fmus, SessionOptions { run, journal: None })?;
         let end = replay.end_step();
         let mds_len = session.fmus.len();
         debug_assert_eq!(mds_len, session.plan.instances.len());
@@ -517,7 +544,10 @@ impl Session {
             let spec = EventSpec {
                 time: session.grid.at(step),
                 target: VarRef::parse(&name).ok_or_else(|| {
-                    Error::Other(format!("{}: '{name}' is not instance.variable", path.display()))
+                    Error::Other(format!(
+                        "{}: '{name}' is not instance.variable",
+                        path.display()
+                    ))
                 })?,
                 value,
                 line: None,
@@ -537,8 +567,11 @@ impl Session {
 }
 
 impl Drop for Session {
+    /// A session dropped without [`Session::close`] ends its journal where it stood (so a
+    /// replay goes as far), and its instances free themselves as they drop.
     fn drop(&mut self) {
-        // The instances free themselves when dropped; the journal is flushed.
-        let _ = self.journal.flush();
+        if self.state != State::Closed {
+            let _ = self.journal.end(self.k);
+        }
     }
 }

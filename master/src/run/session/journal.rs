@@ -306,6 +306,11 @@ impl Journal {
     }
 }
 
+/// The end record of a session at base step `step`, as a line.
+pub fn end_line(step: u64) -> String {
+    json(&Record::End { step }) + "\n"
+}
+
 /// A journal read back for a replay.
 pub struct Replay {
     pub path: PathBuf,
@@ -317,10 +322,17 @@ impl Replay {
     /// Reads a journal file; a line that does not parse is an error naming the file and line.
     pub fn read(path: &Path) -> Result<Replay> {
         let bad = |line: usize, m: String| {
-            Error::system(path, Some(line), format!("not a shipsim session journal: {m}"))
+            Error::system(
+                path,
+                Some(line),
+                format!("not a shipsim session journal: {m}"),
+            )
         };
         let text = crate::limits::read_text(path, 1 << 30, "session journal")?;
-        let mut lines = text.lines().enumerate().filter(|(_, l)| !l.trim().is_empty());
+        let mut lines = text
+            .lines()
+            .enumerate()
+            .filter(|(_, l)| !l.trim().is_empty());
         let Some((_, first)) = lines.next() else {
             return Err(bad(1, "the file is empty".into()));
         };
@@ -406,9 +418,8 @@ impl Replay {
             }
         }
         for s in &h.values {
-            let r = VarRef::parse(&s.variable).ok_or_else(|| {
-                differs(format!("'{}' is not instance.variable", s.variable))
-            })?;
+            let r = VarRef::parse(&s.variable)
+                .ok_or_else(|| differs(format!("'{}' is not instance.variable", s.variable)))?;
             system.set_value(r, Value::from(s.value.clone()))?;
         }
         system.start_time = h.start_time;
@@ -423,11 +434,8 @@ impl Replay {
         system.output.variables = h.variables.clone();
         system.output.decimation = h.decimation;
         system.output.file = None;
-        let fmus = super::super::load_fmus_with(
-            &system,
-            &crate::fmu::Unpack::default(),
-            &run.isolation,
-        )?;
+        let fmus =
+            super::super::load_fmus_with(&system, &crate::fmu::Unpack::default(), &run.isolation)?;
         let names: Vec<&str> = system.instances.iter().map(|i| i.name.as_str()).collect();
         let journal: Vec<&str> = h.fmus.iter().map(|f| f.instance.as_str()).collect();
         if names != journal {
