@@ -279,3 +279,66 @@ fn misuse_is_a_clear_error() {
         assert!(e.to_string().contains("it is closed"), "{e}");
     }
 }
+
+/// The C test FMU integrating u = 1, failing (fmi2Error) or ending the run (fmi2Discard +
+/// fmi2Terminated) at the given steps.
+fn test_session(dir: &Path, fail_at: i32, terminate_at: i32) -> Session {
+    test_fmu(dir);
+    let path = write_system(
+        dir,
+        "fail.toml",
+        &format!(
+            "[simulation]\nstop_time = 1.0\nstep_size = 0.1\n[[instances]]\nname = \"m\"\n\
+             fmu = \"testfmu.fmu\"\nparameters = {{ u = 1.0, fail_at_step = {fail_at}, terminate_at_step = {terminate_at} }}\n"
+        ),
+    );
+    let sys = System::load(&path).unwrap();
+    let fmus = load_fmus(&sys).unwrap();
+    Session::start(sys, fmus, SessionOptions::default()).unwrap()
+}
+
+#[test]
+fn a_failed_session_says_so_and_closes() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut s = test_session(dir.path(), 3, -1);
+    s.step(2).unwrap();
+    let e = s.step(5).unwrap_err();
+    assert!(matches!(e, shipsim::Error::Fmi { .. }), "{e}");
+    assert!(
+        matches!(s.state(), State::Failed(m) if m.contains("fmi2DoStep")),
+        "{:?}",
+        s.state()
+    );
+    for e in [
+        s.step(1).unwrap_err(),
+        s.set("m.u", Value::Real(2.0)).unwrap_err(),
+        s.get("m.y").unwrap_err(),
+        s.checkpoint().unwrap_err(),
+    ] {
+        assert!(
+            e.to_string().contains("it failed: ") && e.to_string().contains("fmi2DoStep"),
+            "{e}"
+        );
+    }
+    s.close().unwrap();
+}
+
+#[test]
+fn an_fmu_that_ends_the_run_ends_the_session() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut s = test_session(dir.path(), -1, 4);
+    assert_eq!(s.step(100).unwrap(), 0.5);
+    assert!(
+        matches!(s.state(), State::Ended(Some(r)) if r.contains("instance 'm' ended the simulation")),
+        "{:?}",
+        s.state()
+    );
+    let e = s.step(1).unwrap_err().to_string();
+    assert!(
+        e.contains("cannot step: instance 'm' ended the simulation"),
+        "{e}"
+    );
+    // Readable still: the FMU's state at its end (it integrated four steps, y = 4 * 0.1 * u).
+    assert_eq!(s.get("m.y").unwrap(), TypedValue::Real(0.4));
+    s.close().unwrap();
+}

@@ -245,3 +245,35 @@ def test_ctrl_c_stops_a_long_advance_and_the_session_goes_on():
     p.send_signal(signal.SIGINT)
     out, err = p.communicate(timeout=60)
     assert out.splitlines() == ["interrupted True open", "stepped 0.15 True"], (out, err)
+
+
+def test_a_failed_session_raises_and_refuses_to_go_on(tmp_path):
+    from test_python_isolation import c_fmu
+
+    c_fmu(tmp_path, "testfmu", "testfmu.c")
+    system = tmp_path / "fail.toml"
+    system.write_text(
+        '[simulation]\nstop_time = 1.0\nstep_size = 0.1\n[[instances]]\nname = "m"\n'
+        'fmu = "testfmu.fmu"\nparameters = { u = 1.0, fail_at_step = 3 }\n'
+    )
+    session = shipsim.System.load(system).start()
+    session.step(2)
+    with pytest.raises(shipsim.SimulationError, match="fmi2DoStep") as e:
+        session.step(5)
+    assert e.value.instance == "m" and e.value.function == "fmi2DoStep"
+    assert session.state == "failed" and "fmi2DoStep" in session.reason
+    for call in (session.step, lambda: session.set("m.u", 2.0), lambda: session.get("m.y")):
+        with pytest.raises(shipsim.SessionError, match="it failed"):
+            call()
+    session.close()
+    assert session.state == "closed"
+
+
+def test_an_isolated_session_is_the_run():
+    s = shipsim.System.load(RRS)
+    ref = s.run(stop_time=20)
+    with s.start(stop_time=20, isolate=["autopilot", "gear"]) as session:
+        while session.state == "open":
+            session.set("autopilot.roll_mode", 1)  # its value already: the same bits
+            session.step(7)
+        same(session.rows(), ref)

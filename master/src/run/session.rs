@@ -227,7 +227,7 @@ impl Session {
                 "it is at the end of the run, t = {} s (start a session with a later stop_time to go further)",
                 self.time()
             ),
-            State::Ended(Some(r)) => format!("{r}"),
+            State::Ended(Some(r)) => r.clone(),
             State::Failed(m) => format!("it failed: {m}"),
             State::Closed => "it is closed".to_string(),
         };

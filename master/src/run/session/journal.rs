@@ -128,7 +128,7 @@ impl JournalHeader {
             .map(|(inst, f)| {
                 Ok(FmuId {
                     instance: inst.name.clone(),
-                    fmu: inst.fmu.clone(),
+                    fmu: inst.fmu.canonicalize().unwrap_or_else(|_| inst.fmu.clone()),
                     sha256: f.archive_hash()?.to_string(),
                 })
             })
@@ -398,7 +398,7 @@ impl Replay {
 
     /// The journal's system, checked against the hashes it gives, with its start values and
     /// options, and its FMUs loaded for `run`'s isolation.
-    pub fn system(&self, run: &super::RunOptions) -> Result<(System, Vec<Arc<Fmu>>)> {
+    pub fn system(&self, run: &crate::run::RunOptions) -> Result<(System, Vec<Arc<Fmu>>)> {
         let h = &self.header;
         let mut system = System::load(&h.system)?;
         let differs = |what: String| {
