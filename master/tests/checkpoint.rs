@@ -12,7 +12,7 @@ use shipsim::run::{
     checkpoint_step, load_fmus, resume_into, run_into, run_to_checkpoint, Checkpoint,
     CheckpointRequest, MemoryRecorder, RunOptions,
 };
-use shipsim::system::{Algorithm, EventSpec, Plan, System, Value, VarRef};
+use shipsim::system::{Algorithm, Plan, System, Value};
 use shipsim::Error;
 use std::path::Path;
 use std::process::Command;
@@ -38,29 +38,6 @@ fn system(name: &str, stop_time: f64, algorithm: Algorithm) -> System {
 fn plan(sys: &System, fmus: &[Arc<Fmu>]) -> Plan {
     let mds: Vec<_> = fmus.iter().map(|f| &f.model_description).collect();
     sys.validate(&mds).unwrap()
-}
-
-/// `sys` with one more event: `target` set to `value` at `time`.
-fn with_event(sys: &System, time: f64, target: &str, value: Value) -> System {
-    let mut s = sys.clone();
-    s.events.push(EventSpec {
-        time,
-        target: VarRef::parse(target).unwrap(),
-        value,
-        line: None,
-    });
-    s
-}
-
-/// Every recorded row as bit patterns: [time, column...].
-fn rows(m: &MemoryRecorder) -> Vec<Vec<u64>> {
-    (0..m.time.len())
-        .map(|i| {
-            std::iter::once(m.time[i].to_bits())
-                .chain(m.data.iter().map(|c| c[i].to_bits()))
-                .collect()
-        })
-        .collect()
 }
 
 fn full_run(plan: &Plan, fmus: &[Arc<Fmu>], opts: &RunOptions) -> Vec<Vec<u64>> {

@@ -11,7 +11,7 @@ use shipsim::fmu::Fmu;
 use shipsim::run::{
     load_fmus, run_into, MemoryRecorder, RunOptions, Session, SessionOptions, State,
 };
-use shipsim::system::{Algorithm, EventSpec, System, TypedValue, Value, VarRef};
+use shipsim::system::{Algorithm, System, TypedValue, Value, VarRef};
 use std::path::Path;
 use std::sync::Arc;
 
@@ -28,28 +28,6 @@ fn rrs(stop_time: f64, algorithm: Algorithm) -> (System, Vec<Arc<Fmu>>) {
     sys.output.file = None;
     let fmus = load_fmus(&sys).unwrap();
     (sys, fmus)
-}
-
-fn with_event(sys: &System, time: f64, target: &str, value: Value) -> System {
-    let mut s = sys.clone();
-    s.events.push(EventSpec {
-        time,
-        target: VarRef::parse(target).unwrap(),
-        value,
-        line: None,
-    });
-    s
-}
-
-/// Every recorded row as bit patterns: [time, column...].
-fn rows(m: &MemoryRecorder) -> Vec<Vec<u64>> {
-    (0..m.time.len())
-        .map(|i| {
-            std::iter::once(m.time[i].to_bits())
-                .chain(m.data.iter().map(|c| c[i].to_bits()))
-                .collect()
-        })
-        .collect()
 }
 
 fn run_rows(sys: &System, fmus: &[Arc<Fmu>]) -> Vec<Vec<u64>> {

@@ -205,6 +205,24 @@ fn run_detached<T: Send>(
     })
 }
 
+/// The options of a run from Python: its own interrupt flag (set by [`run_detached`] on
+/// Ctrl-C) and FMU messages collected for Python's `logging` ([`Logs`]).
+fn run_options(
+    verbose: bool,
+    isolation: shipsim::isolate::Isolation,
+) -> (RunOptions, Logs, Arc<AtomicBool>) {
+    let interrupt = Arc::new(AtomicBool::new(false));
+    let logs = Logs::default();
+    let opts = RunOptions {
+        verbose,
+        interrupt: Some(interrupt.clone()),
+        log_sink: Some(logs.sink(verbose)),
+        isolation,
+        ..Default::default()
+    };
+    (opts, logs, interrupt)
+}
+
 /// FMU log messages collected during a call, handed to Python's `logging` afterwards (the
 /// master's threads do not hold the GIL).
 #[derive(Clone, Default)]
@@ -690,15 +708,7 @@ impl PySystem {
         let isolation = self.isolation(isolate, isolate_instances, call_timeout)?;
         let sys = self.configured(py, stop_time, variables, start_time, step_size, algorithm)?;
         let plan = sys.validate(&self.mds()).map_err(|e| py_err(py, e))?;
-        let interrupt = Arc::new(AtomicBool::new(false));
-        let logs = Logs::default();
-        let opts = RunOptions {
-            verbose,
-            interrupt: Some(interrupt.clone()),
-            log_sink: Some(logs.sink(verbose)),
-            isolation,
-            ..Default::default()
-        };
+        let (opts, logs, interrupt) = run_options(verbose, isolation);
         let mut rec = MemoryRecorder::new();
         let fmus = &self.fmus;
         let result = run_detached(

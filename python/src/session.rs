@@ -8,12 +8,14 @@
 //! thread at a time: a second thread that calls it while it steps gets a [`SessionError`] at
 //! once, never a wait.
 
-use super::{obj, py_err, rows_dict, run_detached, to_value, Logs, SessionError, VariableError};
+use super::{
+    obj, py_err, rows_dict, run_detached, run_options, to_value, Logs, SessionError, VariableError,
+};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use shipsim::error::Error;
 use shipsim::isolate::Isolation;
-use shipsim::run::{RunOptions, Session, SessionCheckpoint, SessionOptions, State};
+use shipsim::run::{Session, SessionCheckpoint, SessionOptions, State};
 use shipsim::system::{System, TypedValue};
 use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
@@ -70,15 +72,7 @@ impl PySession {
         isolation: Isolation,
         journal: Option<PathBuf>,
     ) -> PyResult<PySession> {
-        let interrupt = Arc::new(AtomicBool::new(false));
-        let logs = Logs::default();
-        let run = RunOptions {
-            verbose,
-            interrupt: Some(interrupt.clone()),
-            log_sink: Some(logs.sink(verbose)),
-            isolation,
-            ..Default::default()
-        };
+        let (run, logs, interrupt) = run_options(verbose, isolation);
         let opts = SessionOptions { run, journal };
         let started = py.detach(|| Session::start(system, fmus, opts));
         logs.emit(py)?;
@@ -294,14 +288,7 @@ pub fn replay<'py>(
     journal: PathBuf,
     verbose: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let interrupt = Arc::new(AtomicBool::new(false));
-    let logs = Logs::default();
-    let run = RunOptions {
-        verbose,
-        interrupt: Some(interrupt.clone()),
-        log_sink: Some(logs.sink(verbose)),
-        ..Default::default()
-    };
+    let (run, logs, interrupt) = run_options(verbose, Default::default());
     let result = run_detached(
         py,
         &interrupt,

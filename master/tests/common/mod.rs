@@ -228,3 +228,31 @@ pub fn shipsim_in(dir: &Path, args: &[&str]) -> (bool, String) {
     let status = child.wait().unwrap();
     (status.success(), reader.join().unwrap())
 }
+
+/// `sys` with one more event: `target` set to `value` at `time`.
+pub fn with_event(
+    sys: &shipsim::system::System,
+    time: f64,
+    target: &str,
+    value: shipsim::system::Value,
+) -> shipsim::system::System {
+    let mut s = sys.clone();
+    s.events.push(shipsim::system::EventSpec {
+        time,
+        target: shipsim::system::VarRef::parse(target).unwrap(),
+        value,
+        line: None,
+    });
+    s
+}
+
+/// Every recorded row as bit patterns: [time, column...].
+pub fn rows(m: &shipsim::run::MemoryRecorder) -> Vec<Vec<u64>> {
+    (0..m.time.len())
+        .map(|i| {
+            std::iter::once(m.time[i].to_bits())
+                .chain(m.data.iter().map(|c| c[i].to_bits()))
+                .collect()
+        })
+        .collect()
+}
