@@ -9,7 +9,7 @@ mod common;
 use common::*;
 use shipsim::fmu::Fmu;
 use shipsim::run::{
-    load_fmus, run_into, MemoryRecorder, RunOptions, Session, SessionOptions, State,
+    load_fmus, run_into, Journaling, MemoryRecorder, RunOptions, Session, SessionOptions, State,
 };
 use shipsim::system::{Algorithm, System, TypedValue, Value, VarRef};
 use std::path::Path;
@@ -150,7 +150,7 @@ fn the_journal_replays_the_session_bit_for_bit() {
     sys.set_value(VarRef::parse("waves.seed").unwrap(), Value::Integer(7))
         .unwrap();
     let opts = SessionOptions {
-        journal: Some(journal.clone()),
+        journal: Journaling::File(journal.clone()),
         ..Default::default()
     };
     let mut s = Session::start(sys.clone(), fmus.clone(), opts).unwrap();
@@ -319,4 +319,50 @@ fn an_fmu_that_ends_the_run_ends_the_session() {
     // Readable still: the FMU's state at its end (it integrated four steps, y = 4 * 0.1 * u).
     assert_eq!(s.get("m.y").unwrap(), TypedValue::Real(0.4));
     s.close().unwrap();
+}
+
+#[test]
+fn get_reads_what_the_connections_see_between_the_steps_of_a_slower_instance() {
+    // filter and autopilot step every 2 base steps: at t = 0.05 s they are already at 0.1 s,
+    // but what they published (and what the rows hold) is the value of t = 0 s.
+    let (sys, fmus) = rrs(1.0, Algorithm::Jacobi);
+    let mut s = start(&sys, &fmus);
+    for _ in 0..6 {
+        s.step(1).unwrap();
+        let j = s.rows().time.len() - 1;
+        for name in [
+            "filter.roll_estimate",
+            "autopilot.rudder_command",
+            "ship.roll",
+        ] {
+            let recorded = s.rows().column(name).unwrap()[j];
+            let got = match s.get(name).unwrap() {
+                TypedValue::Real(x) => x,
+                v => panic!("{v:?}"),
+            };
+            let t = s.time();
+            assert_eq!(got.to_bits(), recorded.to_bits(), "{name} at t = {t}");
+        }
+    }
+    assert_ne!(
+        s.get("filter.roll_estimate").unwrap(),
+        TypedValue::Real(0.0)
+    );
+}
+
+#[test]
+fn a_session_without_a_journal_keeps_none() {
+    let (sys, fmus) = rrs(1.0, Algorithm::Jacobi);
+    let opts = SessionOptions {
+        journal: Journaling::Off,
+        ..Default::default()
+    };
+    let mut s = Session::start(sys, fmus, opts).unwrap();
+    for _ in 0..10 {
+        s.set("autopilot.lambda", Value::Real(3.0)).unwrap();
+        s.step(1).unwrap();
+    }
+    assert!(s.journal().records.is_empty());
+    let e = s.journal_text().unwrap_err().to_string();
+    assert!(e.contains("keeps no journal"), "{e}");
 }

@@ -109,7 +109,11 @@ class Session:
 
     # -- values -----------------------------------------------------------------------
     def get(self, name: str) -> Number:
-        """The current value of ``instance.variable`` (any variable), in the FMU's unit."""
+        """The current value of ``instance.variable`` (any variable), in the FMU's unit. A
+        connection source or recorded variable is read as published at :attr:`time` (what the
+        rows and the connections see); any other is read from its FMU, which, for an instance
+        with a ``step_multiple`` above 1 between its steps, is already at the end of its
+        current step."""
         return self._native.get(name)
 
     def set(self, name: str, value: Number) -> "Session":
@@ -147,7 +151,8 @@ class Session:
 
     def journal_text(self) -> str:
         """The journal so far (JSON Lines: a header naming the system, its FMUs and their
-        SHA-256, then one record per value set, checkpoint and restore)."""
+        SHA-256, then one record per value set, checkpoint and restore). A session started
+        with ``journal=False`` has none: :class:`SessionError`."""
         return self._native.journal_text()
 
     def save_journal(self, path: PathLike) -> None:

@@ -269,12 +269,15 @@ class System:
         verbose: bool = False,
         isolate=None,
         call_timeout: Optional[float] = None,
-        journal: Optional[PathLike] = None,
+        journal: Union[PathLike, bool, None] = None,
     ) -> "Session":
         """Starts a stepping session: the instances are made and initialized, and the session
-        is at the start time, ready to :meth:`Session.step`. The options are :meth:`run`'s;
-        ``journal`` names a file that the session writes every value set from outside to (JSON
-        Lines; :meth:`replay` replays it bit for bit). See :class:`Session`."""
+        is at the start time, ready to :meth:`Session.step`. The options are :meth:`run`'s.
+        ``journal``: every value set from outside is journaled (JSON Lines; :meth:`replay`
+        replays it bit for bit), in memory by default (:meth:`Session.journal_text`), also in
+        this file if a path is given, or not at all with ``False`` (a long training loop that
+        sets values every step: the journal would grow by about 100 bytes a value). See
+        :class:`Session`."""
         from ._session import Session
 
         if isinstance(variables, str):
@@ -290,7 +293,7 @@ class System:
             isolate=isolate,
             isolate_instances=names,
             call_timeout=call_timeout,
-            journal=None if journal is None else os.fspath(journal),
+            journal=journal if journal is None or isinstance(journal, bool) else os.fspath(journal),
         )
         for w in native.warnings:
             warnings.warn(w, ShipsimWarning, stacklevel=2)

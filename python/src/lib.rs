@@ -746,8 +746,17 @@ impl PySystem {
         isolate: Option<String>,
         isolate_instances: Option<Vec<String>>,
         call_timeout: Option<f64>,
-        journal: Option<PathBuf>,
+        journal: Option<Bound<'_, PyAny>>,
     ) -> PyResult<session::PySession> {
+        // None: in memory; False: none; a path: also written to that file.
+        let journal = match journal {
+            None => shipsim::run::Journaling::Memory,
+            Some(j) if j.is_instance_of::<pyo3::types::PyBool>() => match j.is_truthy()? {
+                false => shipsim::run::Journaling::Off,
+                true => shipsim::run::Journaling::Memory,
+            },
+            Some(j) => shipsim::run::Journaling::File(j.extract::<PathBuf>()?),
+        };
         let isolation = self.isolation(isolate, isolate_instances, call_timeout)?;
         let sys = self.configured(py, stop_time, variables, start_time, step_size, algorithm)?;
         session::PySession::start(py, sys, self.fmus.clone(), verbose, isolation, journal)

@@ -15,7 +15,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use shipsim::error::Error;
 use shipsim::isolate::Isolation;
-use shipsim::run::{Session, SessionCheckpoint, SessionOptions, State};
+use shipsim::run::{Journaling, Session, SessionCheckpoint, SessionOptions, State};
 use shipsim::system::{System, TypedValue};
 use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
@@ -70,7 +70,7 @@ impl PySession {
         fmus: Vec<Arc<shipsim::fmu::Fmu>>,
         verbose: bool,
         isolation: Isolation,
-        journal: Option<PathBuf>,
+        journal: Journaling,
     ) -> PyResult<PySession> {
         let (run, logs, interrupt) = run_options(verbose, isolation);
         let opts = SessionOptions { run, journal };
@@ -250,7 +250,8 @@ impl PySession {
     /// The journal so far, as JSON Lines.
     fn journal_text(&self) -> PyResult<String> {
         let this = self.lock("journal_text")?;
-        Ok(this.journal_text())
+        this.journal_text()
+            .map_err(|e| SessionError::new_err(e.to_string()))
     }
 }
 

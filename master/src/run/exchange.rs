@@ -349,6 +349,38 @@ impl Ports {
         Ok(())
     }
 
+    /// Where the observed variable `vr` of type `t` of this instance is kept in [`Values`]
+    /// (a connection source or a recorded output), or None if it is not observed.
+    pub fn observed_column(&self, t: VarType, vr: VR) -> Option<Column> {
+        let t = kind_of(t);
+        let o = match t {
+            VarType::Real => &self.real.observed,
+            VarType::Boolean => &self.boolean.observed,
+            VarType::String => &self.string,
+            _ => &self.integer.observed,
+        };
+        let g = o.at + o.vrs.iter().position(|v| *v == vr)?;
+        Some(match t {
+            VarType::Real => Column::Real(g),
+            VarType::Boolean => Column::Boolean(g),
+            VarType::String => Column::String(g),
+            _ => Column::Integer(g),
+        })
+    }
+
+    /// Gives the Real connection named `name` (the first term of its input) the map
+    /// gain*x + `offset`; false if the port has no such single-term connection.
+    pub fn set_real_offset(&mut self, name: &str, gain: f64, offset: f64) -> bool {
+        let p = &mut self.real;
+        match p.names[..p.links.len()].iter().position(|n| n == name) {
+            Some(i) if p.terms.is_empty() => {
+                p.links[i].map = Linear { gain, offset };
+                true
+            }
+            _ => false,
+        }
+    }
+
     /// The observed variables of exchange type `t` (Real, Integer, Boolean or String).
     fn observed_mut(&mut self, t: VarType) -> &mut Observed {
         match t {

@@ -54,7 +54,8 @@ use exchange::Exchange;
 pub use profile::{Profile, Sampling};
 pub use recorder::{write_real, ColumnInfo, CsvRecorder, MemoryRecorder, Recorder, Row, Sample};
 pub use session::{
-    Journal, JournalHeader, Replay, Session, SessionCheckpoint, SessionOptions, Set, State,
+    Journal, JournalHeader, Journaling, Replay, Session, SessionCheckpoint, SessionOptions, Set,
+    State,
 };
 use stepping::{Recording, Stepper};
 pub use time_grid::TimeGrid;

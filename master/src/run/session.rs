@@ -28,14 +28,14 @@ use crate::model_description::{ModelDescription, VarType};
 use crate::system::{
     Algorithm as AlgorithmChoice, EventSpec, Plan, PlanEvent, System, TypedValue, Value, VarRef,
 };
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
 use std::time::Duration;
 
 mod journal;
 
-pub use journal::{Journal, JournalHeader, Replay};
+pub use journal::{Journal, JournalHeader, Journaling, Replay};
 
 /// A value set from outside: at base step `step`, the event it became.
 #[derive(Debug, Clone)]
@@ -112,8 +112,8 @@ pub struct Session {
 #[derive(Default)]
 pub struct SessionOptions {
     pub run: RunOptions,
-    /// Write the journal to this file as the session goes (it is kept in memory too).
-    pub journal: Option<PathBuf>,
+    /// Where the journal is kept: in memory (the default), also in a file, or not at all.
+    pub journal: Journaling,
 }
 
 impl Session {
@@ -124,7 +124,7 @@ impl Session {
         let mds: Vec<&ModelDescription> = fmus.iter().map(|f| &f.model_description).collect();
         let plan = system.validate(&mds)?;
         let header = JournalHeader::of(&system, &fmus)?;
-        let journal = Journal::new(header, opts.journal.as_deref())?;
+        let journal = Journal::new(header, &opts.journal)?;
         let Exchange {
             ports,
             mut values,
@@ -172,6 +172,65 @@ impl Session {
         })
     }
 
+    /// A session of `system` continued from a master checkpoint of the same system (else an
+    /// error naming the difference, [`Checkpoint::check`]): fresh instances are initialized,
+    /// then every state and the exchange's values are restored, and the session is at the
+    /// checkpoint's time with its row recorded. For the loop analysis's forks, which keep no
+    /// journal: the checkpoint's past is in no journal, so the journal is off.
+    pub(crate) fn resume(
+        system: System,
+        fmus: Vec<Arc<Fmu>>,
+        cp: &Checkpoint,
+        run: RunOptions,
+    ) -> Result<Session> {
+        let opts = SessionOptions {
+            run,
+            journal: Journaling::Off,
+        };
+        let mut s = Session::start(system, fmus, opts)?;
+        for (pi, fmu) in s.plan.instances.iter().zip(&s.fmus) {
+            fmu.require_state_support(&pi.name)?;
+        }
+        cp.check(&Fingerprint::of(&s.plan, &s.fmus)?)?;
+        cp.restore(&mut s.slots, &mut s.values)?;
+        s.k = cp.step;
+        s.rows = MemoryRecorder::new();
+        {
+            let mut rec =
+                start_recording(&s.plan, &mut s.rows, &s.columns, cp.step, s.plan.n_steps)?;
+            rec.row(cp.time, &s.values)?;
+        }
+        s.row_count = 1;
+        Ok(s)
+    }
+
+    /// Sets the offset of Real connection `connection` (an index into the plan's
+    /// connections) from the next step on: its destination then gets gain*source + `offset`.
+    /// For the loop analysis, which injects a signal on a connection ([`crate::analysis`]);
+    /// not journaled, so not part of the public session.
+    pub(crate) fn set_connection_offset(&mut self, connection: usize, offset: f64) -> Result<()> {
+        let c = &self.plan.connections[connection];
+        let ok = self.slots[c.to_instance]
+            .ports
+            .set_real_offset(&c.name, c.gain, offset);
+        match ok {
+            true => Ok(()),
+            false => Err(Error::Other(format!(
+                "connection {}: not a Real connection of a single term",
+                c.name
+            ))),
+        }
+    }
+
+    /// Adds events the caller resolved and checked (the loop analysis's injected input),
+    /// each after the events of its step. Not journaled.
+    pub(crate) fn add_events(&mut self, events: impl IntoIterator<Item = PlanEvent>) {
+        for e in events {
+            let at = self.plan.events.partition_point(|x| x.step <= e.step);
+            self.plan.events.insert(at, e);
+        }
+    }
+
     /// The validation's warnings.
     pub fn warnings(&self) -> &[String] {
         &self.plan.warnings
@@ -198,13 +257,18 @@ impl Session {
         &self.journal
     }
     /// The journal as JSON Lines, ending with the session's step if it is not closed yet (a
-    /// replay of it reaches the session's time).
-    pub fn journal_text(&self) -> String {
+    /// replay of it reaches the session's time); an error if the session keeps none.
+    pub fn journal_text(&self) -> Result<String> {
+        if self.journal.is_off() {
+            return Err(Error::Other(
+                "the session keeps no journal (it was started with the journal off)".into(),
+            ));
+        }
         let mut text = self.journal.to_text();
         if self.state != State::Closed {
             text.push_str(&journal::end_line(self.k));
         }
-        text
+        Ok(text)
     }
     /// fmi2DoStep calls so far, and the wall time spent stepping.
     pub fn counts(&self) -> (u64, Duration) {
@@ -365,14 +429,19 @@ impl Session {
         }
     }
 
-    /// The current value of any variable of any instance (fmi2GetXXX at t_k), in the FMU's
-    /// unit. Reading changes nothing.
+    /// The current value of any variable of any instance, in the FMU's unit: a connection
+    /// source or recorded output as published at t_k (what the rows and the connections see),
+    /// any other variable by fmi2GetXXX (for an instance with a step multiple above 1, between
+    /// its steps, that is its value at the end of its current step). Reading changes nothing.
     pub fn get(&mut self, name: &str) -> Result<TypedValue> {
         if let Some(e) = self.unusable_to_read() {
             return Err(e);
         }
         let (i, sv) = self.variable(name)?;
         let (vr, t) = (sv.value_reference, sv.var_type());
+        if let Some(v) = self.published(i, vr, t) {
+            return Ok(v);
+        }
         let inst = &mut self.slots[i].inst;
         Ok(match t {
             Some(VarType::Real) => {
@@ -393,6 +462,20 @@ impl Session {
             Some(VarType::String) | None => {
                 TypedValue::String(inst.get_string(&[vr])?.pop().unwrap_or_default())
             }
+        })
+    }
+
+    /// An observed variable's value (a connection source or a recorded output) as published
+    /// at t_k: what the rows and the connections see. An instance with a step multiple m > 1
+    /// is, between its steps, already at the end of its current step (under Jacobi its outputs
+    /// are published when that step ends), so its FMU would answer with a later value.
+    fn published(&self, i: usize, vr: crate::fmu::VR, t: Option<VarType>) -> Option<TypedValue> {
+        let v = &self.values;
+        Some(match self.slots[i].ports.observed_column(t?, vr)? {
+            Column::Real(g) => TypedValue::Real(v.real[g]),
+            Column::Integer(g) => TypedValue::Integer(v.integer[g]),
+            Column::Boolean(g) => TypedValue::Boolean(v.boolean[g] != 0),
+            Column::String(g) => TypedValue::String(v.string[g].clone()),
         })
     }
 
@@ -536,7 +619,11 @@ impl Session {
     pub fn replay(path: &Path, run: RunOptions) -> Result<Session> {
         let replay = Replay::read(path)?;
         let (system, fmus) = replay.system(&run)?;
-        let mut session = Session::start(system, fmus, SessionOptions { run, journal: None })?;
+        let opts = SessionOptions {
+            run,
+            journal: Journaling::Off,
+        };
+        let mut session = Session::start(system, fmus, opts)?;
         let end = replay.end_step();
         let mds_len = session.fmus.len();
         debug_assert_eq!(mds_len, session.plan.instances.len());

@@ -198,11 +198,25 @@ impl Record {
     }
 }
 
+/// Where a session keeps its journal.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub enum Journaling {
+    /// In memory (`journal_text`, `save`), the default.
+    #[default]
+    Memory,
+    /// In memory and streamed to this file as the session goes.
+    File(PathBuf),
+    /// Not at all: nothing to replay, and memory stays flat however many values are set (a
+    /// reinforcement-learning loop of millions of steps).
+    Off,
+}
+
 /// A session's journal: in memory, and streamed to a file when one is given.
 pub struct Journal {
     pub header: JournalHeader,
     pub records: Vec<Record>,
     file: Option<(PathBuf, BufWriter<std::fs::File>)>,
+    off: bool,
 }
 
 fn json<T: Serialize>(v: &T) -> String {
@@ -210,11 +224,11 @@ fn json<T: Serialize>(v: &T) -> String {
 }
 
 impl Journal {
-    /// A journal with its header, written to `path` if given (created, or truncated).
-    pub fn new(header: JournalHeader, path: Option<&Path>) -> Result<Journal> {
-        let file = match path {
-            None => None,
-            Some(p) => {
+    /// A journal with its header, written to a file if `mode` says so (created, or truncated).
+    pub fn new(header: JournalHeader, mode: &Journaling) -> Result<Journal> {
+        let file = match mode {
+            Journaling::Memory | Journaling::Off => None,
+            Journaling::File(p) => {
                 let p = crate::output_path::writable(p)?;
                 if let Some(dir) = p.parent().filter(|d| !d.as_os_str().is_empty()) {
                     std::fs::create_dir_all(dir).map_err(|e| {
@@ -231,10 +245,16 @@ impl Journal {
             header,
             records: Vec::new(),
             file,
+            off: *mode == Journaling::Off,
         };
         let line = json(&j.header);
         j.write_line(&line)?;
         Ok(j)
+    }
+
+    /// The session keeps no journal ([`Journaling::Off`]).
+    pub fn is_off(&self) -> bool {
+        self.off
     }
 
     /// The file the journal is written to.
@@ -251,6 +271,9 @@ impl Journal {
     }
 
     fn add(&mut self, r: Record, flush: bool) -> Result<()> {
+        if self.off {
+            return Ok(());
+        }
         let line = json(&r);
         self.records.push(r);
         self.write_line(&line)?;
