@@ -1,0 +1,725 @@
+"""Independent reference calculations for the loop analysis of the master (issue 35).
+
+Written from the models' and FMUs' sources and the system files, in numpy only, without the
+tool: what `shipsim loop` must measure. Docstring numbers are filled in below (FINDINGS).
+"""
+from __future__ import annotations
+
+import math
+import pathlib
+import tomllib
+import xml.etree.ElementTree as ET
+import zipfile
+from dataclasses import dataclass, field
+
+import numpy as np
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+FMU_DIR = ROOT / "target" / "fmu"
+EXAMPLE_FMU_DIR = ROOT / "target" / "fmu-examples"
+HEADING_SYSTEM = ROOT / "systems" / "autopilot_current.toml"
+TRACK_SYSTEM = ROOT / "systems" / "autopilot_track_offset.toml"
+
+DEG = math.pi / 180.0
+
+
+# --------------------------------------------------------------------------------------------
+# Generic pieces: the measurement of the spec, margins, small linear algebra
+# --------------------------------------------------------------------------------------------
+
+def snap(omega: float, periods: float, h: float) -> tuple[float, int]:
+    """The spec's snapping: N = round(2 pi P / (omega h)), omega = 2 pi P / (N h)."""
+    n = int(round(2.0 * math.pi * periods / (omega * h)))
+    n = max(n, 1)
+    return 2.0 * math.pi * periods / (n * h), n
+
+
+def phasor(x: np.ndarray, t_rel: np.ndarray, omega: float) -> complex:
+    """X = (2/N) sum x_k exp(-j omega (t_k - T))."""
+    return complex(2.0 / len(x) * np.sum(x * np.exp(-1j * omega * t_rel)))
+
+
+def expm(a: np.ndarray) -> np.ndarray:
+    """Matrix exponential by scaling and squaring of a Taylor series (small, well-scaled
+    matrices only; no scipy in the venv)."""
+    a = np.asarray(a, dtype=float)
+    norm = np.max(np.sum(np.abs(a), axis=1)) if a.size else 0.0
+    s = max(0, int(math.ceil(math.log2(norm / 0.25))) if norm > 0.25 else 0)
+    x = a / 2.0 ** s
+    result = np.eye(len(a))
+    term = np.eye(len(a))
+    for k in range(1, 30):
+        term = term @ x / k
+        result = result + term
+        if np.max(np.abs(term)) < 1e-18:
+            break
+    for _ in range(s):
+        result = result @ result
+    return result
+
+
+def zoh(a: np.ndarray, b: np.ndarray, h: float) -> tuple[np.ndarray, np.ndarray]:
+    """Exact zero-order-hold discretisation (Van Loan block exponential)."""
+    n, m = b.shape
+    blk = np.zeros((n + m, n + m))
+    blk[:n, :n] = a
+    blk[:n, n:] = b
+    e = expm(blk * h)
+    return e[:n, :n], e[:n, n:]
+
+
+def rk4_matrices(a: np.ndarray, b: np.ndarray, h: float, h_max: float) -> tuple[np.ndarray, np.ndarray]:
+    """One communication step of `models::integrate::rk4_advance` on x' = A x + B u with u held:
+    n = ceil(h/h_max (1 - 1e-12)) classical RK4 sub-steps of h/n. For a linear system each
+    sub-step is x+ = (I + Ah + (Ah)^2/2 + (Ah)^3/6 + (Ah)^4/24) x
+    + (h + A h^2/2 + A^2 h^3/6 + A^3 h^4/24) B u."""
+    n = max(1, int(math.ceil(h / h_max * (1.0 - 1e-12))))
+    hs = h / n
+    eye = np.eye(len(a))
+    ah = a * hs
+    phi1 = eye + ah + ah @ ah / 2 + ah @ ah @ ah / 6 + ah @ ah @ ah @ ah / 24
+    gam1 = (eye * hs + ah * hs / 2 + ah @ ah * hs / 6 + ah @ ah @ ah * hs / 24) @ b
+    phi, gam = np.eye(len(a)), np.zeros_like(b)
+    for _ in range(n):
+        phi, gam = phi1 @ phi, phi1 @ gam + gam1
+    return phi, gam
+
+
+def ss_freq(a, b, c, d, z):
+    """c (zI - a)^-1 b + d at complex z (scalar input and output)."""
+    z = np.atleast_1d(z)
+    out = np.empty(len(z), dtype=complex)
+    n = len(a)
+    for i, zi in enumerate(z):
+        out[i] = (c @ np.linalg.solve(zi * np.eye(n) - a, b)).item() + d
+    return out
+
+
+def unwrap_deg(phase_rad: np.ndarray) -> np.ndarray:
+    return np.degrees(np.unwrap(phase_rad))
+
+
+@dataclass
+class Margins:
+    gain_margin_db: float
+    gain_margin_rad_s: float
+    phase_margin_deg: float
+    crossover_rad_s: float
+    delay_margin_s: float
+    sensitivity_peak: float
+    sensitivity_peak_rad_s: float
+
+    def as_dict(self):
+        return dict(self.__dict__)
+
+
+def _bisect(f, lo, hi, iters=100):
+    flo = f(lo)
+    for _ in range(iters):
+        mid = math.sqrt(lo * hi)
+        if (f(mid) > 0) == (flo > 0):
+            lo = mid
+        else:
+            hi = mid
+        if hi / lo - 1 < 1e-13:
+            break
+    return math.sqrt(lo * hi)
+
+
+def margins(loop, w_lo: float, w_hi: float, n: int = 4000) -> Margins:
+    """Margins of a loop given as a vectorised function omega -> L(j omega): first gain crossover
+    (|L| = 1), first phase crossover (unwrapped phase = -180 deg), both refined by bisection;
+    delay margin PM[rad]/omega_c; the peak of |1/(1 + L)| over the scan, refined by a golden
+    section search."""
+    ws = w_lo * (w_hi / w_lo) ** (np.arange(n + 1) / n)
+    lv = loop(ws)
+    ph = np.unwrap(np.angle(lv))
+
+    def phase_at(w, near):
+        p = np.angle(loop(np.array([w]))[0])
+        return p + 2 * math.pi * round((near - p) / (2 * math.pi))
+
+    mag = np.log(np.abs(lv))
+    i_gc = np.nonzero(np.diff(np.sign(mag)))[0]
+    i_pc = np.nonzero(np.diff(np.sign(ph + math.pi)))[0]
+    if len(i_gc) == 0 or len(i_pc) == 0:
+        raise ValueError("no crossover in the scan")
+    i, j = i_gc[0], i_pc[0]
+    wc = _bisect(lambda w: math.log(abs(loop(np.array([w]))[0])), ws[i], ws[i + 1])
+    wp = _bisect(lambda w: phase_at(w, ph[j]) + math.pi, ws[j], ws[j + 1])
+    pm = 180.0 + math.degrees(phase_at(wc, ph[i]))
+    gm = -20.0 * math.log10(abs(loop(np.array([wp]))[0]))
+    s = np.abs(1.0 / (1.0 + lv))
+    k = int(np.argmax(s))
+    a, b = ws[max(k - 1, 0)], ws[min(k + 1, n)]
+    f = lambda w: -abs(1.0 / (1.0 + loop(np.array([w]))[0]))
+    g = (math.sqrt(5) - 1) / 2
+    for _ in range(80):
+        c, d = b - g * (b - a), a + g * (b - a)
+        if f(c) < f(d):
+            b = d
+        else:
+            a = c
+    wm = 0.5 * (a + b)
+    return Margins(gm, wp, pm, wc, math.radians(pm) / wc, -f(wm), wm)
+
+
+# --------------------------------------------------------------------------------------------
+# Parameters: the FMUs' start values (modelDescription.xml), the system file, the --set values
+# --------------------------------------------------------------------------------------------
+
+def fmu_start_values(fmu: pathlib.Path) -> dict:
+    """Start values of every Real, Integer and Boolean variable of an FMU's modelDescription.xml."""
+    with zipfile.ZipFile(fmu) as z:
+        root = ET.fromstring(z.read("modelDescription.xml"))
+    values = {}
+    for sv in root.iter("ScalarVariable"):
+        for child in sv:
+            start = child.get("start")
+            if start is None:
+                continue
+            if child.tag == "Real":
+                values[sv.get("name")] = float(start)
+            elif child.tag == "Integer":
+                values[sv.get("name")] = int(start)
+            elif child.tag == "Boolean":
+                values[sv.get("name")] = start == "true"
+    return values
+
+
+def system_instances(path: pathlib.Path, overrides: dict | None = None) -> tuple[dict, dict]:
+    """(simulation section, {instance: {variable: value}}) of a native system file: the FMU's start
+    values, then the file's parameters, then `overrides` ({"inst.var": value})."""
+    spec = tomllib.loads(path.read_text())
+    inst = {}
+    for i in spec["instances"]:
+        fmu = (path.parent / i["fmu"]).resolve()
+        values = fmu_start_values(fmu)
+        values.update(i.get("parameters", {}))
+        inst[i["name"]] = values
+    for key, v in (overrides or {}).items():
+        name, var = key.split(".", 1)
+        inst[name][var] = v
+    return spec["simulation"], inst
+
+
+# --------------------------------------------------------------------------------------------
+# (a) FirstOrderLag through a zero-order hold
+# --------------------------------------------------------------------------------------------
+
+def first_order_lag_response(omega, h: float, gain: float = 1.0, time_constant: float = 2.0):
+    """Y/D of the FirstOrderLag FMU (examples/first_order_lag: y+ = a y + (1 - a) K u, a =
+    exp(-h/T), u held over the step), with d_k the input over [t_k, t_k+1) and y_k the output
+    published at t_k: G = (1 - a) K / (z - a), z = exp(j omega h)."""
+    a = math.exp(-h / time_constant)
+    z = np.exp(1j * np.asarray(omega, dtype=float) * h)
+    return (1.0 - a) * gain / (z - a)
+
+
+# --------------------------------------------------------------------------------------------
+# (b) The rate limiter's describing function
+# --------------------------------------------------------------------------------------------
+
+def rate_limiter_df(ratio: float) -> complex:
+    """Describing function N = Y1/a of the ideal rate limiter (y' = sat(large gain (x - y), +-R),
+    the servo time constant -> 0) for x = a sin(theta), theta = b t, as a function of
+    ratio = a b / R (the input's largest rate over the limit). Y1 is the fundamental of the
+    steady-state output, as a complex amplitude relative to sin(theta) (angle = phase lead).
+
+    Steady state (half-wave antisymmetric, rho = 1/ratio):
+    * ratio <= 1: y = x, N = 1.
+    * rho <= 1/sqrt(1 + pi^2/4) (ratio >= 1.862): a triangle wave of slope +-R and amplitude
+      R pi/(2b) that turns where it meets the falling input, sin(theta*) = pi rho/2: lag
+      pi/2 - asin(pi rho/2), |N| = 8/pi^2 * (pi rho/2) = 4 rho/pi.
+    * otherwise a trapezoid-like wave: the output tracks the input from theta1 (where the rising
+      ramp meets it) until the input falls faster than R at theta2 = pi - acos(rho), then ramps
+      down at -R until it meets -x at theta1 + pi. theta1 solves
+      sqrt(1 - rho^2) - rho (theta1 + acos rho) + sin theta1 = 0 on [acos rho, theta2].
+    The fundamental is computed in closed form piece by piece (tracking: sin; ramps: linear)."""
+    if ratio <= 1.0:
+        return 1.0 + 0j
+    rho = 1.0 / ratio
+    if rho * math.sqrt(1.0 + math.pi ** 2 / 4.0) <= 1.0:
+        # triangle: peak A = pi rho/2 (in units of a) at theta* = pi - asin(A)
+        amp = math.pi * rho / 2.0
+        lag = math.pi / 2.0 - math.asin(amp)
+        return 8.0 / math.pi ** 2 * amp * complex(math.cos(-lag), math.sin(-lag))
+    th2 = math.pi - math.acos(rho)
+    g = lambda th: math.sqrt(1.0 - rho * rho) - rho * (th + math.acos(rho)) + math.sin(th)
+    lo, hi = math.acos(rho), th2
+    if g(lo) * g(hi) > 0:
+        raise ValueError("no meeting point")
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        if (g(mid) > 0) == (g(lo) > 0):
+            lo = mid
+        else:
+            hi = mid
+    th1 = 0.5 * (lo + hi)
+    return _fundamental_piecewise(th1, th2, rho)
+
+
+def _fundamental_piecewise(th1: float, th2: float, rho: float) -> complex:
+    """Fundamental (relative to sin) of the half-wave antisymmetric wave: y = sin(theta) on
+    [th1, th2], y = sin(th2) - rho (theta - th2) on [th2, th1 + pi]; the other half is -y."""
+    # b1 = (1/pi) int_0^2pi y sin, a1 = (1/pi) int y cos = (2/pi) over one half-wave
+    def int_sin_sin(p, q):
+        return 0.5 * (q - p) - 0.25 * (math.sin(2 * q) - math.sin(2 * p))
+
+    def int_sin_cos(p, q):
+        return 0.5 * (math.sin(q) ** 2 - math.sin(p) ** 2)
+
+    def int_lin(c0, c1, p, q, trig):
+        # int (c0 + c1 theta) trig(theta) d theta
+        if trig == "sin":
+            f = lambda t: -c0 * math.cos(t) + c1 * (math.sin(t) - t * math.cos(t))
+        else:
+            f = lambda t: c0 * math.sin(t) + c1 * (math.cos(t) + t * math.sin(t))
+        return f(q) - f(p)
+
+    y2 = math.sin(th2)
+    c0, c1 = y2 + rho * th2, -rho
+    b1 = (2 / math.pi) * (int_sin_sin(th1, th2) + int_lin(c0, c1, th2, th1 + math.pi, "sin"))
+    a1 = (2 / math.pi) * (int_sin_cos(th1, th2) + int_lin(c0, c1, th2, th1 + math.pi, "cos"))
+    # y1 = b1 sin + a1 cos = Im{(b1 + j a1) e^{j theta}}
+    return complex(b1, a1)
+
+
+def steering_gear_step(angle, command, h, tau, rate_max, angle_max, rate_limited=True):
+    """One exact step of `models::steering_gear::SteeringGear::step_first_order` (vectorised
+    over numpy arrays): command clamped to +-angle_max; a ramp at +-rate_max while
+    |e| > rate_max tau, then the exponential approach; the result clamped."""
+    c = np.clip(command, -angle_max, angle_max)
+    e = c - angle
+    remaining = np.full_like(angle, h)
+    if rate_limited:
+        band = rate_max * tau
+        ramping = np.abs(e) > band
+        t_ramp = np.where(ramping, (np.abs(e) - band) / rate_max, 0.0)
+        t = np.minimum(t_ramp, remaining)
+        angle = angle + np.sign(e) * rate_max * t
+        remaining = remaining - t
+        angle = np.where(ramping & (remaining > 0), c - np.sign(e) * band, angle)
+    decay = np.exp(-remaining / tau)
+    angle = np.where(remaining > 0, c - (c - angle) * decay, angle)
+    return np.clip(angle, -angle_max, angle_max)
+
+
+def steering_gear_df_measured(omega: float, amplitudes, h: float, periods: float, settle: float,
+                              tau: float, rate_max: float, angle_max: float):
+    """What the tool measures for a describing function of the SteeringGear FMU alone (input
+    gear.rudder_command unconnected, u0 = 0, output gear.rudder_angle): d_k = A sin(omega t_k)
+    held over [t_k, t_k+1), the gear integrated exactly, phasors over N steps after the settling
+    time. Returns (snapped omega, N, complex Y/D per amplitude)."""
+    w, n = snap(omega, periods, h)
+    amps = np.asarray(amplitudes, dtype=float)
+    k0 = int(math.ceil(settle / h - 1e-9))
+    angle = np.zeros_like(amps)
+    ys = np.zeros((k0 + n, len(amps)))
+    for k in range(k0 + n):
+        ys[k] = angle  # published at t_k
+        d = amps * math.sin(w * k * h)
+        angle = steering_gear_step(angle, d, h, tau, rate_max, angle_max)
+    t = np.arange(k0, k0 + n) * h
+    e = np.exp(-1j * w * t)
+    y = 2.0 / n * (ys[k0:].T @ e)
+    d = 2.0 / n * (amps[:, None] * np.sin(w * t)[None, :]) @ e
+    return w, n, y / d
+
+
+# --------------------------------------------------------------------------------------------
+# (c) The DDG-51 heading loop of systems/autopilot_current.toml
+# --------------------------------------------------------------------------------------------
+
+def tustin(num, den, step):
+    """`models::controllers::loop_shaped::TustinController::new`: controllable canonical form of
+    num/den (normalised by den[0]), Tustin at `step`: M = (I - A T/2)^-1, Ad = M (I + A T/2),
+    Bd = M B T, Cd = C M, Dd = D + C Bd / 2."""
+    n = len(den) - 1
+    a0 = den[0]
+    den = [x / a0 for x in den]
+    num = [0.0] * (n + 1 - len(num)) + [x / a0 for x in num]
+    d = num[0]
+    b = [num[k + 1] - d * den[k + 1] for k in range(n)]  # s^(n-1) ... s^0
+    a = np.zeros((n, n))
+    for i in range(n - 1):
+        a[i, i + 1] = 1.0
+    for j in range(n):
+        a[n - 1, j] = -den[n - j]
+    bv = np.zeros((n, 1))
+    bv[n - 1, 0] = 1.0
+    c = np.array([[b[n - 1 - j] for j in range(n)]])
+    eye = np.eye(n)
+    m = np.linalg.inv(eye - a * step / 2)
+    ad = m @ (eye + a * step / 2)
+    bd = m @ bv * step
+    cd = c @ m
+    dd = d + 0.5 * (c @ bd).item()
+    return ad, bd, cd, dd
+
+
+def poly_mul(p, q):
+    return list(np.convolve(p, q))
+
+
+def polyval(p, s):
+    return np.polyval(np.asarray(p, dtype=float), s)
+
+
+@dataclass
+class ShipLoop:
+    """A DDG-51 loop of a system file as the FMUs integrate it: NomotoShip (model 1) ->
+    Sensors (one channel, sample-and-hold) -> controller (HeadingAutopilot or TrackController,
+    Tustin) -> SteeringGear (first order, no rate limit) -> NomotoShip, under the Jacobi master.
+    kind "heading": the controller sees the heading psi; "track": the cross-track position y
+    (the controller's input is (y_ref - y)/L). Parameters: the FMUs' start values, the system
+    file, then the overrides."""
+    kind: str
+    h: float
+    t0: float
+    length: float        # ship (NomotoShip) length and speed
+    speed: float
+    k_prime: float
+    t_prime: float
+    max_substep: float
+    gear_tau: float      # SteeringGear time_constant [s]
+    gear_angle_max: float
+    ctl: dict            # the controller's design parameters (FMU variable names)
+    sensor_interval: float
+    overrides: dict = field(default_factory=dict)
+
+    CONTROLLER = {"heading": "ap", "track": "ctl"}
+
+    @classmethod
+    def from_system(cls, path: pathlib.Path = HEADING_SYSTEM, overrides: dict | None = None,
+                    kind: str | None = None):
+        kind = kind or ("track" if "track" in path.name else "heading")
+        sim, inst = system_instances(path, overrides)
+        ship, gear, sensors = inst["ship"], inst["gear"], inst["sensors"]
+        ctl = inst[cls.CONTROLLER[kind]]
+        assert sim.get("algorithm", "jacobi").lower() == "jacobi"
+        assert ship["model"] == 1 and not gear["rate_limited"] and gear.get("servo_order", 1) == 1
+        assert ctl.get("preset", 0) == 0 and ctl["reference_mode"] == 0
+        assert ship.get("initial_heading", 0.0) == 0.0 and ship.get("initial_yaw_rate", 0.0) == 0.0
+        channel = "heading" if kind == "heading" else "cross_track"
+        assert sensors["noise_scale"] == 0.0 or sensors[f"{channel}_sigma"] == 0.0, \
+            "the analysis needs the noise off: sensors.noise_scale=0"
+        return cls(
+            kind=kind, h=sim["step_size"], t0=sim["start_time"], length=ship["length"],
+            speed=ship["speed"], k_prime=ship["k_prime"], t_prime=ship["t_prime"],
+            max_substep=ship["max_substep"], gear_tau=gear["time_constant"],
+            gear_angle_max=gear["angle_max"], ctl=ctl,
+            sensor_interval=sensors[f"{channel}_interval"], overrides=dict(overrides or {}),
+        )
+
+    # -- the elements -----------------------------------------------------------------------
+    @property
+    def scale(self):
+        """dt'/dt = U/L of the ship."""
+        return self.speed / self.length
+
+    @property
+    def input_scale(self):
+        """The controller's error per unit of the measured signal: 1 (heading, rad), 1/L of the
+        controller's ship_length (track: (y_ref - y)/L)."""
+        return 1.0 if self.kind == "heading" else 1.0 / self.ctl["ship_length"]
+
+    def controller_tf(self):
+        """Heading: C(s') = omega_n^2/(K a) (T s' + 1)(s' + a)/(s'^2 + 2 zeta omega_n s' +
+        omega_n^2) [Taylor2000, eq. (5.30)]; track: C_y = gain prod(s' + z_i)/prod(s' + p_i)
+        [Taylor2000, sec. 5.3.2]. In t' of the controller's ship_length and ship_speed."""
+        p = self.ctl
+        if self.kind == "track":
+            num, den = [p["gain"]], [1.0]
+            for i in range(1, 5):
+                num = poly_mul(num, [1.0, p[f"zero{i}"]])
+                den = poly_mul(den, [1.0, p[f"pole{i}"]])
+            return num, den
+        w2 = p["omega_n"] ** 2
+        ka = p["nomoto_k"] * p["gear_pole"]
+        num = poly_mul([p["nomoto_t"] * w2 / ka, w2 / ka], [1.0, p["gear_pole"]])
+        den = [1.0, 2.0 * p["zeta"] * p["omega_n"], w2]
+        return num, den
+
+    def ctl_samples(self):
+        """(n, tau') of the controller's sampler for one communication step: n = ceil(h' /
+        sample_step), tau' = h'/n, h' = h U/L of its own ship_length and ship_speed."""
+        hp = self.h * self.ctl["ship_speed"] / self.ctl["ship_length"]
+        n = max(1, int(math.ceil(hp / self.ctl["sample_step"] * (1.0 - 1e-12))))
+        return n, hp / n
+
+    def ctl_step_matrices(self):
+        """The controller over one communication step with its input e held: n Tustin samples;
+        (A, B, C, D) of x_{k+1} = A x_k + B e_k, y = C x_k + D e_k, y the output of the last
+        sample (published at t_{k+1})."""
+        n, tau = self.ctl_samples()
+        ad, bd, cd, dd = tustin(*self.controller_tf(), tau)
+        a, b = np.eye(len(ad)), np.zeros_like(bd)
+        c_out, d_out = cd, dd
+        for _ in range(n):
+            c_out, d_out = cd @ a, (cd @ b).item() + dd
+            a, b = ad @ a, ad @ b + bd
+        return a, b, c_out, d_out
+
+    def ship_continuous(self):
+        """(A, B, C) of the ship from the rudder angle to the measured signal: states [r', psi]
+        (heading) or [r', psi, y] (track), r'' = s (K' delta - r')/T', psi' = s r', y' = U psi
+        (the kinematics U sin psi linearised at psi = 0, no sway, no current), s = U/L."""
+        s = self.scale
+        if self.kind == "heading":
+            a = np.array([[-s / self.t_prime, 0.0], [s, 0.0]])
+            c = np.array([[0.0, 1.0]])
+        else:
+            a = np.array([[-s / self.t_prime, 0.0, 0.0], [s, 0.0, 0.0], [0.0, self.speed, 0.0]])
+            c = np.array([[0.0, 0.0, 1.0]])
+        b = np.zeros((len(a), 1))
+        b[0, 0] = s * self.k_prime / self.t_prime
+        return a, b, c
+
+    def ship_matrices(self, exact=False):
+        """The ship over one step with the rudder held: RK4 as models::hull::nomoto (or the
+        exact ZOH)."""
+        a, b, c = self.ship_continuous()
+        if exact:
+            return zoh(a, b, self.h) + (c,)
+        return rk4_matrices(a, b, self.h, self.max_substep) + (c,)
+
+    def gear_decay(self):
+        return math.exp(-self.h / self.gear_tau)
+
+    def sensor_period(self) -> int:
+        m = self.sensor_interval / self.h
+        if abs(m - round(m)) > 1e-9:
+            raise ValueError("the sensor interval is not a whole number of steps")
+        return int(round(m))
+
+    def sensor_delays(self) -> list[int]:
+        """Delay (in steps) of the published measurement behind the published true value, for
+        each step k mod M of the sensor period M = interval/h (the Sensors model under the
+        Jacobi master, see FINDINGS): k = 0 mod M: 1 step (the sample taken as the step ending at
+        t_k reaches the instant uses the input held over that step); else k mod M steps (the
+        sample re-taken at the instant with the value set there)."""
+        m = self.sensor_period()
+        return [1] + list(range(1, m))
+
+    # -- frequency responses of the levels of the term-by-term table -------------------------
+    def loop_continuous(self, w, gear="file"):
+        """Continuous loop in real time, s' = s L/U: C(s') K'/(s'(T's' + 1)) [/s' for the track,
+        y' = y/L] times the gear: "design" a/(s' + a) (the thesis), "file" 1/(tau s + 1)."""
+        s = 1j * np.asarray(w, dtype=float)
+        sp = s / self.scale
+        num, den = self.controller_tf()
+        c = polyval(num, sp) / polyval(den, sp)
+        ship = self.k_prime / (sp * (self.t_prime * sp + 1.0))
+        if self.kind == "track":
+            ship = ship / sp * self.length * self.input_scale
+        if gear == "design":
+            a = self.ctl["gear_pole"]
+            g = a / (sp + a)
+        else:
+            g = 1.0 / (self.gear_tau * s + 1.0)
+        return c * ship * g
+
+    def loop_sampled(self, w, level: str):
+        """Loop transfer functions of the sampled levels (z = exp(j w h)):
+        "zoh":    the ideal single-rate digital loop: the controller's step map (Tustin) with its
+                  output held into the exact ZOH equivalent of gear + ship (one system);
+        "split":  + the ship fed the gear angle published at t_k, held over the step (two FMUs),
+                  the gear exact, the ship by RK4;
+        "jacobi": + one step in the controller (its output at t_k+1 from the input at t_k) and
+                  one in the sensor (sampling at every step, published one step later);
+        "full":   + the sensor's sample-and-hold every interval: the fundamental (m = 0) term of
+                  its periodically time-varying map, the mean of exp(-j w h delay) over the
+                  period's delays (sensor_delays)."""
+        w = np.asarray(w, dtype=float)
+        z = np.exp(1j * w * self.h)
+        ca, cb, cc, cd = self.ctl_step_matrices()
+        ctl = ss_freq(ca, cb, cc, cd, z) * self.input_scale
+        sa, sb, sc = self.ship_continuous()
+        if level == "zoh":
+            n = len(sa)
+            a = np.zeros((n + 1, n + 1))
+            a[0, 0] = -1.0 / self.gear_tau
+            a[1:, 1:] = sa
+            a[1:, :1] = sb
+            b = np.zeros((n + 1, 1))
+            b[0, 0] = 1.0 / self.gear_tau
+            phi, gam = zoh(a, b, self.h)
+            c = np.hstack([[[0.0]], sc])
+            return ctl * ss_freq(phi, gam, c, 0.0, z)
+        a = self.gear_decay()
+        gear = (1.0 - a) / (z - a)
+        phi, gam, c = self.ship_matrices()
+        ship = ss_freq(phi, gam, c, 0.0, z)
+        if level == "split":
+            return ctl * gear * ship
+        if level == "jacobi":
+            return ctl * gear * ship * z ** -2
+        if level == "full":
+            delays = np.array(self.sensor_delays())
+            sensor = np.mean(np.exp(-1j * np.outer(w, delays) * self.h), axis=1)
+            return ctl * gear * ship * sensor / z
+        raise ValueError(level)
+
+    # -- the time-domain loop of the master -----------------------------------------------
+    def simulate(self, n_steps: int, injection=None, reference: float = 0.0, n_freq: int = 1):
+        """The coupled system stepped as the master's Jacobi algorithm does, from the zero
+        operating point, vectorised over `n_freq` parallel runs.
+
+        Published at t_k (k = 0 ... n_steps): r_k (controller rudder_command), delta_k
+        (gear.rudder_angle), x_k (ship.heading or ship.y), m_k (the sensor's measured value).
+        Step k: u_k = r_k + d_k (the break), gear from u_k, ship from delta_k, sensor from x_k
+        (sample-and-hold, see sensor_delays), controller from e_k = (reference - m_k) scaled.
+        `injection(k)` gives d_k (an array of n_freq) or None.
+        Returns dict of arrays (n_steps + 1, n_freq): r, u, delta, x, m."""
+        ca, cb, cc, cd = self.ctl_step_matrices()
+        phi, gam, sc = self.ship_matrices()
+        a = self.gear_decay()
+        lim = self.ctl["command_limit"]
+        amax = self.gear_angle_max
+        m_per = self.sensor_period()
+        x_ctl = np.zeros((len(ca), n_freq))
+        xs = np.zeros((len(phi), n_freq))
+        r = np.zeros(n_freq)
+        delta = np.zeros(n_freq)
+        held = np.zeros(n_freq)
+        out = {k: np.zeros((n_steps + 1, n_freq)) for k in ("r", "u", "delta", "x", "m")}
+        for k in range(n_steps + 1):
+            x = (sc @ xs)[0]
+            d = injection(k) if injection is not None else 0.0
+            u = r + d
+            out["r"][k], out["u"][k], out["delta"][k], out["x"][k], out["m"][k] = (
+                r, u, delta, x, held)
+            if k == n_steps:
+                break
+            new_held = x if (k % m_per == 0 or (k + 1) % m_per == 0) else held
+            e = (reference - held) * self.input_scale
+            y = (cc @ x_ctl)[0] + cd * e
+            x_ctl = ca @ x_ctl + cb * e
+            c = np.clip(u, -amax, amax)
+            new_delta = np.clip(c - (c - delta) * a, -amax, amax)
+            xs = phi @ xs + gam * delta
+            r, delta, held = np.clip(y, -lim, lim), new_delta, new_held
+        return out
+
+    def measure_loop(self, omegas, amplitude: float, periods: float, settle: float):
+        """What `shipsim loop --break "<controller>.rudder_command -> gear.rudder_command"`
+        measures at each frequency (operating point: the start time, the zero state):
+        d_k = A sin(omega (t_k - t0)) on the connection, phasors of r_k and u_k over the N steps
+        from k0 = ceil(settle/h), L = -R/U. Returns (snapped omegas, N, L)."""
+        snapped = [snap(w, periods, self.h) for w in omegas]
+        ws = np.array([s[0] for s in snapped])
+        ns = np.array([s[1] for s in snapped])
+        k0 = int(math.ceil(settle / self.h - 1e-9))
+        run = self.simulate(k0 + int(ns.max()), n_freq=len(ws),
+                            injection=lambda k: amplitude * np.sin(ws * (k * self.h)))
+        # the analysis must stay linear: neither the command limit nor the rudder limit reached
+        peak_r, peak_u = np.abs(run["r"]).max(), np.abs(run["u"]).max()
+        assert peak_r < self.ctl["command_limit"] and peak_u < self.gear_angle_max, (
+            f"amplitude {amplitude} saturates the loop: max |r| = {peak_r}, max |u| = {peak_u}")
+        L = np.empty(len(ws), dtype=complex)
+        for i, (w, n) in enumerate(zip(ws, ns)):
+            k = np.arange(k0, k0 + n)
+            t = k * self.h
+            L[i] = -phasor(run["r"][k, i], t, w) / phasor(run["u"][k, i], t, w)
+        return ws, ns, L
+
+
+
+def measured_margins(loop: ShipLoop, amplitude: float, periods: float, settle: float):
+    """The margins the tool must report: those of the sampled loop at the exact crossing
+    frequencies, as its sinusoidal correlation measures the loop there.
+
+    The crossings are found on the fundamental term of the loop (loop_sampled "full", exact);
+    the time-domain loop (measure_loop) is then measured at those frequencies (snapped), and its
+    ratio q = L_measured/L_full there (the aliases of the sensor's hold leaking into the
+    correlation over N steps that are not a whole number of sensor periods; 1e-3 relative or
+    less below 0.8 rad/s) corrects the loop near each crossing: GM from L_full q(w180), PM and
+    the crossover from L_full q(wc), the peak of |1/(1 + L)| from L_full q(w_Ms).
+    Returns (Margins, the Margins of the fundamental term, {name: (omega, q)})."""
+    full = lambda w: loop.loop_sampled(w, "full")
+    base = margins(full, 1e-4, math.pi / loop.h * 0.999)
+    probes = [base.crossover_rad_s, base.gain_margin_rad_s, base.sensitivity_peak_rad_s]
+    ws, _, lm = loop.measure_loop(probes, amplitude, periods, settle)
+    q = lm / full(ws)
+    one = lambda w, qi: full(np.array([w]))[0] * qi
+
+    def unwrapped(w, qi, near_rad):
+        p = np.angle(one(w, qi))
+        return p + 2 * math.pi * round((near_rad - p) / (2 * math.pi))
+
+    pc_near = math.radians(base.phase_margin_deg - 180.0)
+    wc = _bisect(lambda w: math.log(abs(one(w, q[0]))), base.crossover_rad_s * 0.95,
+                 base.crossover_rad_s * 1.05)
+    pm = 180.0 + math.degrees(unwrapped(wc, q[0], pc_near))
+    wp = _bisect(lambda w: unwrapped(w, q[1], -math.pi) + math.pi,
+                 base.gain_margin_rad_s * 0.95, base.gain_margin_rad_s * 1.05)
+    gm = -20.0 * math.log10(abs(one(wp, q[1])))
+    lo, hi = base.sensitivity_peak_rad_s * 0.7, base.sensitivity_peak_rad_s * 1.3
+    f = lambda w: -abs(1.0 / (1.0 + one(w, q[2])))
+    g = (math.sqrt(5) - 1) / 2
+    for _ in range(80):
+        c, d = hi - g * (hi - lo), lo + g * (hi - lo)
+        if f(c) < f(d):
+            hi = d
+        else:
+            lo = c
+    wm = 0.5 * (lo + hi)
+    result = Margins(gm, wp, pm, wc, math.radians(pm) / wc, -f(wm), wm)
+    return result, base, {n: (float(w), complex(qi)) for n, w, qi in
+                          zip(("crossover", "phase_crossover", "sensitivity_peak"), ws, q)}
+
+HeadingLoop = ShipLoop
+
+#: The settings of the analysis: noise off, current off, waves off (track system), external
+#: reference 0 (track system; the heading system already has it).
+HEADING_SETTINGS = {
+    "sensors.noise_scale": 0.0,
+    "current.current_speed_initial": 0.0,
+    "current.current_speed_final": 0.0,
+}
+TRACK_SETTINGS = {
+    "sensors.noise_scale": 0.0,
+    "current.current_speed_initial": 0.0,
+    "current.current_speed_final": 0.0,
+    "waves.yaw_gain": 0.0,
+    "ctl.reference_mode": 0,
+}
+
+
+def loop_levels(loop: ShipLoop):
+    """The term-by-term table: [(label, Margins)], each level adding one effect."""
+    nyq = math.pi / loop.h * 0.999
+    levels = [
+        ("continuous design [Taylor2000]: gear a/(s'+a), a = 6 in t'",
+         lambda w: loop.loop_continuous(w, gear="design"), 3.0),
+        (f"+ the file's gear, time_constant = {loop.gear_tau:.4f} s",
+         lambda w: loop.loop_continuous(w), 3.0),
+        (f"+ master sampling h = {loop.h} s: Tustin controller, gear + ship ZOH",
+         lambda w: loop.loop_sampled(w, "zoh"), nyq),
+        ("+ ship fed the held gear angle (gear exact, ship RK4)",
+         lambda w: loop.loop_sampled(w, "split"), nyq),
+        ("+ Jacobi: one step in the controller, one in the sensor",
+         lambda w: loop.loop_sampled(w, "jacobi"), nyq),
+        (f"+ sensor sample-and-hold every {loop.sensor_interval} s (fundamental term)",
+         lambda w: loop.loop_sampled(w, "full"), nyq),
+    ]
+    return [(label, margins(f, 1e-4, hi)) for label, f, hi in levels]
+
+
+def format_levels(rows) -> str:
+    lines = [f"{'level':66s} {'GM dB':>7s} {'w180':>7s} {'PM deg':>7s} {'wc':>7s} "
+             f"{'DM s':>6s} {'Ms':>6s} {'w_Ms':>6s}"]
+    for label, m in rows:
+        lines.append(f"{label:66s} {m.gain_margin_db:7.3f} {m.gain_margin_rad_s:7.4f} "
+                     f"{m.phase_margin_deg:7.3f} {m.crossover_rad_s:7.5f} "
+                     f"{m.delay_margin_s:6.2f} {m.sensitivity_peak:6.4f} "
+                     f"{m.sensitivity_peak_rad_s:6.4f}")
+    return "\n".join(lines)
+
+
+if __name__ == "__main__":
+    for path, settings in [(HEADING_SYSTEM, HEADING_SETTINGS), (TRACK_SYSTEM, TRACK_SETTINGS)]:
+        loop = ShipLoop.from_system(path, settings)
+        print(path.name, loop.kind)
+        print(format_levels(loop_levels(loop)))
