@@ -39,6 +39,7 @@
 // `!(x > 0.0)` is the check that also rejects NaN, which `x <= 0.0` would let through.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+pub mod analysis;
 pub mod campaign;
 pub mod digest;
 pub mod error;

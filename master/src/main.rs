@@ -155,6 +155,9 @@ enum Command {
     /// Plot recorded columns of one CSV, or of several overlaid, against time (and x-y tracks
     /// with equal axes) into a PNG.
     Plot(PlotArgs),
+    /// Loop analysis through the FMUs: margins at a broken connection (--break), frequency
+    /// responses (--input, --output) and describing functions (--amplitudes).
+    Loop(cli::loop_cmd::LoopArgs),
     /// Replay the journal of a stepping session (Python's `System.start(journal=...)`):
     /// the same rows as the session, bit for bit, as a CSV.
     Replay(cli::replay::ReplayArgs),
@@ -381,6 +384,7 @@ fn dispatch(cmd: Command, session: &Session) -> shipsim::Result<()> {
             cli::campaign::dispatch(command, || session.interrupt.clone())
         }
         Command::Stats(args) => cli::stats::run(&args),
+        Command::Loop(args) => cli::loop_cmd::run(&args, session.interrupt.clone()),
         Command::Replay(args) => cli::replay::run(&args, session.interrupt.clone()),
         Command::FmuHost { .. } => Ok(()),
     }

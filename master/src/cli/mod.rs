@@ -1,4 +1,5 @@
 pub mod campaign;
 pub mod isolate;
+pub mod loop_cmd;
 pub mod replay;
 pub mod stats;
