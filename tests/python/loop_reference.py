@@ -34,6 +34,18 @@ def snap(omega: float, periods: float, h: float) -> tuple[float, int]:
     return 2.0 * math.pi * periods / (n * h), n
 
 
+def window_of(omega: float, h: float, min_periods: int, max_periods: int = 100000) -> tuple[int, int]:
+    """(P, N) of a snapped frequency: the smallest whole number of periods P >= min_periods that
+    spans a whole number N of steps (the tool may take more periods than asked, e.g. where a
+    period is short)."""
+    per = 2.0 * math.pi / (omega * h)
+    for p in range(int(min_periods), max_periods):
+        n = p * per
+        if abs(n - round(n)) < 1e-6:
+            return p, int(round(n))
+    raise ValueError(f"{omega} rad/s is not 2 pi P/(N h) for P < {max_periods}")
+
+
 def phasor(x: np.ndarray, t_rel: np.ndarray, omega: float) -> complex:
     """X = (2/N) sum x_k exp(-j omega (t_k - T))."""
     return complex(2.0 / len(x) * np.sum(x * np.exp(-1j * omega * t_rel)))
@@ -602,14 +614,18 @@ class ShipLoop:
             r, delta, held = np.clip(y, -lim, lim), new_delta, new_held
         return out
 
-    def measure_loop(self, omegas, amplitude: float, periods: float, settle: float):
+    def measure_loop(self, omegas, amplitude: float, periods: float, settle: float, steps=None):
         """What `shipsim loop --break "<controller>.rudder_command -> gear.rudder_command"`
         measures at each frequency (operating point: the start time, the zero state):
         d_k = A sin(omega (t_k - t0)) on the connection, phasors of r_k and u_k over the N steps
-        from k0 = ceil(settle/h), L = -R/U. Returns (snapped omegas, N, L)."""
-        snapped = [snap(w, periods, self.h) for w in omegas]
-        ws = np.array([s[0] for s in snapped])
-        ns = np.array([s[1] for s in snapped])
+        from k0 = ceil(settle/h), L = -R/U. Returns (snapped omegas, N, L). With `steps` (N per
+        frequency) the omegas are taken as they are (already snapped) with those windows."""
+        if steps is None:
+            snapped = [snap(w, periods, self.h) for w in omegas]
+            ws = np.array([s[0] for s in snapped])
+            ns = np.array([s[1] for s in snapped])
+        else:
+            ws, ns = np.asarray(omegas, dtype=float), np.asarray(steps, dtype=int)
         k0 = int(math.ceil(settle / self.h - 1e-9))
         run = self.simulate(k0 + int(ns.max()), n_freq=len(ws),
                             injection=lambda k: amplitude * np.sin(ws * (k * self.h)))
