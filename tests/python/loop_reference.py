@@ -1,7 +1,149 @@
 """Independent reference calculations for the loop analysis of the master (issue 35).
 
-Written from the models' and FMUs' sources and the system files, in numpy only, without the
-tool: what `shipsim loop` must measure. Docstring numbers are filled in below (FINDINGS).
+What `shipsim loop` (and `System.loop_margins`, `frequency_response`, `describing_function`) must
+measure, computed here in numpy only (no scipy in the venv, nothing installed), from the models'
+and FMUs' sources and the system files, never from the tool. `python tests/python/loop_reference.py`
+prints the term-by-term tables. The tests are in test_loop_verification.py.
+
+The measurement (the spec of issue 35, coded here as `snap`, `phasor`, `ShipLoop.measure_loop`):
+t_k = t0 + k h; d_k = A sin(w (t_k - T)) held over [t_k, t_k+1); w snapped so that P periods are
+N = round(2 pi P/(w h)) steps; phasors X = (2/N) sum x_k exp(-j w (t_k - T)) over the N steps from
+k0 = ceil(settle/h); a response is Y/D; the loop at a break "a.y -> b.u" is L = -R/U with r_k = a.y
+published at t_k and u_k = r_k + d_k. Margins: first |L| = 1 (PM = 180 + angle L, delay margin =
+PM[rad]/wc), first angle L = -180 deg (GM = -20 log10 |L|), peak of |1/(1 + L)|.
+(The tool takes more than P periods where a period is shorter than 50 steps, see `shipsim loop
+--help`; the tests accept that, checking that each frequency is 2 pi P'/(N h), P' >= P.)
+
+FINDINGS
+========
+
+(a) FirstOrderLag (examples/first_order_lag: y+ = a y + (1 - a) K u, a = exp(-h/T), u held): the
+response measured from d_k to the y published at t_k is exactly G = K (1 - a)/(z - a),
+z = exp(j w h) (checked against the recursion with the correlation, 1e-9). The tool agrees to
+1e-13 relative at 10 frequencies 0.05 ... 20 rad/s (h = 0.1 s, K = 2.5, T = 1.5 s).
+
+(b) Rate limiter [Klugt1987, sec. 5.2.2]: `rate_limiter_df(ab/R)` is the exact fundamental of the
+steady-state output of y' = sat(k (x - y), +-R), k -> inf, for x = a sin(bt): 1 for ab/R <= 1; a
+trapezoid-like wave (the output tracks the input between the meeting point theta1 and
+theta2 = pi - acos(R/ab), ramps in between) for 1 < ab/R < sqrt(1 + pi^2/4) = 1.862; a triangle
+of amplitude pi R/(2b) beyond, |N| = 4R/(pi a b), lag pi/2 - asin(pi R/(2ab)). At ab = 3R:
+0.424413 a, lag 58.426 deg (the 0.4244 and 58.4 deg of the models' test). Checked against a
+simulated rate limiter (0.05 %). Through the SteeringGear FMU (time_constant 0.001 s, 15 deg/s,
+angle_max 3 rad, h = 0.005 s, w = 0.63 -> 0.629984 rad/s, P = 4, settle 200 s):
+
+    ab/R      ideal |N|  ideal deg   FMU measured |N|  deg      (tool = this to 1e-14)
+    0.8       1.000000     0.000     1.000000        -0.185
+    1.2       0.966867    -4.073     0.966796        -4.280
+    1.5       0.838358   -15.814     0.838304       -16.022
+    2.0       0.636620   -38.243     0.636620       -38.405
+    3.0       0.424413   -58.426     0.424413       -58.541
+    5.0       0.254648   -71.690     0.254648       -71.777
+
+The extra 0.09-0.21 deg are the step: y published at t_k is the gear after the command held over
+the step before (omega h = 0.18 deg at h = 0.005 s). The rate-limited start leaves a decaying offset:
+the fundamental moves by 3e-7 between settle 100 s and 200 s, by < 1e-9 after.
+
+(c) The DDG-51 heading loop of systems/autopilot_current.toml, at the break
+"ap.rudder_command -> gear.rudder_command".
+
+Settings: --set sensors.noise_scale=0 (noise off), current.current_speed_initial=0 and
+current.current_speed_final=0 (the current enters only the ship's kinematics x, y, never the
+heading loop; it is switched off so that the operating point is exactly the zero state); no --at
+(the start time, the zero state; every element is linear there, the +-30 deg limits are far).
+
+The elements, as the FMUs integrate them (every one read from its source):
+* SteeringGear (models/src/steering_gear.rs, first order, no rate limit): exact exponential over
+  the step for the held command, delta+ = u - (u - delta) exp(-h/tau). The file's
+  time_constant = 2.0916473591203615 s is exactly L/(6U) (L = 142.0368 m, U = 11.3178 m/s): the
+  6/(s+6) of the issue is in t' = tU/L, in seconds it is 1/(2.0916 s + 1), a pole at 0.478 rad/s.
+  So the file's gear IS the design's gear: its term in the table is zero.
+* NomotoShip (models/src/hull/nomoto.rs, model 1): T' r'' + r' = K' delta in t', psi' = r'
+  (T' = 1.9287, K' = 2.04), RK4 with ceil(h/0.1) = 1 sub-step of 0.05 s, rudder held; the track
+  loop adds y' = U sin(psi), linearised (U psi).
+* Sensors (models/src/sensors.rs): sample-and-hold every heading_interval = 1 s = M = 20 steps
+  (noise off). Under the Jacobi master the outputs published at t_k are read BEFORE the inputs
+  of t_k are set, so: at an instant t_k = j*1 s the sample is taken when the step ending at t_k
+  reaches it, from the input held over that step, i.e. the heading of t_(k-1); at t_k+1 ...
+  t_k+19 the published value is the sample re-taken at t_k with the heading set there. Delays
+  behind the published heading over one period: 1, 1, 2, 3, ..., 19 steps (mean 9.55 steps).
+  Seen in a plain `shipsim run` (heading_measured at t = 1.0 is the heading of 0.95).
+* HeadingAutopilot (models/src/controllers/loop_shaped.rs): C(s') = w_n^2/(K a)(T s' + 1)(s' + a)/
+  (s'^2 + 2 zeta w_n s' + w_n^2), w_n = sqrt 60, zeta = 2, a = 6 (the FMU's defaults, read from
+  its modelDescription), Tustin (controllable canonical form) at tau' = h U/L = 0.003984 t'
+  (below sample_step 0.01: one sample per communication step, so the autopilot's own sampling
+  is the master's), the error taken from the input held at t_k, the output published at t_k+1.
+* Jacobi master (master/src/run/algorithm.rs): every instance steps from the outputs published at
+  t_k; so r_k+1 from m_k, delta_k+1 from u_k, psi_k+1 from delta_k, m_k+1 from psi_k.
+
+This discretised loop (`ShipLoop.simulate`) reproduces a plain `shipsim run` of the system (a
+0.05 rad heading-reference step, every signal of the loop at every step) to 1e-15 (heading loop)
+and 3e-9 (track loop, the linearised sin psi).
+
+What the correlation measures. The sensor's hold makes the loop periodically time-varying (period
+1 s): a sinusoid at w comes back at w and at its aliases w + 2 pi m/(1 s). Two parts:
+* the fundamental (m = 0) term of the hold's harmonic transfer function: the mean over the period
+  of exp(-j w h delay) = (exp(-j w h) + sum_{i=1}^{19} exp(-j w h i))/20; the loop through it is
+  `loop_sampled(w, "full")` (exact, a z-domain product of the elements);
+* the aliases, which re-enter the fundamental through the plant only at the 1e-6 level (the gear
+  and the ship filter 2 pi rad/s by 1e-5), but which are large in r and u themselves (the
+  controller's high-frequency gain on the hold's steps: 30 % of the fundamental at 0.6 rad/s) and
+  leak into the correlation when N is not a whole number of sensor periods: up to 0.02 dB /
+  0.1 deg near the heading loop's phase crossover, 0.05 dB / 0.4 deg for the track loop, varying
+  with N and with where the window starts.
+Hence the reference for the tool is the time-domain simulation of the same loop with the same
+injection and window (`measure_loop`); the margins (`measured_margins`) are found on the exact
+fundamental term and corrected by the simulated measurement at the crossings. When N is a
+multiple of 20 the leakage vanishes: the simulated measurement equals the fundamental term to
+1e-6 dB / 4e-5 deg (tested) - a tool that snapped N to whole periods of the slowest hold as well
+would measure the fundamental term exactly, independent of the window.
+
+Term by term (each row adds one effect to the one above; w in rad/s; Ms = peak |1/(1 + L)|):
+
+    heading loop                                              GM dB   w180    PM deg   wc      DM s   Ms     w_Ms
+    continuous design [Taylor2000] (gear a/(s'+a), a = 6)     29.823  0.6172  64.406  0.07288  15.42  1.3038 0.1429
+    + the file's gear, time_constant = 2.0916 s (= L/(6U))    29.823  0.6172  64.406  0.07288  15.42  1.3038 0.1429
+    + master sampling h = 0.05 s: Tustin, gear + ship ZOH     29.304  0.5990  64.302  0.07288  15.40  1.3062 0.1426
+    + ship fed the held gear angle (gear exact, ship RK4)     28.813  0.5823  64.197  0.07288  15.37  1.3086 0.1424
+    + Jacobi: one step in the autopilot, one in the sensor    27.107  0.5271  63.779  0.07288  15.27  1.3182 0.1416
+    + sensor sample-and-hold every 1 s (fundamental term)     22.317  0.3942  61.999  0.07287  14.85  1.3609 0.1380
+    measured (P = 4, settle 300 s, A = 0.01 rad): reference   22.293  0.3939  61.996  0.07287  14.849 1.3609 0.1380
+    measured: the tool (same settings, Ms = max over grid)    22.295  0.3940  61.996  0.07287  14.849 1.3611 0.1385
+
+Each row is an added delay at an unchanged crossover: the command held over the step h/2 (0.104
+deg at wc = 0.0729 rad/s), the gear angle held into the ship h/2 (0.105 deg), the autopilot's and
+the sensor's Jacobi steps 2h (0.418 deg), the 1 s hold 8.55 h more (1.785 deg). In all an
+equivalent delay of 0.5775 s: the continuous design times exp(-0.5775 s) has 22.26 dB / 61.99 deg.
+The phase lost is small at the crossover (0.073 rad/s) but large at the phase crossover
+(0.62 rad/s: 20 deg), which moves down to 0.394 rad/s where |L| is 7.5 dB larger: the gain
+margin falls 29.82 -> 22.32 dB (the 1 s hold alone 4.8 dB), the phase margin only
+64.41 -> 62.00 deg, the delay margin 15.42 -> 14.85 s (by the 0.5775 s). The issue's hand
+measurement without the sensor's hold (PM about 62, GM 27-28 dB) matches the "Jacobi" row's
+27.1 dB.
+
+The tool's table (34 rows: the 30 frequencies and 4 refinement points) equals the simulated
+measurement at every row to 1e-13 dB and 1e-12 deg: the same loop, injection and window.
+
+(d) The track loop (AT-2) of systems/autopilot_track_offset.toml at "ctl.rudder_command ->
+gear.rudder_command" (TrackController C_y = 20 (s'+0.5)^2 (s'+6)(s'+1000)/((s'+11)(s'+15)
+(s'+30)^2) on y/L, the cross-track position sampled every 1 s). Settings: those of the heading
+loop plus waves.yaw_gain=0 (no wave moment) and ctl.reference_mode=0 (no lateral-offset
+manoeuvre; external reference 0); P = 8 (its aliases leak more).
+
+    track loop                                                GM dB   w180    PM deg   wc      DM s   Ms     w_Ms
+    continuous design [Taylor2000]                            21.574  0.5798  50.990  0.07581  11.74  1.2512 0.1266
+    + the file's gear (= L/(6U))                              21.574  0.5798  50.990  0.07581  11.74  1.2512 0.1266
+    + master sampling h = 0.05 s: Tustin, gear + ship ZOH     21.410  0.5731  50.882  0.07581  11.71  1.2539 0.1264
+    + ship fed the held gear angle (gear exact, ship RK4)     21.251  0.5665  50.773  0.07581  11.69  1.2567 0.1262
+    + Jacobi: one step in the controller, one in the sensor   20.648  0.5420  50.338  0.07581  11.59  1.2678 0.1255
+    + sensor sample-and-hold every 1 s (fundamental term)     18.576  0.4588  48.480  0.07579  11.16  1.3175 0.1221
+    measured (P = 8, settle 300 s, A = 0.01 rad): reference   18.526  0.4576  48.516  0.07582  11.17  1.3182 0.1216
+    measured: the tool (same settings, Ms = max over grid)    18.529  0.4580  48.397  0.07572  11.16  1.3165 0.1194
+
+The same 0.5775 s (continuous design times exp(-0.5775 s): 18.50 dB / 48.48 deg). The tool's
+phase margin differs from the reference's by 0.12 deg: its refinement measures at other N, whose
+leakage differs (the fundamental term's 48.48 deg lies between). Its table rows equal the
+simulated measurement to 3e-4 dB / 1e-5 deg (the reference linearises U sin psi; the tool's own
+linearity check shows 4e-4 dB at twice the amplitude).
 """
 from __future__ import annotations
 
