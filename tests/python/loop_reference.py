@@ -716,7 +716,8 @@ class ShipLoop:
         raise ValueError(level)
 
     # -- the time-domain loop of the master -----------------------------------------------
-    def simulate(self, n_steps: int, injection=None, reference: float = 0.0, n_freq: int = 1):
+    def simulate(self, n_steps: int, injection=None, reference: float = 0.0, n_freq: int = 1,
+                 start_step: int = 0):
         """The coupled system stepped as the master's Jacobi algorithm does, from the zero
         operating point, vectorised over `n_freq` parallel runs.
 
@@ -724,7 +725,9 @@ class ShipLoop:
         (gear.rudder_angle), x_k (ship.heading or ship.y), m_k (the sensor's measured value).
         Step k: u_k = r_k + d_k (the break), gear from u_k, ship from delta_k, sensor from x_k
         (sample-and-hold, see sensor_delays), controller from e_k = (reference - m_k) scaled.
-        `injection(k)` gives d_k (an array of n_freq) or None.
+        `injection(k)` gives d_k (an array of n_freq) or None. `start_step`: the run starts from
+        the zero state at t0 + start_step h (a fork at T of a loop that is still at rest: only
+        the phase of the sensor's sampling instants t0 + j interval changes; k counts from T).
         Returns dict of arrays (n_steps + 1, n_freq): r, u, delta, x, m."""
         ca, cb, cc, cd = self.ctl_step_matrices()
         phi, gam, sc = self.ship_matrices()
@@ -746,7 +749,8 @@ class ShipLoop:
                 r, u, delta, x, held)
             if k == n_steps:
                 break
-            new_held = x if (k % m_per == 0 or (k + 1) % m_per == 0) else held
+            ka = k + start_step
+            new_held = x if (ka % m_per == 0 or (ka + 1) % m_per == 0) else held
             e = (reference - held) * self.input_scale
             y = (cc @ x_ctl)[0] + cd * e
             x_ctl = ca @ x_ctl + cb * e
@@ -756,11 +760,12 @@ class ShipLoop:
             r, delta, held = np.clip(y, -lim, lim), new_delta, new_held
         return out
 
-    def measure_loop(self, omegas, amplitude: float, periods: float, settle: float, steps=None):
+    def measure_loop(self, omegas, amplitude: float, periods: float, settle: float, steps=None,
+                     at: float | None = None):
         """What `shipsim loop --break "<controller>.rudder_command -> gear.rudder_command"`
         measures at each frequency (operating point: the start time, the zero state):
         d_k = A sin(omega (t_k - t0)) on the connection, phasors of r_k and u_k over the N steps
-        from k0 = ceil(settle/h), L = -R/U. Returns (snapped omegas, N, L). With `steps` (N per
+        from k0 = ceil(settle/h) after T, L = -R/U (`at`: T, default the start). Returns (snapped omegas, N, L). With `steps` (N per
         frequency) the omegas are taken as they are (already snapped) with those windows."""
         if steps is None:
             snapped = [snap(w, periods, self.h) for w in omegas]
@@ -769,7 +774,9 @@ class ShipLoop:
         else:
             ws, ns = np.asarray(omegas, dtype=float), np.asarray(steps, dtype=int)
         k0 = int(math.ceil(settle / self.h - 1e-9))
-        run = self.simulate(k0 + int(ns.max()), n_freq=len(ws),
+        start = 0 if at is None else int(round((at - self.t0) / self.h))
+        assert at is None or abs(self.t0 + start * self.h - at) < 1e-9, "T off the step grid"
+        run = self.simulate(k0 + int(ns.max()), n_freq=len(ws), start_step=start,
                             injection=lambda k: amplitude * np.sin(ws * (k * self.h)))
         # the analysis must stay linear: neither the command limit nor the rudder limit reached
         peak_r, peak_u = np.abs(run["r"]).max(), np.abs(run["u"]).max()
