@@ -312,6 +312,104 @@ class System:
         raw = _native.replay(os.fspath(journal), verbose=verbose)
         return _frame(raw, as_frame, {})
 
+    # -- loop analysis (docs/loop-analysis.md) ---------------------------------------------
+    def loop_margins(
+        self,
+        connection: str,
+        *,
+        at: Optional[float] = None,
+        frequencies: Optional[Iterable[float]] = None,
+        amplitude: Optional[float] = None,
+        periods: Optional[int] = None,
+        settle: Optional[float] = None,
+        linearity: bool = True,
+        jobs: Optional[int] = None,
+        output: Optional[PathLike] = None,
+    ) -> Dict[str, Any]:
+        """The loop transfer function at ``connection`` (``"ap.rudder_command ->
+        gear.rudder_command"``) and its stability margins, as ``shipsim loop --break``
+        measures them: the loop stays closed, a sinusoid of ``amplitude`` (default 0.01, in the
+        connection's unit) rides on the connection, and L = -(returned)/(sent) is measured by
+        correlation over ``periods`` whole periods (default 4) after ``settle`` seconds
+        (default 3 periods), each frequency a fork from the state at ``at`` (default: the
+        start, after initialization). ``frequencies`` [rad/s] default to 20 log-spaced from
+        0.001 to 0.3 times pi/h; crossings are refined by more forks.
+
+        Returns a dict: ``gain_margin_db``, ``gain_margin_rad_s``, ``phase_margin_deg``,
+        ``crossover_rad_s``, ``delay_margin_s``, ``sensitivity_peak`` (max |1/(1+L)|) and
+        ``sensitivity_peak_rad_s`` (None where the range has no such crossing), and
+        ``table``: a DataFrame (omega_rad_s, gain_db, phase_deg, re, im, distortion,
+        gain_change_db, phase_change_deg: the change at twice the amplitude, with
+        ``linearity``). With ``output``, the tables (CSV, Parquet) and the Bode and Nyquist
+        plots are written into that folder too."""
+        from ._campaign import _table
+
+        raw = _native.loop_margins(
+            self._native, connection, at=at,
+            frequencies=None if frequencies is None else [float(w) for w in frequencies],
+            amplitude=amplitude, periods=periods, settle=settle, linearity=linearity, jobs=jobs,
+            output=None if output is None else os.fspath(output),
+        )
+        raw["table"] = _table(raw["table"], None)
+        return raw
+
+    def frequency_response(
+        self,
+        input: str,
+        outputs: Union[str, Iterable[str]],
+        *,
+        at: Optional[float] = None,
+        frequencies: Optional[Iterable[float]] = None,
+        amplitude: Optional[float] = None,
+        periods: Optional[int] = None,
+        settle: Optional[float] = None,
+        linearity: bool = True,
+        jobs: Optional[int] = None,
+        output: Optional[PathLike] = None,
+    ):
+        """The frequency response from ``input`` (an input or tunable parameter, or a
+        connection ``"a.y -> b.u"``) to each of ``outputs``, as ``shipsim loop --input X
+        --output Y`` measures it (the options of :meth:`loop_margins`). Returns a DataFrame:
+        omega_rad_s, output, gain_db, phase_deg (unwrapped per output), re, im, distortion,
+        gain_change_db, phase_change_deg."""
+        from ._campaign import _table
+
+        if isinstance(outputs, str):
+            outputs = [outputs]
+        raw = _native.frequency_response(
+            self._native, input, list(outputs), at=at,
+            frequencies=None if frequencies is None else [float(w) for w in frequencies],
+            amplitude=amplitude, periods=periods, settle=settle, linearity=linearity, jobs=jobs,
+            output=None if output is None else os.fspath(output),
+        )
+        return _table(raw["table"], None)
+
+    def describing_function(
+        self,
+        input: str,
+        output: str,
+        frequency: float,
+        amplitudes: Iterable[float],
+        *,
+        at: Optional[float] = None,
+        periods: Optional[int] = None,
+        settle: Optional[float] = None,
+        jobs: Optional[int] = None,
+        directory: Optional[PathLike] = None,
+    ):
+        """The describing function from ``input`` to ``output`` at ``frequency`` [rad/s]
+        over ``amplitudes``: the fundamental of the output over the injected sinusoid, for
+        nonlinear elements (rate and angle limits). Returns a DataFrame: amplitude,
+        omega_rad_s, output, gain, gain_db, phase_deg, re, im, distortion."""
+        from ._campaign import _table
+
+        raw = _native.describing_function(
+            self._native, input, output, float(frequency), [float(a) for a in amplitudes],
+            at=at, periods=periods, settle=settle, jobs=jobs,
+            directory=None if directory is None else os.fspath(directory),
+        )
+        return _table(raw["table"], None)
+
     def __repr__(self) -> str:
         names = ", ".join(self.instances)
         return f"System({self.source!r}: {names}; step {self.step_size} s, stop {self.stop_time} s)"

@@ -33,6 +33,7 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
+mod analysis;
 mod session;
 
 create_exception!(
@@ -1245,6 +1246,9 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<session::PySession>()?;
     m.add_class::<session::PyCheckpoint>()?;
     m.add_function(wrap_pyfunction!(session::replay, m)?)?;
+    m.add_function(wrap_pyfunction!(analysis::loop_margins, m)?)?;
+    m.add_function(wrap_pyfunction!(analysis::frequency_response, m)?)?;
+    m.add_function(wrap_pyfunction!(analysis::describing_function, m)?)?;
     // Isolated FMU instances (`isolate=`, `isolate = true`, campaigns' foreign FMUs) run in
     // processes of this interpreter: `python -m shipsim._fmu_host fmu-host FMU`.
     let executable: Option<PathBuf> = py.import("sys")?.getattr("executable")?.extract().ok();

@@ -29,7 +29,10 @@ mod margins;
 mod output;
 
 pub use margins::Margins;
-pub use output::{write_describing, write_margins, write_response, Written};
+pub use output::{
+    describing_table, loop_table, response_table, write_describing, write_margins, write_response,
+    Written,
+};
 
 /// Where the sinusoid is injected.
 #[derive(Debug, Clone)]

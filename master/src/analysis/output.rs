@@ -63,8 +63,8 @@ fn curves(series: &[(String, Vec<f64>, Vec<Complex64>)]) -> Vec<Curve> {
         .collect()
 }
 
-/// The response table (one row per frequency and output) and its Bode plot.
-pub fn write_response(dir: &Path, points: &[ResponsePoint], title: &str) -> Result<Written> {
+/// The response table: one row per frequency and output.
+pub fn response_table(points: &[ResponsePoint]) -> Table {
     let rows: Vec<(f64, &OutputResponse)> = points
         .iter()
         .flat_map(|p| p.outputs.iter().map(move |o| (p.omega, o)))
@@ -94,7 +94,16 @@ pub fn write_response(dir: &Path, points: &[ResponsePoint], title: &str) -> Resu
     let phase = (0..points.len()).flat_map(|k| phases.iter().map(move |p| p[k]));
     t.push("phase_deg", ColumnData::Float(phase.collect()));
     push_common(&mut t, &rows);
-    let (table, parquet) = write_table(dir, "response", &t)?;
+    t
+}
+
+/// The response table (one row per frequency and output) and its Bode plot.
+pub fn write_response(dir: &Path, points: &[ResponsePoint], title: &str) -> Result<Written> {
+    let (table, parquet) = write_table(dir, "response", &response_table(points))?;
+    let names: Vec<String> = points
+        .first()
+        .map(|p| p.outputs.iter().map(|o| o.name.clone()).collect())
+        .unwrap_or_default();
     let series: Vec<(String, Vec<f64>, Vec<Complex64>)> = names
         .iter()
         .enumerate()
@@ -140,16 +149,13 @@ fn push_common(t: &mut Table, rows: &[(f64, &OutputResponse)]) {
     );
 }
 
-/// The loop's table, its Bode and Nyquist plots.
-pub fn write_margins(
-    dir: &Path,
-    points: &[LoopPoint],
-    m: &Margins,
-    title: &str,
-) -> Result<Written> {
+/// The loop's table: one row per measured frequency.
+pub fn loop_table(points: &[LoopPoint]) -> Table {
     let mut t = Table::default();
-    let w: Vec<f64> = points.iter().map(|p| p.omega).collect();
-    t.push("omega_rad_s", ColumnData::Float(w.clone()));
+    t.push(
+        "omega_rad_s",
+        ColumnData::Float(points.iter().map(|p| p.omega).collect()),
+    );
     t.push(
         "gain_db",
         ColumnData::Float(points.iter().map(|p| db(p.l)).collect()),
@@ -178,7 +184,18 @@ pub fn write_margins(
         "phase_change_deg",
         optional(points.iter().map(|p| p.phase_change_deg)),
     );
-    let (table, parquet) = write_table(dir, "loop", &t)?;
+    t
+}
+
+/// The loop's table, its Bode and Nyquist plots.
+pub fn write_margins(
+    dir: &Path,
+    points: &[LoopPoint],
+    m: &Margins,
+    title: &str,
+) -> Result<Written> {
+    let w: Vec<f64> = points.iter().map(|p| p.omega).collect();
+    let (table, parquet) = write_table(dir, "loop", &loop_table(points))?;
     let shown = |x: Option<f64>, unit: &str| x.map_or("none".into(), |v| format!("{v:.2} {unit}"));
     let title = format!(
         "{title}: GM {} at {}, PM {} at {}",
@@ -242,8 +259,8 @@ fn nyquist(points: &[LoopPoint]) -> Track {
     }
 }
 
-/// The describing function's table and plot (gain and phase against the amplitude).
-pub fn write_describing(dir: &Path, points: &[DescribingPoint], title: &str) -> Result<Written> {
+/// The describing function's table: one row per amplitude.
+pub fn describing_table(points: &[DescribingPoint]) -> Table {
     let rows: Vec<(f64, &OutputResponse)> = points
         .iter()
         .flat_map(|p| p.outputs.iter().map(move |o| (p.amplitude, o)))
@@ -279,7 +296,16 @@ pub fn write_describing(dir: &Path, points: &[DescribingPoint], title: &str) -> 
         ColumnData::Float(rows.iter().map(|r| r.1.ratio.arg().to_degrees()).collect()),
     );
     push_common(&mut t, &rows);
-    let (table, parquet) = write_table(dir, "describing", &t)?;
+    t
+}
+
+/// The describing function's table and plot (gain and phase against the amplitude).
+pub fn write_describing(dir: &Path, points: &[DescribingPoint], title: &str) -> Result<Written> {
+    let (table, parquet) = write_table(dir, "describing", &describing_table(points))?;
+    let rows: Vec<(f64, &OutputResponse)> = points
+        .iter()
+        .flat_map(|p| p.outputs.iter().map(move |o| (p.amplitude, o)))
+        .collect();
     let a: Vec<f64> = points.iter().map(|p| p.amplitude).collect();
     let panel = |label: &str, f: fn(Complex64) -> f64| Panel {
         y_label: label.into(),
