@@ -256,7 +256,8 @@ pub(crate) struct Work<'a> {
 }
 
 impl<'a> Work<'a> {
-    pub fn new(plan: &'a Plan, base: &'a Base) -> Result<Work<'a>> {
+    /// The work of `plan` on `base`, whose sinusoids reach `max_amplitude`.
+    pub fn new(plan: &'a Plan, base: &'a Base, max_amplitude: f64) -> Result<Work<'a>> {
         let input = match &plan.injection {
             Resolved::Input { name } => {
                 let mut s = base.session()?;
@@ -265,9 +266,11 @@ impl<'a> Work<'a> {
                     v => return Err(Error::Other(format!("'{name}' is {v:?}, not a Real"))),
                 };
                 // The same checks as a set: settable during a run, and u0 ± A in range.
-                let amp = plan_amplitude_check(&mut s, name, u0)?;
+                let template = input_event(&mut s, name, u0)?;
+                input_event(&mut s, name, u0 + max_amplitude)?;
+                input_event(&mut s, name, u0 - max_amplitude)?;
                 s.close()?;
-                Some((u0, amp))
+                Some((u0, template))
             }
             Resolved::Connection { .. } => None,
         };
@@ -462,13 +465,13 @@ impl<'a> Work<'a> {
     }
 }
 
-/// Checks that `name` can be set during the run with values around `u0` (through the
-/// session's own check of a set), and returns the event template that sets it.
-fn plan_amplitude_check(s: &mut Session, name: &str, u0: f64) -> Result<PlanEvent> {
+/// The event that sets input `name` to `value` now, checked as a set is (settable during a
+/// run, within the declared range): the template of the injected events.
+fn input_event(s: &mut Session, name: &str, value: f64) -> Result<PlanEvent> {
     let spec = EventSpec {
         time: s.time(),
         target: VarRef::parse(name).expect("checked"),
-        value: Value::Real(u0),
+        value: Value::Real(value),
         line: None,
     };
     let mds: Vec<&ModelDescription> = s.fmus().iter().map(|f| &f.model_description).collect();

@@ -250,7 +250,8 @@ pub fn frequency_response(
         .max()
         .unwrap_or(0);
     let base = prepare(system, fmus, plan.variables(), max, opts)?;
-    let work = fork::Work::new(&plan, &base)?;
+    let twice = if opts.linearity { 2.0 } else { 1.0 };
+    let work = fork::Work::new(&plan, &base, twice * opts.amplitude)?;
     pool(opts.jobs, || {
         work.responses(&freqs, opts.amplitude, opts.linearity)
     })?
@@ -269,7 +270,7 @@ pub fn loop_margins(
     let lowest = freqs.iter().copied().fold(f64::INFINITY, f64::min);
     let max = plan.length(lowest).total();
     let base = prepare(system, fmus, plan.variables(), max, opts)?;
-    let work = fork::Work::new(&plan, &base)?;
+    let work = fork::Work::new(&plan, &base, 2.0 * opts.amplitude)?;
     pool(opts.jobs, || margins::measure(&work, &freqs, opts))?
 }
 
@@ -304,6 +305,7 @@ pub fn describing_function(
         plan.length(omega).total(),
         opts,
     )?;
-    let work = fork::Work::new(&plan, &base)?;
+    let largest = amplitudes.iter().copied().fold(0.0, f64::max);
+    let work = fork::Work::new(&plan, &base, largest)?;
     pool(opts.jobs, || work.describing(omega, amplitudes))?
 }
