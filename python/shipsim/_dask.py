@@ -95,3 +95,41 @@ def run_on_dask(campaign, client, output: str, retry_failed: bool,
         raise
     finally:
         collector.close()
+
+
+# -- loop analysis on Dask (System.loop_margins(client=...)) ------------------------------------
+# A worker process keeps the systems of its loop tasks loaded, keyed by what makes them.
+_LOOP_SYSTEMS: Dict[Tuple[str, Tuple[Tuple[str, str], ...], bool], Any] = {}
+
+
+def loop_points(source: str, values: Tuple[Tuple[str, str], ...], strict_units: bool,
+                connection: str, chunk: List[float], options: Dict[str, Any]) -> List[tuple]:
+    """A Dask task: the loop's points at `chunk` of the grid, measured in this worker process
+    on the system of `source` with `values` set (loaded once per process)."""
+    key = (source, values, strict_units)
+    system = _LOOP_SYSTEMS.get(key)
+    if system is None:
+        system = _native.System.load(source)
+        for name, value in values:
+            system.set(name, value)
+        system.strict_units = strict_units
+        _LOOP_SYSTEMS[key] = system
+    return _native.loop_points(system, connection, chunk, jobs=1, **options)
+
+
+def loop_on_dask(system, connection: str, options: Dict[str, Any], client) -> List[tuple]:
+    """The grid of a loop analysis measured on the workers of `client`, in chunks of about
+    four per worker; returns the points in grid order (the crossings are refined by the
+    caller). The workers read the system file and FMUs at the client's absolute paths."""
+    from ._campaign import _chunk_size
+
+    grid = _native.loop_grid(system._native, frequencies=options.get("frequencies"))
+    options = dict(options, frequencies=grid)
+    workers = max(1, len(client.scheduler_info().get("workers", {})))
+    size = _chunk_size(len(grid), workers)
+    chunks = [grid[i:i + size] for i in range(0, len(grid), size)]
+    source = os.path.abspath(system.source)
+    values = tuple(sorted(system.values.items()))
+    futures = [client.submit(loop_points, source, values, system.strict_units, connection, c,
+                             options, pure=False) for c in chunks]
+    return [p for f in futures for p in f.result()]

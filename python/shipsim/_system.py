@@ -325,6 +325,7 @@ class System:
         linearity: bool = True,
         jobs: Optional[int] = None,
         output: Optional[PathLike] = None,
+        client=None,
     ) -> Dict[str, Any]:
         """The loop transfer function at ``connection`` (``"ap.rudder_command ->
         gear.rudder_command"``) and its stability margins, as ``shipsim loop --break``
@@ -341,14 +342,26 @@ class System:
         ``table``: a DataFrame (omega_rad_s, gain_db, phase_deg, re, im, distortion,
         gain_change_db, phase_change_deg: the change at twice the amplitude, with
         ``linearity``). With ``output``, the tables (CSV, Parquet) and the Bode and Nyquist
-        plots are written into that folder too."""
+        plots are written into that folder too.
+
+        ``client`` (a ``dask.distributed.Client``): the grid's forks run on its workers, in
+        chunks, and the crossings are refined here; the result is the same, bit for bit. The
+        workers read the system file and its FMUs at this process's absolute paths."""
         from ._campaign import _table
 
+        options = dict(
+            at=at, frequencies=None if frequencies is None else [float(w) for w in frequencies],
+            amplitude=amplitude, periods=periods, settle=settle, linearity=linearity,
+        )
+        grid = None
+        if client is not None:
+            from ._dask import loop_on_dask
+
+            grid = loop_on_dask(self, connection, options, client)
+            options["frequencies"] = _native.loop_grid(self._native, frequencies=options["frequencies"])
         raw = _native.loop_margins(
-            self._native, connection, at=at,
-            frequencies=None if frequencies is None else [float(w) for w in frequencies],
-            amplitude=amplitude, periods=periods, settle=settle, linearity=linearity, jobs=jobs,
-            output=None if output is None else os.fspath(output),
+            self._native, connection, jobs=jobs,
+            output=None if output is None else os.fspath(output), grid=grid, **options,
         )
         raw["table"] = _table(raw["table"], None)
         return raw

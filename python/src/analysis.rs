@@ -6,7 +6,7 @@
 use super::{py_err, run_detached, run_options, table_dict, PySystem};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use shipsim::analysis::{self, Injection, Options};
+use shipsim::analysis::{self, Injection, LoopPoint, Options};
 use std::path::PathBuf;
 
 /// The measurement's options from Python's keywords.
@@ -46,9 +46,79 @@ fn injection(input: &str) -> Injection {
     }
 }
 
-/// The loop at `connection` and its margins; see the Python `System.loop_margins`.
+/// A measured point as plain numbers (a Dask task's result): ω, Re L, Im L, distortion, and
+/// the linearity check's gain and phase change.
+type PointTuple = (f64, f64, f64, f64, Option<f64>, Option<f64>);
+
+fn to_tuple(p: &LoopPoint) -> PointTuple {
+    (
+        p.omega,
+        p.l.re,
+        p.l.im,
+        p.distortion,
+        p.gain_change_db,
+        p.phase_change_deg,
+    )
+}
+
+fn from_tuple(t: &PointTuple) -> LoopPoint {
+    LoopPoint {
+        omega: t.0,
+        l: num_complex::Complex64::new(t.1, t.2),
+        distortion: t.3,
+        gain_change_db: t.4,
+        phase_change_deg: t.5,
+    }
+}
+
+/// The grid of a loop analysis (the given frequencies, or the default range for the step).
 #[pyfunction]
-#[pyo3(signature = (system, connection, at=None, frequencies=None, amplitude=None, periods=None, settle=None, linearity=true, jobs=None, output=None))]
+#[pyo3(signature = (system, frequencies=None))]
+pub fn loop_grid(
+    py: Python<'_>,
+    system: &PySystem,
+    frequencies: Option<Vec<f64>>,
+) -> PyResult<Vec<f64>> {
+    let (opts, _, _) = options(None, frequencies, None, None, None, true, None);
+    analysis::grid(&system.system, &opts).map_err(|e| py_err(py, e))
+}
+
+/// The loop's points at `chunk` of the grid, without refinement: a Dask worker's task.
+#[pyfunction]
+#[pyo3(signature = (system, connection, chunk, at=None, frequencies=None, amplitude=None, periods=None, settle=None, linearity=true, jobs=None))]
+#[allow(clippy::too_many_arguments)]
+pub fn loop_points(
+    py: Python<'_>,
+    system: &PySystem,
+    connection: String,
+    chunk: Vec<f64>,
+    at: Option<f64>,
+    frequencies: Option<Vec<f64>>,
+    amplitude: Option<f64>,
+    periods: Option<u32>,
+    settle: Option<f64>,
+    linearity: bool,
+    jobs: Option<usize>,
+) -> PyResult<Vec<PointTuple>> {
+    let (opts, logs, interrupt) =
+        options(at, frequencies, amplitude, periods, settle, linearity, jobs);
+    let (sys, fmus) = (&system.system, &system.fmus);
+    let result = run_detached(
+        py,
+        &interrupt,
+        |_| Ok(()),
+        || analysis::loop_points(sys, fmus, &connection, &chunk, &opts),
+    );
+    logs.emit(py)?;
+    let points = result?.map_err(|e| py_err(py, e))?;
+    Ok(points.iter().map(to_tuple).collect())
+}
+
+/// The loop at `connection` and its margins; see the Python `System.loop_margins`. With
+/// `grid`, the grid's points were measured elsewhere (Dask) and only the crossings are
+/// refined here.
+#[pyfunction]
+#[pyo3(signature = (system, connection, at=None, frequencies=None, amplitude=None, periods=None, settle=None, linearity=true, jobs=None, output=None, grid=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn loop_margins<'py>(
     py: Python<'py>,
@@ -62,6 +132,7 @@ pub fn loop_margins<'py>(
     linearity: bool,
     jobs: Option<usize>,
     output: Option<PathBuf>,
+    grid: Option<Vec<PointTuple>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let (opts, logs, interrupt) =
         options(at, frequencies, amplitude, periods, settle, linearity, jobs);
@@ -71,7 +142,13 @@ pub fn loop_margins<'py>(
         &interrupt,
         |_| Ok(()),
         || {
-            let (points, m) = analysis::loop_margins(sys, fmus, &connection, &opts)?;
+            let (points, m) = match &grid {
+                Some(g) => {
+                    let points = g.iter().map(from_tuple).collect();
+                    analysis::loop_margins_from(sys, fmus, &connection, points, &opts)?
+                }
+                None => analysis::loop_margins(sys, fmus, &connection, &opts)?,
+            };
             let written = match &output {
                 Some(dir) => Some(analysis::write_margins(dir, &points, &m, &connection)?),
                 None => None,

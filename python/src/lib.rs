@@ -1247,6 +1247,8 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<session::PyCheckpoint>()?;
     m.add_function(wrap_pyfunction!(session::replay, m)?)?;
     m.add_function(wrap_pyfunction!(analysis::loop_margins, m)?)?;
+    m.add_function(wrap_pyfunction!(analysis::loop_grid, m)?)?;
+    m.add_function(wrap_pyfunction!(analysis::loop_points, m)?)?;
     m.add_function(wrap_pyfunction!(analysis::frequency_response, m)?)?;
     m.add_function(wrap_pyfunction!(analysis::describing_function, m)?)?;
     // Isolated FMU instances (`isolate=`, `isolate = true`, campaigns' foreign FMUs) run in

@@ -622,3 +622,23 @@ def test_python_loop_margins_heading():
                  periods=HEADING_PERIODS, settle=SETTLE)
     check_margins({k: v for k, v in got.items() if k != "table"}, "heading")
     check_loop_table(got["table"].to_dict("records"), "heading")
+
+
+def test_loop_margins_on_dask_equal_the_local_analysis():
+    """System.loop_margins(client=...): the grid's forks run on a LocalCluster of 2 worker
+    processes and the crossings are refined here; margins and table equal the local analysis
+    bit for bit (each fork starts from the same state, whatever process runs it)."""
+    import distributed
+    import shipsim
+
+    s = shipsim.System.load(ROOT / "systems" / "autopilot_current.toml")
+    s.set("sensors.noise_scale", 0)
+    kwargs = dict(frequencies=np.geomspace(0.02, 1.5, 12), amplitude=0.01, periods=4, settle=300)
+    local = s.loop_margins("ap.rudder_command -> gear.rudder_command", **kwargs)
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                  dashboard_address=":0") as cluster, distributed.Client(cluster) as client:
+        remote = s.loop_margins("ap.rudder_command -> gear.rudder_command", client=client, **kwargs)
+    for key in ["gain_margin_db", "phase_margin_deg", "crossover_rad_s", "delay_margin_s",
+                "gain_margin_rad_s", "sensitivity_peak"]:
+        assert remote[key] == local[key], key
+    assert remote["table"].equals(local["table"])

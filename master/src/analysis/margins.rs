@@ -112,7 +112,17 @@ fn crossing(
 
 /// Measures L on the grid, refines every crossing and computes the margins.
 pub fn measure(work: &Work, freqs: &[f64], opts: &Options) -> Result<(Vec<LoopPoint>, Margins)> {
-    let mut points = work.loop_points(freqs, opts.amplitude, opts.linearity)?;
+    let points = work.loop_points(freqs, opts.amplitude, opts.linearity)?;
+    refine_all(work, points, opts)
+}
+
+/// Refines every crossing of measured grid `points` (measured here or elsewhere: a Dask
+/// worker's points are the same bits) and computes the margins.
+pub fn refine_all(
+    work: &Work,
+    mut points: Vec<LoopPoint>,
+    opts: &Options,
+) -> Result<(Vec<LoopPoint>, Margins)> {
     sort(&mut points);
     let kinds: [(fn(Complex64) -> f64, bool); 2] = [(gain_db, false), (phase_from_180, true)];
     let mut refined = Vec::new();

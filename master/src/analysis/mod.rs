@@ -265,13 +265,65 @@ pub fn loop_margins(
     opts: &Options,
 ) -> Result<(Vec<LoopPoint>, Margins)> {
     let freqs = frequencies(opts, system.step_size)?;
+    let (plan, base) = loop_base(system, fmus, connection, &freqs, opts)?;
+    let work = fork::Work::new(&plan, &base, 2.0 * opts.amplitude)?;
+    pool(opts.jobs, || margins::measure(&work, &freqs, opts))?
+}
+
+/// The frequencies an analysis with `opts` measures on its grid: given, or the default range
+/// for the system's step (what a caller that splits the grid into chunks splits).
+pub fn grid(system: &System, opts: &Options) -> Result<Vec<f64>> {
+    frequencies(opts, system.step_size)
+}
+
+/// The loop's points at `chunk`, a part of the grid of `opts` (no refinement): what a Dask
+/// worker measures. The system is prepared for the whole grid, so that every chunk's forks are
+/// the forks of [`loop_margins`], bit for bit.
+pub fn loop_points(
+    system: &System,
+    fmus: &[Arc<Fmu>],
+    connection: &str,
+    chunk: &[f64],
+    opts: &Options,
+) -> Result<Vec<LoopPoint>> {
+    let freqs = frequencies(opts, system.step_size)?;
+    let (plan, base) = loop_base(system, fmus, connection, &freqs, opts)?;
+    let work = fork::Work::new(&plan, &base, 2.0 * opts.amplitude)?;
+    pool(opts.jobs, || {
+        work.loop_points(chunk, opts.amplitude, opts.linearity)
+    })?
+}
+
+/// [`loop_margins`] from grid points measured elsewhere ([`loop_points`]): the crossings are
+/// refined here.
+pub fn loop_margins_from(
+    system: &System,
+    fmus: &[Arc<Fmu>],
+    connection: &str,
+    grid_points: Vec<LoopPoint>,
+    opts: &Options,
+) -> Result<(Vec<LoopPoint>, Margins)> {
+    let freqs = frequencies(opts, system.step_size)?;
+    let (plan, base) = loop_base(system, fmus, connection, &freqs, opts)?;
+    let work = fork::Work::new(&plan, &base, 2.0 * opts.amplitude)?;
+    pool(opts.jobs, || margins::refine_all(&work, grid_points, opts))?
+}
+
+/// The plan and prepared system of a loop analysis over `freqs` (its stop time covers the
+/// fork of the lowest frequency).
+fn loop_base(
+    system: &System,
+    fmus: &[Arc<Fmu>],
+    connection: &str,
+    freqs: &[f64],
+    opts: &Options,
+) -> Result<(fork::Plan, Base)> {
     let injection = Injection::Connection(connection.to_string());
     let plan = fork::Plan::new(system, fmus, &injection, &[], opts)?;
     let lowest = freqs.iter().copied().fold(f64::INFINITY, f64::min);
     let max = plan.length(lowest).total();
     let base = prepare(system, fmus, plan.variables(), max, opts)?;
-    let work = fork::Work::new(&plan, &base, 2.0 * opts.amplitude)?;
-    pool(opts.jobs, || margins::measure(&work, &freqs, opts))?
+    Ok((plan, base))
 }
 
 /// The describing function from `input` to `output` at `omega` over `amplitudes`.
