@@ -6,7 +6,8 @@ use crate::plot::{color, create_parent_dir, drawing_error, register_font, Area};
 use plotters::prelude::*;
 use std::path::Path;
 
-/// A named response over ω: (name, ω [rad/s], gain [dB], phase [deg]).
+/// A named response over ω (or over the amplitude, for a describing function): (name, x,
+/// gain [dB], phase [deg]).
 pub struct Curve {
     pub name: String,
     pub omega: Vec<f64>,
@@ -20,12 +21,24 @@ pub struct Marker {
     pub label: String,
 }
 
-/// Writes the chart (1100 × 760 px) to `path`.
+/// Writes the chart (1100 × 760 px) to `path`, over frequency [rad/s].
 pub fn bode(path: &Path, title: &str, curves: &[Curve], markers: &[Marker]) -> Result<()> {
+    chart(path, title, "frequency [rad/s]", curves, markers)
+}
+
+/// The same chart over another logarithmic axis (`x_desc`: the amplitude of a describing
+/// function).
+pub fn chart(
+    path: &Path,
+    title: &str,
+    x_desc: &str,
+    curves: &[Curve],
+    markers: &[Marker],
+) -> Result<()> {
     register_font();
     let path = &crate::output_path::writable(path)?;
     create_parent_dir(path)?;
-    draw(path, title, curves, markers)
+    draw(path, (title, x_desc), curves, markers)
         .map_err(|e| Error::Other(format!("plot {}: {e}", path.display())))
 }
 
@@ -41,7 +54,12 @@ fn range(values: impl Iterator<Item = f64>) -> (f64, f64) {
     }
 }
 
-fn draw(path: &Path, title: &str, curves: &[Curve], markers: &[Marker]) -> Result<()> {
+fn draw(
+    path: &Path,
+    (title, x_desc): (&str, &str),
+    curves: &[Curve],
+    markers: &[Marker],
+) -> Result<()> {
     let root = BitMapBackend::new(path, (1100, 760)).into_drawing_area();
     root.fill(&WHITE).map_err(drawing_error)?;
     let root = root
@@ -51,8 +69,8 @@ fn draw(path: &Path, title: &str, curves: &[Curve], markers: &[Marker]) -> Resul
     let w = range(curves.iter().flat_map(|c| c.omega.iter().copied()));
     let gain = |c: &Curve| c.gain_db.clone();
     let phase = |c: &Curve| c.phase_deg.clone();
-    panel(&top, w, "gain [dB]", curves, gain, markers)?;
-    panel(&bottom, w, "phase [deg]", curves, phase, markers)?;
+    panel(&top, w, (x_desc, "gain [dB]"), curves, gain, markers)?;
+    panel(&bottom, w, (x_desc, "phase [deg]"), curves, phase, markers)?;
     root.present().map_err(drawing_error)?;
     Ok(())
 }
@@ -60,7 +78,7 @@ fn draw(path: &Path, title: &str, curves: &[Curve], markers: &[Marker]) -> Resul
 fn panel(
     area: &Area,
     (w0, w1): (f64, f64),
-    y_desc: &str,
+    (x_desc, y_desc): (&str, &str),
     curves: &[Curve],
     y: impl Fn(&Curve) -> Vec<f64>,
     markers: &[Marker],
@@ -76,7 +94,7 @@ fn panel(
         .map_err(drawing_error)?;
     chart
         .configure_mesh()
-        .x_desc("frequency [rad/s]")
+        .x_desc(x_desc)
         .y_desc(y_desc)
         .label_style(("sans-serif", 14))
         .draw()

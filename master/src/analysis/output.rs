@@ -1,12 +1,12 @@
 //! The analysis's files: tables (CSV and Parquet, the campaign tables' writers) and plots (a
-//! Bode plot against log10 ω, a Nyquist plot with equal axes, the describing function against
-//! the amplitude), into one folder.
+//! Bode plot over a logarithmic frequency axis, a Nyquist plot with equal axes, the describing
+//! function over a logarithmic amplitude axis), into one folder.
 
-use super::bode::{bode, Curve, Marker};
+use super::bode::{bode, chart, Curve, Marker};
 use super::{DescribingPoint, LoopPoint, Margins, OutputResponse, ResponsePoint};
 use crate::campaign::table::{ColumnData, Table};
 use crate::error::{Error, Result};
-use crate::plot::{plot_figure, Panel, Series, Track};
+use crate::plot::{plot_figure, Series, Track};
 use num_complex::Complex64;
 use std::path::{Path, PathBuf};
 
@@ -306,25 +306,16 @@ pub fn write_describing(dir: &Path, points: &[DescribingPoint], title: &str) -> 
         .iter()
         .flat_map(|p| p.outputs.iter().map(move |o| (p.amplitude, o)))
         .collect();
-    let a: Vec<f64> = points.iter().map(|p| p.amplitude).collect();
-    let panel = |label: &str, f: fn(Complex64) -> f64| Panel {
-        y_label: label.into(),
-        series: vec![Series {
-            label: rows.first().map(|r| r.1.name.clone()).unwrap_or_default(),
-            t: a.clone(),
-            y: points.iter().map(|p| f(p.outputs[0].ratio)).collect(),
-        }],
+    let name = rows.first().map(|r| r.1.name.clone()).unwrap_or_default();
+    let ratios: Vec<Complex64> = points.iter().map(|p| p.outputs[0].ratio).collect();
+    let curve = Curve {
+        name,
+        omega: points.iter().map(|p| p.amplitude).collect(),
+        gain_db: ratios.iter().map(|x| db(*x)).collect(),
+        phase_deg: unwrapped(ratios.iter().copied()),
     };
     let png = dir.join("describing.png");
-    plot_figure(
-        &png,
-        &format!("{title} (x: amplitude)"),
-        &[
-            panel("gain N(A)", |c| c.norm()),
-            panel("phase [deg]", |c| c.arg().to_degrees()),
-        ],
-        &[],
-    )?;
+    chart(&png, title, "amplitude of the sinusoid", &[curve], &[])?;
     Ok(Written {
         table,
         parquet,
