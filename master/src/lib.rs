@@ -53,6 +53,7 @@ pub mod log;
 pub mod model_description;
 pub mod output_path;
 pub mod plot;
+pub mod realtime;
 pub mod results;
 pub mod run;
 pub mod slave;

@@ -363,7 +363,7 @@ impl Context<'_> {
                 })?;
                 let f = std::fs::File::create(&path)
                     .map_err(|e| Error::io(format!("cannot create {}", path.display()), e))?;
-                let w = Box::new(std::io::BufWriter::new(f));
+                let w: Box<dyn std::io::Write> = Box::new(std::io::BufWriter::new(f));
                 Some((CsvRecorder::new(w), s.decimation as u64, 0))
             }
             _ => None,

@@ -102,13 +102,16 @@ pub trait Recorder {
 ///
 /// The output is flushed at least once a second of wall time ([`FlushClock`]), so a process
 /// killed by a crashing FMU loses at most about the last second of rows.
-pub struct CsvRecorder {
-    out: Box<dyn Write>,
+///
+/// The writer is any `Write` (by default a boxed one); a stepping session that streams its rows
+/// ([`super::Session::record_into`]) needs one that is `Send`.
+pub struct CsvRecorder<W: Write = Box<dyn Write>> {
+    out: W,
     clock: FlushClock,
 }
 
-impl CsvRecorder {
-    pub fn new(out: Box<dyn Write>) -> CsvRecorder {
+impl<W: Write> CsvRecorder<W> {
+    pub fn new(out: W) -> CsvRecorder<W> {
         CsvRecorder {
             out,
             clock: FlushClock::new(std::time::Duration::from_secs(1)),
@@ -255,7 +258,7 @@ fn write_error(e: std::io::Error) -> Error {
     Error::io("writing the output file", e)
 }
 
-impl Recorder for CsvRecorder {
+impl<W: Write> Recorder for CsvRecorder<W> {
     fn start(&mut self, columns: &[ColumnInfo], _expected_rows: u64) -> Result<()> {
         let header_error = |e| Error::io("writing the output header", e);
         let mut w = csv::WriterBuilder::new()

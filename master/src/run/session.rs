@@ -91,6 +91,8 @@ pub struct Session {
     values: Values,
     columns: Vec<Column>,
     rows: MemoryRecorder,
+    /// Where the rows go instead of [`Session::rows`] after [`Session::record_into`].
+    stream: Option<Box<dyn Recorder + Send>>,
     row_count: u64,
     grid: TimeGrid,
     /// The next base step: the session is at t_k.
@@ -159,6 +161,7 @@ impl Session {
             values,
             columns,
             rows,
+            stream: None,
             row_count: 1,
             k: 0,
             count: StepCount::default(),
@@ -229,6 +232,31 @@ impl Session {
             let at = self.plan.events.partition_point(|x| x.step <= e.step);
             self.plan.events.insert(at, e);
         }
+    }
+
+    /// Records the session's rows into `recorder` from now on instead of keeping them in
+    /// memory: the recorder is started with the run's columns and gets the row at t_0 at once,
+    /// then every row as the session steps, and is finished when the session closes. For a
+    /// long session (a paced run, [`crate::realtime`]) whose rows must not pile up in memory:
+    /// [`Session::rows`] is then empty, and a checkpoint can be taken (to save it) but not
+    /// restored. Only at t_0, before any value is set.
+    pub fn record_into(&mut self, mut recorder: Box<dyn Recorder + Send>) -> Result<()> {
+        if self.k != 0 || !self.sets.is_empty() || self.stream.is_some() {
+            return Err(Error::Other(
+                "a session records into a recorder only from its start, before any step or set, and once".into(),
+            ));
+        }
+        if let Some(e) = self.unusable_to_read() {
+            return Err(e);
+        }
+        {
+            let r = recorder.as_mut() as &mut dyn Recorder;
+            let mut rec = start_recording(&self.plan, r, &self.columns, 0, self.plan.n_steps)?;
+            rec.row(self.plan.start_time, &self.values)?;
+        }
+        self.rows = MemoryRecorder::new();
+        self.stream = Some(recorder);
+        Ok(())
     }
 
     /// The validation's warnings.
@@ -363,7 +391,10 @@ impl Session {
             slots: std::mem::take(&mut self.slots),
             values: std::mem::take(&mut self.values),
             recording: Some(Recording {
-                recorder: &mut self.rows as &mut dyn Recorder,
+                recorder: match self.stream.as_deref_mut() {
+                    Some(r) => r as &mut dyn Recorder,
+                    None => &mut self.rows as &mut dyn Recorder,
+                },
                 columns: &self.columns,
                 decimation: self.plan.decimation as u64,
                 rows: self.row_count,
@@ -538,7 +569,8 @@ impl Session {
         self.checkpoints += 1;
         let id = self.checkpoints;
         self.journal.checkpoint(id, self.k)?;
-        let n = self.row_count as usize;
+        // A streaming session keeps no rows to copy (and cannot be restored).
+        let n = self.rows.time.len().min(self.row_count as usize);
         Ok(SessionCheckpoint {
             checkpoint: cp,
             session: self.id,
@@ -556,6 +588,12 @@ impl Session {
     pub fn restore(&mut self, cp: &SessionCheckpoint) -> Result<()> {
         if matches!(self.state, State::Failed(_) | State::Closed) {
             return Err(self.unusable("restore a checkpoint").expect("not open"));
+        }
+        if self.stream.is_some() {
+            return Err(Error::Other(format!(
+                "cannot restore the checkpoint at t = {} s: the session streams its rows into a recorder, which cannot take them back",
+                cp.time()
+            )));
         }
         if cp.session != self.id {
             return Err(Error::Other(format!(
@@ -599,6 +637,7 @@ impl Session {
         self.state = State::Closed;
         let end = self.journal.end(self.k);
         let _ = self.rows.finish();
+        let streamed = self.stream.as_mut().map_or(Ok(()), |r| r.finish());
         let slots = std::mem::take(&mut self.slots);
         let mut first_error = None;
         for s in slots {
@@ -610,6 +649,7 @@ impl Session {
             }
         }
         end?;
+        streamed?;
         first_error.map_or(Ok(()), Err)
     }
 
