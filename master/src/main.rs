@@ -113,6 +113,8 @@ enum Command {
         /// Default: no limit.
         #[arg(long, value_name = "SECONDS")]
         call_timeout: Option<f64>,
+        #[command(flatten)]
+        realtime: cli::realtime::RealTimeArgs,
     },
     /// Host one isolated FMU instance for a master (internal: started by `run --isolate`).
     #[command(hide = true)]
@@ -347,6 +349,7 @@ fn dispatch(cmd: Command, session: &Session) -> shipsim::Result<()> {
             limits,
             isolate,
             call_timeout,
+            realtime,
         } => {
             let checkpoints = Checkpoints {
                 at: checkpoint_at.map(parse_checkpoint_at).transpose()?,
@@ -376,6 +379,9 @@ fn dispatch(cmd: Command, session: &Session) -> shipsim::Result<()> {
                 quiet,
                 isolation: cli::isolate::isolation(isolate.as_deref(), call_timeout, &sys)?,
             };
+            if realtime.wanted(&sys) {
+                return run_real_time(sys, &realtime, &flags, &checkpoints, session, &limits);
+            }
             run_cli(&sys, &flags, checkpoints, session, &limits)
         }
         Command::ExportOsp { system, output } => export_osp(&system, output),
@@ -646,6 +652,46 @@ fn run_cli(
         _ => {}
     }
     Ok(())
+}
+
+/// `shipsim run` paced or with `[[io]]` ([`cli::realtime`]): the flags it cannot take are
+/// refused.
+fn run_real_time(
+    sys: System,
+    args: &cli::realtime::RealTimeArgs,
+    flags: &RunFlags,
+    checkpoints: &Checkpoints,
+    session: &Session,
+    limits: &LimitArgs,
+) -> shipsim::Result<()> {
+    if flags.profile.is_some() || checkpoints.at.is_some() || checkpoints.resume.is_some() {
+        return Err(Error::Other(
+            "a paced or I/O run takes neither --profile, --checkpoint-at nor --resume (use --checkpoint-every T)".into(),
+        ));
+    }
+    let output = match flags.no_output {
+        true => None,
+        false => flags.output.clone().or_else(|| sys.output.file.clone()),
+    };
+    if let Some(f) = &output {
+        refuse_input(&sys, "output file", f)?;
+    }
+    if !flags.quiet {
+        sys.notes.iter().for_each(|n| eprintln!("note: {n}"));
+    }
+    let cx = cli::realtime::Context {
+        output,
+        run: RunOptions {
+            verbose: flags.verbose,
+            interrupt: Some(session.interrupt.clone()),
+            isolation: flags.isolation.clone(),
+            monitor: Some(cli::isolate::guard(flags.isolation.call_timeout)),
+            ..Default::default()
+        },
+        unpack: session.unpack(limits),
+        quiet: flags.quiet,
+    };
+    cli::realtime::run(sys, args, cx)
 }
 
 /// A file the run writes (`what`: "output file") must not be one it reads: the system file or

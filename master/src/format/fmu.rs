@@ -68,5 +68,6 @@ pub fn load(path: &Path) -> Result<System> {
         last_step: Default::default(),
         archive: None,
         notes: vec![note],
+        io: Vec::new(),
     })
 }

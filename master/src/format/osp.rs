@@ -239,6 +239,7 @@ pub fn parse(path: &Path, text: &str) -> Result<System> {
         last_step: Default::default(),
         archive: None,
         notes: Vec::new(),
+        io: Vec::new(),
     })
 }
 

@@ -97,6 +97,9 @@ struct RawSystem {
     events: Vec<Spanned<RawEvent>>,
     #[serde(default)]
     output: Option<RawOutput>,
+    /// `[[io]]`: channels on the wire for a paced or I/O run ([`crate::system::io`]).
+    #[serde(default)]
+    io: Vec<crate::system::io::IoSpec>,
 }
 
 #[derive(Deserialize)]
@@ -223,6 +226,7 @@ pub fn parse(path: &Path, text: &str) -> Result<System> {
         last_step,
         archive: None,
         notes: Vec::new(),
+        io: raw.io,
     })
 }
 

@@ -13,6 +13,7 @@ use crate::error::{did_you_mean, Error, Result};
 use crate::fmu::UnpackedFmu;
 use std::path::PathBuf;
 
+pub mod io;
 pub mod last_step;
 pub mod plan;
 pub mod validate;
@@ -277,6 +278,9 @@ pub struct System {
     /// What the reader chose for the user where the file does not say (`shipsim run` prints
     /// them): an FMU run alone names its time span and output file.
     pub notes: Vec<String>,
+    /// The `[[io]]` channels of a native TOML file ([`io`]): used by a paced or I/O run
+    /// ([`crate::realtime`]), ignored by every other.
+    pub io: Vec<io::IoSpec>,
 }
 
 /// How a run whose file gives no step size (an SSD without a fixed-step master annotation:

@@ -130,6 +130,7 @@ impl Reader<'_> {
             last_step: Default::default(),
             archive: None,
             notes: Vec::new(),
+            io: Vec::new(),
         })
     }
 
