@@ -1,0 +1,276 @@
+//! Real-time runs end to end through the CLI, on loopback with ports chosen by the OS, every
+//! loop bounded and every run under a time limit (`shipsim_in`: 60 s):
+//!
+//! - a bench autopilot's HTC and then OpenCPN's APB turn the ship of systems/hil_heading.toml
+//!   to the commanded heading, and the journal replays the paced session bit for bit;
+//! - a hostile stream (bad checksums, garbage, NaN fields, 10^5 datagrams, a sender that goes
+//!   quiet) leaves the run to complete with the rejections counted in its summary;
+//! - a paced run of N s takes N s plus start-up.
+mod common;
+use common::*;
+use std::net::UdpSocket;
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+fn sentence(body: &str) -> Vec<u8> {
+    let mut s = String::new();
+    shipsim::realtime::nmea::frame(&mut s, body);
+    s.into_bytes()
+}
+
+/// A UDP port free on loopback now.
+fn free_port() -> u16 {
+    UdpSocket::bind("127.0.0.1:0")
+        .unwrap()
+        .local_addr()
+        .unwrap()
+        .port()
+}
+
+/// systems/hil_heading.toml with our FMUs, its ports replaced and `extra` appended to the
+/// nmea-in inputs' table text replaced by `inputs` when given.
+fn hil(dir: &Path, out_port: u16, in_port: u16, inputs: Option<&str>) -> PathBuf {
+    let text = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../systems/hil_heading.toml"),
+    )
+    .unwrap();
+    let fmu_dir = our_fmu("NomotoShip").parent().unwrap().to_path_buf();
+    let mut text = text
+        .replace("../target/fmu/", &format!("{}/", fmu_dir.display()))
+        .replace("127.0.0.1:10110", &format!("127.0.0.1:{out_port}"))
+        .replace("127.0.0.1:10111", &format!("127.0.0.1:{in_port}"))
+        .replace("../target/demo/hil_heading.csv", "hil.csv");
+    if let Some(i) = inputs {
+        let at = text.find("inputs = [").unwrap();
+        text = format!("{}{i}\n", &text[..at]);
+    }
+    write_system(dir, "hil.toml", &text)
+}
+
+/// The UTC seconds of day of the GGA sentences in a datagram (the simulated time + 12 h).
+fn gga_time(d: &str) -> Option<f64> {
+    let line = d.lines().find(|l| l.contains("GGA,"))?;
+    let t = line.split(',').nth(1)?;
+    let (h, m, s): (f64, f64, f64) = (
+        t[..2].parse().ok()?,
+        t[2..4].parse().ok()?,
+        t[4..].parse().ok()?,
+    );
+    Some(h * 3600.0 + m * 60.0 + s - 12.0 * 3600.0)
+}
+
+#[test]
+fn htc_then_apb_turn_the_ship_and_the_session_replays() {
+    let dir = tempfile::tempdir().unwrap();
+    let (out_port, in_port) = (free_port(), free_port());
+    let sys = hil(dir.path(), out_port, in_port, None);
+    let rx = UdpSocket::bind(("127.0.0.1", out_port)).unwrap();
+    rx.set_read_timeout(Some(Duration::from_millis(200)))
+        .unwrap();
+    let sender = std::thread::spawn(move || {
+        let tx = UdpSocket::bind("127.0.0.1:0").unwrap();
+        let to = ("127.0.0.1", in_port);
+        let (mut htc, mut apb) = (false, false);
+        let mut buf = [0u8; 4096];
+        let end = Instant::now() + Duration::from_secs(40);
+        while Instant::now() < end && !apb {
+            let Ok(n) = rx.recv(&mut buf) else { continue };
+            let t = gga_time(std::str::from_utf8(&buf[..n]).unwrap()).unwrap_or(0.0);
+            if !htc {
+                // A bench autopilot: heading control, heading to steer 30 deg, null rudder.
+                tx.send_to(&sentence("APHTC,V,,,H,N,,,,,30.0,,,T"), to)
+                    .unwrap();
+                htc = true;
+            } else if t >= 40.0 {
+                // OpenCPN following a route: heading to steer 350 deg (10 deg to port of north).
+                let s = sentence("ECAPB,A,A,0.010,L,N,V,V,350.0,T,002,350.0,T,350.0,T,A");
+                tx.send_to(&s, to).unwrap();
+                apb = true;
+            }
+        }
+        (htc, apb)
+    });
+    let (ok, err) = shipsim_in(
+        dir.path(),
+        &[
+            "run",
+            sys.to_str().unwrap(),
+            "--real-time-factor",
+            "8",
+            "--stop-time",
+            "120",
+        ],
+    );
+    assert!(ok, "{err}");
+    assert_eq!(sender.join().unwrap(), (true, true));
+    eprintln!("{err}");
+    let (h, rows) = read_csv(&dir.path().join("hil.csv"));
+    let (head, used) = (
+        col(&h, "ship.heading"),
+        col(&h, "ap.heading_reference_used"),
+    );
+    let at = |t: f64| rows.iter().find(|r| r[0] >= t).unwrap();
+    // Before the APB the ship steers 30 deg; at the end -10 deg (350 taken nearest).
+    let before_apb = rows
+        .iter()
+        .filter(|r| (r[used] - 30f64.to_radians()).abs() < 1e-12)
+        .count();
+    assert!(before_apb > 200, "HTC's 30 deg held for {before_apb} rows");
+    assert!(
+        (at(40.0)[head].to_degrees() - 30.0).abs() < 3.0,
+        "{}",
+        at(40.0)[head].to_degrees()
+    );
+    let last = rows.last().unwrap();
+    assert!((last[used].to_degrees() + 10.0).abs() < 1e-9);
+    assert!(
+        (last[head].to_degrees() + 10.0).abs() < 1.5,
+        "{}",
+        last[head].to_degrees()
+    );
+    assert!(err.contains("2 input values applied"), "{err}");
+    // The paced session replays bit for bit.
+    let (ok, rerr) = shipsim_in(dir.path(), &["replay", "hil.jsonl", "-o", "replayed.csv"]);
+    assert!(ok, "{rerr}");
+    let a = std::fs::read(dir.path().join("hil.csv")).unwrap();
+    let b = std::fs::read(dir.path().join("replayed.csv")).unwrap();
+    assert!(a == b, "the replay differs from the paced run's CSV");
+}
+
+#[test]
+fn a_hostile_stream_is_counted_and_the_run_completes() {
+    let dir = tempfile::tempdir().unwrap();
+    let (out_port, in_port) = (free_port(), free_port());
+    let inputs = r#"inputs = [
+  { field = "HTC.heading_to_steer", variable = "ap.heading_reference", near = "ship.heading", on_quiet = "fallback", after = 1.5, fallback = 0.0 },
+]"#;
+    let sys = hil(dir.path(), out_port, in_port, Some(inputs));
+    let sender = std::thread::spawn(move || {
+        std::thread::sleep(Duration::from_millis(700));
+        let tx = UdpSocket::bind("127.0.0.1:0").unwrap();
+        let to = ("127.0.0.1", in_port);
+        let body = "APHTC,V,,,H,N,,,,,20.0,,,T";
+        let sum = shipsim::realtime::nmea::checksum(body.as_bytes()) ^ 0x5A;
+        let bad = format!("${body}*{sum:02X}\r\n").into_bytes();
+        let hostile: Vec<Vec<u8>> = vec![
+            bad,
+            b"\xff\x00garbage\r\n".to_vec(),
+            sentence("APHTC,V,,,H,N,,,,,NaN,,,T"),
+            sentence("APHTC,V,,,H,N,,,,,720,,,T"),
+            sentence("APHTC,V,,,H,N,,,,,,,,T"),
+            sentence("GPGGA,1,2"),
+            vec![b'$'; 2000],
+            sentence("APHTC,V,,,H,N,,,,,20.0,,,T"),
+        ];
+        for i in 0..100_000usize {
+            let _ = tx.send_to(&hostile[i % hostile.len()], to);
+        }
+        // Then quiet: the input falls back to 0 after 1.5 s.
+    });
+    let begin = Instant::now();
+    let (ok, err) = shipsim_in(
+        dir.path(),
+        &[
+            "run",
+            sys.to_str().unwrap(),
+            "--real-time-factor",
+            "4",
+            "--stop-time",
+            "24",
+        ],
+    );
+    sender.join().unwrap();
+    assert!(ok, "{err}");
+    eprintln!("{err}");
+    assert!(begin.elapsed() < Duration::from_secs(20));
+    for kind in [
+        "bad checksum",
+        "malformed",
+        "not a number",
+        "out of range",
+        "missing required field",
+        "unknown sentence",
+    ] {
+        assert!(
+            err.contains(&format!("{kind}: ")),
+            "no count of '{kind}' in:\n{err}"
+        );
+    }
+    assert!(err.contains("falls back to 0"), "{err}");
+    // Each kind logged once while it ran.
+    assert_eq!(
+        err.matches("rejected input (bad checksum)").count(),
+        1,
+        "{err}"
+    );
+    let (h, rows) = read_csv(&dir.path().join("hil.csv"));
+    let used = col(&h, "ap.heading_reference_used");
+    assert_eq!(rows.last().unwrap()[used], 0.0);
+}
+
+#[test]
+fn a_quiet_sender_can_end_the_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let inputs = r#"inputs = [ { field = "APB.heading_to_steer", variable = "ap.heading_reference", on_quiet = "end", after = 1.0 } ]"#;
+    let sys = hil(dir.path(), free_port(), free_port(), Some(inputs));
+    let (ok, err) = shipsim_in(
+        dir.path(),
+        &[
+            "run",
+            sys.to_str().unwrap(),
+            "--real-time",
+            "--stop-time",
+            "30",
+        ],
+    );
+    assert!(ok, "{err}");
+    assert!(err.contains("was quiet for 1 s"), "{err}");
+    let (_, rows) = read_csv(&dir.path().join("hil.csv"));
+    let end = rows.last().unwrap()[0];
+    assert!((0.9..3.0).contains(&end), "ended at {end}");
+}
+
+/// A paced RRS run of 4 s takes 4 s plus start-up (loose band: 4 to 7 s on a loaded machine),
+/// and says its lateness.
+#[test]
+fn a_paced_run_takes_its_simulated_time() {
+    let dir = tempfile::tempdir().unwrap();
+    let sys = rrs_file(dir.path());
+    let begin = Instant::now();
+    let (ok, err) = shipsim_in(
+        dir.path(),
+        &[
+            "run",
+            sys.to_str().unwrap(),
+            "--real-time",
+            "--stop-time",
+            "4",
+            "-o",
+            "rrs.csv",
+        ],
+    );
+    let wall = begin.elapsed().as_secs_f64();
+    assert!(ok, "{err}");
+    eprintln!("{err}");
+    assert!((4.0..7.0).contains(&wall), "{wall} s");
+    assert!(
+        err.contains("paced at 1x real time: lateness median"),
+        "{err}"
+    );
+    // Unpaced, the same rows (the session is the run; pacing only waits).
+    let (ok, e2) = shipsim_in(
+        dir.path(),
+        &[
+            "run",
+            sys.to_str().unwrap(),
+            "--stop-time",
+            "4",
+            "-o",
+            "plain.csv",
+        ],
+    );
+    assert!(ok, "{e2}");
+    let a = std::fs::read(dir.path().join("rrs.csv")).unwrap();
+    let b = std::fs::read(dir.path().join("plain.csv")).unwrap();
+    assert!(a == b, "the paced run's CSV differs from the plain run's");
+}
