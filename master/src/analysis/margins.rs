@@ -31,6 +31,9 @@ pub struct Margins {
     pub sensitivity_peak_rad_s: f64,
 }
 
+/// A quantity of L that is zero at a crossing.
+type Measure = fn(Complex64) -> f64;
+
 fn gain_db(l: Complex64) -> f64 {
     20.0 * l.norm().log10()
 }
@@ -124,7 +127,8 @@ pub fn refine_all(
     opts: &Options,
 ) -> Result<(Vec<LoopPoint>, Margins)> {
     sort(&mut points);
-    let kinds: [(fn(Complex64) -> f64, bool); 2] = [(gain_db, false), (phase_from_180, true)];
+    // What crosses zero at a crossing, and whether it is a wrapped phase.
+    let kinds: [(Measure, bool); 2] = [(gain_db, false), (phase_from_180, true)];
     let mut refined = Vec::new();
     for (f, wrapped) in kinds {
         let found: Vec<Vec<LoopPoint>> = brackets(&points, f, wrapped)
