@@ -1122,6 +1122,20 @@ fn rrs_thesis_checks(
         ),
         gm > 0.0 && pm.margin_deg() > 0.0 && dm.delay_s() > rule,
     ));
+    // The tool's margins are the limiting crossings of this table (its nearest-to-−1 rule).
+    let m = &on.margins;
+    let same = |x: Option<f64>, y: f64, tol: f64| x.is_some_and(|x| (x - y).abs() <= tol);
+    c.push(Check::holds(
+        "RRS on: shipsim::analysis's margins are the limiting crossings",
+        "the crossing nearest −1 for GM and PM, the least lag-to-−1 over the crossovers for DM",
+        format!(
+            "tool: GM {:?} dB, PM {:?}°, DM {:?} s",
+            m.gain_margin_db, m.phase_margin_deg, m.delay_margin_s
+        ),
+        same(m.gain_margin_db, gm, 0.01)
+            && same(m.phase_margin_deg, pm.margin_deg(), 0.05)
+            && same(m.delay_margin_s, dm.delay_s(), 0.01),
+    ));
     Ok(())
 }
 
@@ -1218,11 +1232,10 @@ fn rrs_loop_table(on: &RrsLoop, off: &RrsLoop) -> String {
     s += &format!(
         "\n\n{} {} With RRS on the loop crosses |L| = 1 three times: the course loop's crossover, \
          then the roll resonance lifts |L| above 1 with L in the upper half plane, far from −1, \
-         and the roll loop's own crossover. The tool takes the smallest *signed* wrapped phase, \
-         so it reports the middle crossing (L on the far side of −1) as a negative phase margin \
-         and a negative delay margin; the loop is stable (the forks settle, and the Nyquist \
-         curve's crossings of the negative real axis lie right of −1), and its margins are the \
-         per-crossing ones above.\n",
+         and the roll loop's own crossover. The tool lists every crossing and reports the one \
+         nearest −1 (the middle one, with L on the far side of −1, is 149° away), and the least \
+         delay that reaches −1 over all three; the loop is stable (the forks settle, and the \
+         Nyquist curve's crossings of the negative real axis lie right of −1).\n",
         summary("on", on),
         summary("off", off)
     );
