@@ -1128,10 +1128,15 @@ fn rrs_thesis_checks(
     c.push(Check::holds(
         "RRS on: shipsim::analysis's margins are the limiting crossings",
         "the crossing nearest −1 for GM and PM, the least lag-to-−1 over the crossovers for DM",
-        format!(
-            "tool: GM {:?} dB, PM {:?}°, DM {:?} s",
-            m.gain_margin_db, m.phase_margin_deg, m.delay_margin_s
-        ),
+        {
+            let f = |x: Option<f64>, d: usize| x.map_or("none".into(), |v| format!("{v:.d$}"));
+            format!(
+                "tool: GM {} dB, PM {}°, DM {} s",
+                f(m.gain_margin_db, 2),
+                f(m.phase_margin_deg, 1),
+                f(m.delay_margin_s, 2)
+            )
+        },
         same(m.gain_margin_db, gm, 0.01)
             && same(m.phase_margin_deg, pm.margin_deg(), 0.05)
             && same(m.delay_margin_s, dm.delay_s(), 0.01),
