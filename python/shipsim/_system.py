@@ -338,7 +338,10 @@ class System:
 
         Returns a dict: ``gain_margin_db``, ``gain_margin_rad_s``, ``phase_margin_deg``,
         ``crossover_rad_s``, ``delay_margin_s``, ``sensitivity_peak`` (max |1/(1+L)|) and
-        ``sensitivity_peak_rad_s`` (None where the range has no such crossing), and
+        ``sensitivity_peak_rad_s`` (None where the range has no such crossing; with several
+        crossings the one nearest -1, and the least delay over the crossovers),
+        ``gain_crossovers`` and ``phase_crossovers`` (every crossing as (omega, phase margin
+        [deg]) and (omega, gain margin [dB])), and
         ``table``: a DataFrame (omega_rad_s, gain_db, phase_deg, re, im, distortion,
         gain_change_db, phase_change_deg: the change at twice the amplitude, with
         ``linearity``). With ``output``, the tables (CSV, Parquet) and the Bode and Nyquist

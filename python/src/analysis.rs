@@ -167,6 +167,10 @@ pub fn loop_margins<'py>(
     d.set_item("delay_margin_s", m.delay_margin_s)?;
     d.set_item("sensitivity_peak", m.sensitivity_peak)?;
     d.set_item("sensitivity_peak_rad_s", m.sensitivity_peak_rad_s)?;
+    let pairs =
+        |c: &[analysis::Crossing]| c.iter().map(|c| (c.omega, c.margin)).collect::<Vec<_>>();
+    d.set_item("gain_crossovers", pairs(&m.gain_crossovers))?;
+    d.set_item("phase_crossovers", pairs(&m.phase_crossovers))?;
     d.set_item("table", table_dict(py, &analysis::loop_table(&points))?)?;
     set_files(&d, written)?;
     Ok(d)

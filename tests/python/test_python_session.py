@@ -199,27 +199,31 @@ def test_misuse_raises_its_exception():
 
 
 def test_two_threads_stepping_one_session():
+    # A long advance in one thread (about a second: 600,000 macro steps of RRS); the main
+    # thread's calls meanwhile fail at once with SessionError, never wait for it.
     s = shipsim.System.load(RRS)
-    with s.start(stop_time=2000) as session:
-        errors = []
+    with s.start(stop_time=30000, variables=[]) as session:
+        errors, started = [], threading.Event()
 
         def stepper():
-            session.advance_to(1500)
+            started.set()
+            session.advance_to(30000)
 
         t = threading.Thread(target=stepper)
         t.start()
-        time.sleep(0.05)
+        started.wait()
+        time.sleep(0.1)  # the advance holds the session from its first instant
         begin = time.perf_counter()
-        while t.is_alive():
+        while t.is_alive() and not errors:
             try:
                 session.step()
             except shipsim.SessionError as e:
-                errors.append(str(e))
-            time.sleep(0.01)
+                errors.append((str(e), time.perf_counter() - begin))
         t.join()
-        assert time.perf_counter() - begin < 30
-        assert errors and "being stepped by another thread" in errors[0]
-        assert session.time >= 1500
+        assert errors, "the other thread's advance ended before a call could meet it"
+        message, waited = errors[0]
+        assert "being stepped by another thread" in message
+        assert session.time == 30000.0
 
 
 def test_ctrl_c_stops_a_long_advance_and_the_session_goes_on():

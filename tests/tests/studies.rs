@@ -47,3 +47,8 @@ fn path_estimation() {
 fn container_ship_seaway() {
     check("container_ship_seaway");
 }
+
+#[test]
+fn loop_analysis() {
+    check("loop_analysis");
+}

@@ -94,6 +94,7 @@ fn panel(
         .map_err(drawing_error)?;
     chart
         .configure_mesh()
+        .x_label_formatter(&|v| short(*v))
         .x_desc(x_desc)
         .y_desc(y_desc)
         .label_style(("sans-serif", 14))
@@ -129,4 +130,29 @@ fn panel(
         .draw()
         .map_err(drawing_error)?;
     Ok(())
+}
+
+/// A tick value with three significant digits and no trailing zeros (0.3, not
+/// 0.30000000000000004).
+fn short(v: f64) -> String {
+    if v == 0.0 || !v.is_finite() {
+        return format!("{v}");
+    }
+    let decimals = (2 - v.abs().log10().floor() as i32).clamp(0, 12) as usize;
+    let s = format!("{v:.decimals$}");
+    match s.contains('.') {
+        true => s.trim_end_matches('0').trim_end_matches('.').to_string(),
+        false => s,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn ticks_are_short() {
+        assert_eq!(super::short(0.30000000000000004), "0.3");
+        assert_eq!(super::short(0.00123456), "0.00123");
+        assert_eq!(super::short(20.0), "20");
+        assert_eq!(super::short(1.5), "1.5");
+    }
 }

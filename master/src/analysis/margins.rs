@@ -5,7 +5,9 @@
 //! - gain crossover ω_c: |L| = 1; phase margin PM = 180° + ∠L(jω_c) (wrapped to ±180°);
 //!   delay margin PM[rad]/ω_c (a pure delay that uses the phase margin up);
 //! - phase crossover ω_180: ∠L = −180° (mod 360°); gain margin GM = −20·log10|L(jω_180)|;
-//! - with several crossings, the smallest margin is reported (the one that limits);
+//! - with several crossings, each is listed, and the one closest to −1 (the smallest |margin|,
+//!   its sign kept, as MATLAB's `margin` does) is the margin; the delay margin is the least
+//!   delay over the gain crossovers, (180° + ∠L) mod 360° of lag at each;
 //! - the sensitivity peak is max |1/(1 + L)| over the measured points.
 
 use super::fork::Work;
@@ -29,7 +31,21 @@ pub struct Margins {
     pub delay_margin_s: Option<f64>,
     pub sensitivity_peak: f64,
     pub sensitivity_peak_rad_s: f64,
+    /// Every gain crossover (|L| = 1) with its phase margin [deg], in frequency order.
+    pub gain_crossovers: Vec<Crossing>,
+    /// Every phase crossover (angle L = -180 deg) with its gain margin [dB].
+    pub phase_crossovers: Vec<Crossing>,
 }
+
+/// A crossing: its frequency [rad/s] and the margin there.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Crossing {
+    pub omega: f64,
+    pub margin: f64,
+}
+
+/// A quantity of L that is zero at a crossing.
+type Measure = fn(Complex64) -> f64;
 
 fn gain_db(l: Complex64) -> f64 {
     20.0 * l.norm().log10()
@@ -124,7 +140,8 @@ pub fn refine_all(
     opts: &Options,
 ) -> Result<(Vec<LoopPoint>, Margins)> {
     sort(&mut points);
-    let kinds: [(fn(Complex64) -> f64, bool); 2] = [(gain_db, false), (phase_from_180, true)];
+    // What crosses zero at a crossing, and whether it is a wrapped phase.
+    let kinds: [(Measure, bool); 2] = [(gain_db, false), (phase_from_180, true)];
     let mut refined = Vec::new();
     for (f, wrapped) in kinds {
         let found: Vec<Vec<LoopPoint>> = brackets(&points, f, wrapped)
@@ -159,22 +176,37 @@ pub fn margins(points: &[LoopPoint]) -> Margins {
     for w in points.windows(2) {
         let (a, b) = (&w[0], &w[1]);
         if gain_db(a.l).signum() != gain_db(b.l).signum() {
-            let (wc, pm) = crossing(a, b, gain_db, |p| phase_from_180(p.l));
-            if m.phase_margin_deg.is_none_or(|x| pm < x) {
-                m.phase_margin_deg = Some(pm);
-                m.crossover_rad_s = Some(wc);
-                m.delay_margin_s = Some(pm.to_radians() / wc);
-            }
+            let (omega, pm) = crossing(a, b, gain_db, |p| phase_from_180(p.l));
+            m.gain_crossovers.push(Crossing { omega, margin: pm });
         }
         let (pa, pb) = (phase_from_180(a.l), phase_from_180(b.l));
         if pa.signum() != pb.signum() && pa.abs() < 90.0 && pb.abs() < 90.0 {
-            let (w180, g) = crossing(a, b, phase_from_180, |p| gain_db(p.l));
-            if m.gain_margin_db.is_none_or(|x| -g < x) {
-                m.gain_margin_db = Some(-g);
-                m.gain_margin_rad_s = Some(w180);
-            }
+            let (omega, g) = crossing(a, b, phase_from_180, |p| gain_db(p.l));
+            m.phase_crossovers.push(Crossing { omega, margin: -g });
         }
     }
+    // The margin that limits: the crossing closest to -1 (the smallest |margin|, its sign
+    // kept, as MATLAB's `margin` reports it).
+    let closest = |c: &[Crossing]| {
+        c.iter()
+            .min_by(|x, y| x.margin.abs().total_cmp(&y.margin.abs()))
+            .cloned()
+    };
+    if let Some(c) = closest(&m.gain_crossovers) {
+        m.phase_margin_deg = Some(c.margin);
+        m.crossover_rad_s = Some(c.omega);
+    }
+    if let Some(c) = closest(&m.phase_crossovers) {
+        m.gain_margin_db = Some(c.margin);
+        m.gain_margin_rad_s = Some(c.omega);
+    }
+    // A delay only lags: at each gain crossover it takes (180 deg + angle L) mod 360 deg of lag
+    // to reach -1; the delay margin is the least such delay over the crossovers.
+    m.delay_margin_s = m
+        .gain_crossovers
+        .iter()
+        .map(|c| c.margin.rem_euclid(360.0).to_radians() / c.omega)
+        .min_by(f64::total_cmp);
     let peak = points
         .iter()
         .map(|p| (1.0 / (1.0 + p.l).norm(), p.omega))
@@ -221,5 +253,36 @@ mod tests {
         let dm = m.phase_margin_deg.unwrap().to_radians() / m.crossover_rad_s.unwrap();
         assert_eq!(m.delay_margin_s, Some(dm));
         assert!(m.sensitivity_peak > 1.0);
+    }
+
+    /// Three gain crossovers, one of them with L above the real axis (the RRS roll loop's
+    /// shape): the phase margin is the crossing nearest -1, the delay margin the least lag to
+    /// -1 over all three, both positive for this stable loop.
+    #[test]
+    fn several_crossovers_give_the_nearest_margin_and_the_least_delay() {
+        let p = |w: f64, gain: f64, phase_deg: f64| LoopPoint {
+            omega: w,
+            l: Complex64::from_polar(gain, phase_deg.to_radians()),
+            distortion: 0.0,
+            gain_change_db: None,
+            phase_change_deg: None,
+        };
+        let points = [
+            p(0.09, 1.1, -129.5),
+            p(0.11, 0.9, -129.5),
+            p(0.52, 0.9, 31.0),
+            p(0.55, 1.1, 31.0),
+            p(0.75, 1.1, -116.3),
+            p(0.78, 0.9, -116.3),
+        ];
+        let m = margins(&points);
+        assert_eq!(m.gain_crossovers.len(), 3);
+        assert!((m.phase_margin_deg.unwrap() - 50.5).abs() < 1e-9, "{m:?}");
+        assert!((m.crossover_rad_s.unwrap() - 0.1).abs() < 0.002, "{m:?}");
+        let roll = m.gain_crossovers[2];
+        let dm = 63.7f64.to_radians() / roll.omega;
+        assert!((m.delay_margin_s.unwrap() - dm).abs() < 1e-9, "{m:?}");
+        let upper = m.gain_crossovers[1];
+        assert!((upper.margin + 149.0).abs() < 1e-9 && upper.omega > 0.52);
     }
 }

@@ -28,7 +28,7 @@ mod fork;
 mod margins;
 mod output;
 
-pub use margins::Margins;
+pub use margins::{Crossing, Margins};
 pub use output::{
     describing_table, loop_table, response_table, write_describing, write_margins, write_response,
     Written,

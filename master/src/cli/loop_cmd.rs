@@ -197,6 +197,8 @@ fn margins(
         "delay_margin_s": opt(m.delay_margin_s),
         "sensitivity_peak": m.sensitivity_peak,
         "sensitivity_peak_rad_s": m.sensitivity_peak_rad_s,
+        "gain_crossovers": m.gain_crossovers.iter().map(|c| serde_json::json!({"omega_rad_s": c.omega, "phase_margin_deg": c.margin})).collect::<Vec<_>>(),
+        "phase_crossovers": m.phase_crossovers.iter().map(|c| serde_json::json!({"omega_rad_s": c.omega, "gain_margin_db": c.margin})).collect::<Vec<_>>(),
         "points": points.len(),
         "table": written.table,
         "parquet": written.parquet,

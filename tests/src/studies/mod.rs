@@ -11,6 +11,7 @@ pub mod autopilot_robustness;
 pub mod container_ship_seaway;
 pub mod dgps_trial;
 pub mod dp_observer;
+pub mod loop_analysis;
 mod path_common;
 pub mod path_control;
 pub mod path_estimation;
@@ -30,6 +31,7 @@ pub const STUDIES: &[Study] = &[
     ("autopilot", autopilot::run),
     ("path_estimation", path_estimation::run),
     ("container_ship_seaway", container_ship_seaway::run),
+    ("loop_analysis", loop_analysis::run),
 ];
 
 /// Studies in the report only (`cargo xtask report`): campaigns too long for the test suite,
