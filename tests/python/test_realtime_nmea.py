@@ -4,8 +4,8 @@ ports chosen by the OS, every run under a time limit):
 - pynmea2 parses every sentence, checksums included;
 - gpsd, started here on loopback, reads our UDP NMEA, and `gpspipe -w` reports the latitude,
   longitude, course and speed that the run's CSV implies at the same simulated time, within the
-  sentences' precision. Without gpsd the test says in one line what it did not check (and fails
-  with CI=true).
+  sentences' precision. Without gpsd (or pynmea2) a test says in one line what it did not check
+  and how to install it (and fails with CI=true).
 
 Environment: SHIPSIM_BIN (the master), SHIPSIM_FMU_DIR (our built FMUs).
 """
@@ -54,8 +54,20 @@ def run(tmp, system, factor, stop):
     )
 
 
+def missing(msg):
+    """A missing tool: one line of what was not checked and how to get it; a failure in CI."""
+    if os.environ.get("CI") == "true":
+        pytest.fail(msg)
+    print(msg)
+    pytest.skip(msg)
+
+
 def test_pynmea2_parses_every_sentence(tmp_path):
-    pynmea2 = pytest.importorskip("pynmea2")
+    try:
+        import pynmea2
+    except ImportError:
+        missing("pynmea2 missing: not checked that pynmea2 parses every NMEA sentence we send "
+                "(pip install pynmea2==1.19.0, tests/python/requirements.txt)")
     out_port = free_port()
     system = hil(tmp_path, out_port, free_port())
     rx = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
@@ -110,11 +122,8 @@ def plane(lat0, lon0, north, east):
 def test_gpsd_reads_our_nmea(tmp_path):
     gpsd, gpspipe = shutil.which("gpsd") or shutil.which("gpsd", path="/usr/sbin"), shutil.which("gpspipe")
     if not (gpsd and gpspipe):
-        msg = "gpsd/gpspipe missing: not checked that gpsd reads our UDP NMEA and reports the CSV's lat/lon/course/speed"
-        if os.environ.get("CI") == "true":
-            pytest.fail(msg)
-        print(msg)
-        pytest.skip(msg)
+        missing("gpsd/gpspipe missing: not checked that gpsd reads our UDP NMEA and reports the CSV's "
+                "lat/lon/course/speed (apt-get install gpsd gpsd-clients)")
     out_port, gpsd_port = free_port(), free_port(socket.SOCK_STREAM)
     system = hil(tmp_path, out_port, free_port())
     daemon = subprocess.Popen([gpsd, "-N", "-n", "-G", "-S", str(gpsd_port), f"udp://127.0.0.1:{out_port}"],
