@@ -274,3 +274,48 @@ fn a_paced_run_takes_its_simulated_time() {
     let b = std::fs::read(dir.path().join("plain.csv")).unwrap();
     assert!(a == b, "the paced run's CSV differs from the plain run's");
 }
+
+/// A paced run flushes its journal at most a wall second apart: an HTC sent early in a 6 s run
+/// is in the journal's file 2.5 s later, while the run still goes (a crash loses at most a
+/// second of inputs).
+#[test]
+fn a_paced_run_flushes_its_journal_every_second() {
+    let dir = tempfile::tempdir().unwrap();
+    let (out_port, in_port) = (free_port(), free_port());
+    let sys = hil(dir.path(), out_port, in_port, None);
+    let rx = UdpSocket::bind(("127.0.0.1", out_port)).unwrap();
+    rx.set_read_timeout(Some(Duration::from_millis(200)))
+        .unwrap();
+    let journal = dir.path().join("hil.jsonl");
+    let watcher = std::thread::spawn(move || {
+        let mut buf = [0u8; 4096];
+        let end = Instant::now() + Duration::from_secs(30);
+        while Instant::now() < end && rx.recv(&mut buf).is_err() {}
+        // The run is under way (it sent its first datagram): command a heading.
+        let tx = UdpSocket::bind("127.0.0.1:0").unwrap();
+        tx.send_to(
+            &sentence("APHTC,V,,,H,N,,,,,30.0,,,T"),
+            ("127.0.0.1", in_port),
+        )
+        .unwrap();
+        std::thread::sleep(Duration::from_millis(2500));
+        std::fs::read_to_string(&journal).unwrap_or_default()
+    });
+    let (ok, err) = shipsim_in(
+        dir.path(),
+        &[
+            "run",
+            sys.to_str().unwrap(),
+            "--real-time",
+            "--stop-time",
+            "6",
+        ],
+    );
+    let mid_run = watcher.join().unwrap();
+    assert!(ok, "{err}");
+    assert!(err.contains("1 input values applied"), "{err}");
+    assert!(
+        mid_run.contains(r#""record":"set""#) && !mid_run.contains(r#""record":"end""#),
+        "the journal 2.5 s after the HTC, mid-run:\n{mid_run}"
+    );
+}

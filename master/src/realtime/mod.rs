@@ -28,6 +28,10 @@ use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
+/// A real-time run writes the journal's buffered records to its file at most this often (so
+/// that a crash loses at most this much of the inputs; a flush is one `write` call).
+pub const JOURNAL_FLUSH_EVERY: Duration = Duration::from_secs(1);
+
 /// How a real-time run goes.
 #[derive(Clone)]
 pub struct RealTimeOptions {
@@ -76,6 +80,8 @@ pub struct Report {
     /// Why the run ended before its stop time (an input's quiet rule, an FMU).
     pub ended_by: Option<String>,
     pub checkpoints: Vec<PathBuf>,
+    /// The journal's flushes during the run (one per [`JOURNAL_FLUSH_EVERY`] at most).
+    pub journal_flushes: u64,
 }
 
 impl std::fmt::Display for Report {
@@ -147,6 +153,8 @@ pub fn run(session: &mut Session, io: &[IoSpec], opts: &RealTimeOptions) -> Resu
         last_note: None,
         noted_overruns: 0,
         waiting_datagram: Vec::new(),
+        last_flush: Instant::now(),
+        journal_flushes: 0,
         next_checkpoint: opts
             .checkpoint_every
             .as_ref()
@@ -166,6 +174,7 @@ pub fn run(session: &mut Session, io: &[IoSpec], opts: &RealTimeOptions) -> Resu
     d.report.rejected = inputs.rejections();
     d.report.applied = inputs.applied;
     d.report.datagrams_sent = outputs.sent;
+    d.report.journal_flushes = d.journal_flushes;
     if let Some(p) = d.pacer.take() {
         d.report.lateness = p.lateness;
         d.report.overruns = p.overruns;
@@ -185,6 +194,9 @@ struct Driver<'o> {
     noted_overruns: u64,
     /// Arrivals applied whose values no datagram has carried yet.
     waiting_datagram: Vec<Instant>,
+    /// The journal's last flush (at most one a wall second), and how many there were.
+    last_flush: Instant,
+    journal_flushes: u64,
     next_checkpoint: Option<f64>,
 }
 
@@ -229,6 +241,11 @@ impl Driver<'_> {
                 for a in self.waiting_datagram.drain(..) {
                     self.report.delay_to_datagram.add(now - a);
                 }
+            }
+            if now - self.last_flush >= JOURNAL_FLUSH_EVERY {
+                session.flush_journal()?;
+                self.last_flush = now;
+                self.journal_flushes += 1;
             }
             self.checkpoint(session, t)?;
         }

@@ -284,6 +284,11 @@ impl Session {
     pub fn journal(&self) -> &Journal {
         &self.journal
     }
+    /// Writes the journal's buffered records to its file (a paced run does so at most once a
+    /// wall second, so that a crash loses at most a second of inputs).
+    pub fn flush_journal(&mut self) -> Result<()> {
+        self.journal.flush()
+    }
     /// The journal as JSON Lines, ending with the session's step if it is not closed yet (a
     /// replay of it reaches the session's time); an error if the session keeps none.
     pub fn journal_text(&self) -> Result<String> {

@@ -15,8 +15,8 @@
 //!   from the history);
 //! - `{"record":"end","step":k}`: the session closed at t_k.
 //!
-//! The file is buffered and flushed at each checkpoint, restore and end, and when the
-//! session is dropped; a session without an end record (its process died) replays to the
+//! The file is buffered and flushed at each checkpoint, restore and end, when the session is
+//! dropped, and by a real-time run at most once a wall second ([`crate::realtime`]); a session without an end record (its process died) replays to the
 //! step of its last record.
 
 use crate::error::{Error, Result};
