@@ -319,3 +319,108 @@ fn a_paced_run_flushes_its_journal_every_second() {
         "the journal 2.5 s after the HTC, mid-run:\n{mid_run}"
     );
 }
+
+/// `shipsim replay JOURNAL --from CHECKPOINT`: a paced run with a checkpoint every 10 s and
+/// heading commands before and after the checkpoint at 10 s; the replay from it writes the full
+/// replay's rows from t = 10 s on, byte for byte (and a checkpoint after the journal's end is
+/// refused).
+#[test]
+fn a_replay_from_a_checkpoint_is_the_full_replays_tail() {
+    let dir = tempfile::tempdir().unwrap();
+    let (out_port, in_port) = (free_port(), free_port());
+    let sys = hil(dir.path(), out_port, in_port, None);
+    let rx = UdpSocket::bind(("127.0.0.1", out_port)).unwrap();
+    rx.set_read_timeout(Some(Duration::from_millis(200)))
+        .unwrap();
+    let sender = std::thread::spawn(move || {
+        let tx = UdpSocket::bind("127.0.0.1:0").unwrap();
+        let to = ("127.0.0.1", in_port);
+        let mut buf = [0u8; 4096];
+        let mut sent = 0;
+        let end = Instant::now() + Duration::from_secs(30);
+        while Instant::now() < end && sent < 3 {
+            let Ok(n) = rx.recv(&mut buf) else { continue };
+            let t = gga_time(std::str::from_utf8(&buf[..n]).unwrap()).unwrap_or(0.0);
+            // Before the checkpoint, at about it, and after it.
+            let (at, heading) = [(0.0, "30.0"), (10.0, "20.0"), (15.0, "350.0")][sent];
+            if t >= at {
+                let body = format!("APHTC,V,,,H,N,,,,,{heading},,,T");
+                tx.send_to(&sentence(&body), to).unwrap();
+                sent += 1;
+            }
+        }
+        sent
+    });
+    let (ok, err) = shipsim_in(
+        dir.path(),
+        &[
+            "run",
+            sys.to_str().unwrap(),
+            "--real-time-factor",
+            "10",
+            "--stop-time",
+            "25",
+            "--checkpoint-every",
+            "10",
+        ],
+    );
+    assert!(ok, "{err}");
+    assert_eq!(sender.join().unwrap(), 3);
+    assert!(err.contains("3 input values applied"), "{err}");
+    let ckpt = dir.path().join("hil-10.ckpt");
+    assert!(ckpt.is_file(), "{err}");
+    let (ok, e) = shipsim_in(dir.path(), &["replay", "hil.jsonl", "-o", "full.csv"]);
+    assert!(ok, "{e}");
+    let (ok, e) = shipsim_in(
+        dir.path(),
+        &[
+            "replay",
+            "hil.jsonl",
+            "--from",
+            "hil-10.ckpt",
+            "-o",
+            "tail.csv",
+        ],
+    );
+    assert!(ok, "{e}");
+    assert!(e.contains("from t = 10 s to t = 25 s"), "{e}");
+    let full = std::fs::read_to_string(dir.path().join("full.csv")).unwrap();
+    let tail = std::fs::read_to_string(dir.path().join("tail.csv")).unwrap();
+    let mut lines = full.split_inclusive('\n');
+    let mut expected = lines.next().unwrap().to_string();
+    for l in lines {
+        let t: f64 = l.split(',').next().unwrap().parse().unwrap();
+        if t >= 10.0 - 1e-9 {
+            expected.push_str(l);
+        }
+    }
+    assert!(expected.lines().count() > 100);
+    assert!(
+        tail == expected,
+        "the replay from t = 10 s is not the full replay's tail"
+    );
+    assert_eq!(
+        std::fs::read(dir.path().join("full.csv")).unwrap(),
+        std::fs::read(dir.path().join("hil.csv")).unwrap()
+    );
+    // A checkpoint after the journal's end: the run to 5 s has a journal ending at step 100.
+    let (ok, e) = shipsim_in(
+        dir.path(),
+        &[
+            "run",
+            sys.to_str().unwrap(),
+            "--real-time-factor",
+            "20",
+            "--stop-time",
+            "5",
+            "-o",
+            "short.csv",
+        ],
+    );
+    assert!(ok, "{e}");
+    let (ok, e) = shipsim_in(
+        dir.path(),
+        &["replay", "short.jsonl", "--from", "hil-10.ckpt"],
+    );
+    assert!(!ok && e.contains("after the journal's last step"), "{e}");
+}

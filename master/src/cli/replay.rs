@@ -1,6 +1,8 @@
 //! `shipsim replay JOURNAL [-o FILE.csv]`: replays the journal of a stepping session (Python's
 //! `System.start(journal=...)`, [`shipsim::run::Session::replay`]) and writes its rows as
-//! `shipsim run` writes a CSV, bit for bit the session's.
+//! `shipsim run` writes a CSV, bit for bit the session's. With `--from CHECKPOINT` (a paced
+//! run's `--checkpoint-every`) it replays from that checkpoint's time on
+//! ([`shipsim::run::Session::replay_from`]): the rows are the full replay's tail, bit for bit.
 
 use clap::Args;
 use shipsim::error::{Error, Result};
@@ -18,6 +20,10 @@ pub struct ReplayArgs {
     /// The CSV to write (default: the journal's name with .csv, beside it).
     #[arg(long, short)]
     pub output: Option<PathBuf>,
+    /// Replay from this checkpoint of the session (written by `shipsim run --checkpoint-every`):
+    /// the rows from its time on.
+    #[arg(long, value_name = "CHECKPOINT")]
+    pub from: Option<PathBuf>,
 }
 
 pub fn run(args: &ReplayArgs, interrupt: Arc<AtomicBool>) -> Result<()> {
@@ -25,7 +31,10 @@ pub fn run(args: &ReplayArgs, interrupt: Arc<AtomicBool>) -> Result<()> {
         interrupt: Some(interrupt),
         ..Default::default()
     };
-    let mut session = Session::replay(&args.journal, opts)?;
+    let mut session = match &args.from {
+        None => Session::replay(&args.journal, opts)?,
+        Some(cp) => Session::replay_from(&args.journal, cp, opts)?,
+    };
     for w in session.warnings() {
         eprintln!("warning: {w}");
     }
@@ -38,8 +47,12 @@ pub fn run(args: &ReplayArgs, interrupt: Arc<AtomicBool>) -> Result<()> {
     let mut w = std::io::BufWriter::new(std::fs::File::create(&path).map_err(io)?);
     write_rows(&mut w, session.rows()).map_err(io)?;
     w.flush().map_err(io)?;
+    let from = match session.rows().time.first() {
+        Some(t) if args.from.is_some() => format!(" from t = {t} s"),
+        _ => String::new(),
+    };
     eprintln!(
-        "replayed {} to t = {} s: {} rows written to {}",
+        "replayed {}{from} to t = {} s: {} rows written to {}",
         args.journal.display(),
         session.time(),
         session.rows().time.len(),

@@ -191,20 +191,33 @@ impl Session {
             journal: Journaling::Off,
         };
         let mut s = Session::start(system, fmus, opts)?;
-        for (pi, fmu) in s.plan.instances.iter().zip(&s.fmus) {
+        s.continue_from(cp)?;
+        Ok(s)
+    }
+
+    /// Puts a freshly started session at checkpoint `cp` (see [`Session::resume`]); the
+    /// session's plan (its events before the checkpoint's step included) must be the
+    /// checkpoint's.
+    fn continue_from(&mut self, cp: &Checkpoint) -> Result<()> {
+        for (pi, fmu) in self.plan.instances.iter().zip(&self.fmus) {
             fmu.require_state_support(&pi.name)?;
         }
-        cp.check(&Fingerprint::of(&s.plan, &s.fmus)?)?;
-        cp.restore(&mut s.slots, &mut s.values)?;
-        s.k = cp.step;
-        s.rows = MemoryRecorder::new();
+        cp.check(&Fingerprint::of(&self.plan, &self.fmus)?)?;
+        cp.restore(&mut self.slots, &mut self.values)?;
+        self.k = cp.step;
+        self.rows = MemoryRecorder::new();
         {
-            let mut rec =
-                start_recording(&s.plan, &mut s.rows, &s.columns, cp.step, s.plan.n_steps)?;
-            rec.row(cp.time, &s.values)?;
+            let mut rec = start_recording(
+                &self.plan,
+                &mut self.rows,
+                &self.columns,
+                cp.step,
+                self.plan.n_steps,
+            )?;
+            rec.row(cp.time, &self.values)?;
         }
-        s.row_count = 1;
-        Ok(s)
+        self.row_count = 1;
+        Ok(())
     }
 
     /// Sets the offset of Real connection `connection` (an index into the plan's
@@ -670,11 +683,52 @@ impl Session {
         };
         let mut session = Session::start(system, fmus, opts)?;
         let end = replay.end_step();
-        let mds_len = session.fmus.len();
-        debug_assert_eq!(mds_len, session.plan.instances.len());
-        for (step, name, value) in replay.sets() {
+        session.push_replayed(path, replay.sets())?;
+        session.advance_until(end, "replay")?;
+        Ok(session)
+    }
+
+    /// Replays a journal from a checkpoint of its session (a paced run's `--checkpoint-every`,
+    /// [`Checkpoint::read`]): the session resumed at the checkpoint's step k ([`Session::resume`],
+    /// which checks that the checkpoint belongs to the journal's system and its values set
+    /// before step k), the journal's values set at step k or later applied, to the session's last time. Its rows are the full
+    /// replay's from t_k on, bit for bit.
+    pub fn replay_from(path: &Path, checkpoint: &Path, run: RunOptions) -> Result<Session> {
+        let replay = Replay::read(path)?;
+        let bad = |message: String| Error::Checkpoint {
+            file: checkpoint.to_path_buf(),
+            message,
+        };
+        let cp = Checkpoint::read(checkpoint)?;
+        let end = replay.end_step();
+        if cp.step > end {
+            return Err(bad(format!(
+                "its step {} (t = {} s) is after the journal's last step {end}",
+                cp.step, cp.time
+            )));
+        }
+        let (system, fmus) = replay.system(&run)?;
+        let opts = SessionOptions {
+            run,
+            journal: Journaling::Off,
+        };
+        let mut session = Session::start(system, fmus, opts)?;
+        // Every value set is an event of the plan (those before the checkpoint are part of what
+        // the checkpoint is checked against); from the checkpoint on, those at or after its step
+        // are applied.
+        session.push_replayed(path, replay.sets())?;
+        session.continue_from(&cp).map_err(|e| bad(e.to_string()))?;
+        session.advance_until(end, "replay")?;
+        Ok(session)
+    }
+
+    /// A journal's values set, as events of this session at their steps.
+    fn push_replayed(&mut self, path: &Path, sets: Vec<(u64, String, Value)>) -> Result<()> {
+        let mds_len = self.fmus.len();
+        debug_assert_eq!(mds_len, self.plan.instances.len());
+        for (step, name, value) in sets {
             let spec = EventSpec {
-                time: session.grid.at(step),
+                time: self.grid.at(step),
                 target: VarRef::parse(&name).ok_or_else(|| {
                     Error::Other(format!(
                         "{}: '{name}' is not instance.variable",
@@ -685,16 +739,15 @@ impl Session {
                 line: None,
             };
             let mds: Vec<&ModelDescription> =
-                session.fmus.iter().map(|f| &f.model_description).collect();
-            let end_t = session.grid.at(session.plan.n_steps);
-            let event = session
+                self.fmus.iter().map(|f| &f.model_description).collect();
+            let end_t = self.grid.at(self.plan.n_steps);
+            let event = self
                 .system
-                .resolve_event(&mds, &spec, session.plan.n_steps, end_t)
+                .resolve_event(&mds, &spec, self.plan.n_steps, end_t)
                 .map_err(|e| Error::Other(format!("{}: {e}", path.display())))?;
-            session.push(Set { step, event });
+            self.push(Set { step, event });
         }
-        session.advance_until(end, "replay")?;
-        Ok(session)
+        Ok(())
     }
 }
 
