@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import difflib
+import math
 import os
 import warnings
 from dataclasses import dataclass, field
@@ -207,6 +208,8 @@ class System:
         as_frame: Optional[bool] = None,
         isolate=None,
         call_timeout: Optional[float] = None,
+        real_time: bool = False,
+        real_time_factor: Optional[float] = None,
     ):
         """Runs the system and returns the recorded variables.
 
@@ -236,6 +239,15 @@ class System:
         ``ValueError``) kills an isolated FMU call that runs longer. Instances with
         ``isolate = true`` in the system file are isolated whatever the argument.
 
+        ``real_time=True`` paces the run to the wall clock, ``real_time_factor=X`` at X times
+        real time (a positive number; else ``ValueError``), as ``shipsim run --real-time``
+        (``--real-time-factor X``) does, through the same runner: each macro step waits for
+        its deadline, a late step is counted, never skipped. The rows are the unpaced run's, bit
+        for bit; the summary is then ``start_time``, ``end_time``, ``macro_steps``,
+        ``wall_time``, ``paced_factor``, ``lateness_median``, ``lateness_p99``,
+        ``lateness_max`` [s] and ``overruns`` (late steps), and a run that cannot keep up adds
+        its messages to the warnings. The system file's ``[[io]]`` channels are not opened.
+
         The GIL is released while the master runs. Ctrl-C stops the run at its next
         communication point and raises ``KeyboardInterrupt``. FMU log messages go to the
         ``shipsim.fmu`` logger (warnings and worse; everything with ``verbose``).
@@ -243,6 +255,13 @@ class System:
         if isinstance(variables, str):
             variables = [variables]  # one pattern, not its characters
         isolate, names = _isolation(isolate)
+        factor = None
+        if real_time_factor is not None:
+            factor = float(real_time_factor)
+            if not (factor > 0 and math.isfinite(factor)):
+                raise ValueError(f"real_time_factor = {real_time_factor!r}: a positive number")
+        elif real_time:
+            factor = 1.0
         raw = self._native.run(
             stop_time=stop_time,
             variables=None if variables is None else list(variables),
@@ -253,6 +272,7 @@ class System:
             isolate=isolate,
             isolate_instances=names,
             call_timeout=call_timeout,
+            real_time_factor=factor,
         )
         for w in raw["warnings"]:
             warnings.warn(w, ShipsimWarning, stacklevel=2)

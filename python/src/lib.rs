@@ -691,7 +691,7 @@ impl PySystem {
     }
 
     /// Runs the system and returns its recorded columns; see the Python `System.run`.
-    #[pyo3(signature = (stop_time=None, variables=None, start_time=None, step_size=None, algorithm=None, verbose=false, isolate=None, isolate_instances=None, call_timeout=None))]
+    #[pyo3(signature = (stop_time=None, variables=None, start_time=None, step_size=None, algorithm=None, verbose=false, isolate=None, isolate_instances=None, call_timeout=None, real_time_factor=None))]
     #[allow(clippy::too_many_arguments)]
     fn run<'py>(
         &self,
@@ -705,11 +705,15 @@ impl PySystem {
         isolate: Option<String>,
         isolate_instances: Option<Vec<String>>,
         call_timeout: Option<f64>,
+        real_time_factor: Option<f64>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let isolation = self.isolation(isolate, isolate_instances, call_timeout)?;
         let sys = self.configured(py, stop_time, variables, start_time, step_size, algorithm)?;
         let plan = sys.validate(&self.mds()).map_err(|e| py_err(py, e))?;
         let (opts, logs, interrupt) = run_options(verbose, isolation);
+        if let Some(x) = real_time_factor {
+            return self.run_paced(py, sys, plan, opts, logs, interrupt, x);
+        }
         let mut rec = MemoryRecorder::new();
         let fmus = &self.fmus;
         let result = run_detached(
@@ -761,6 +765,69 @@ impl PySystem {
         let isolation = self.isolation(isolate, isolate_instances, call_timeout)?;
         let sys = self.configured(py, stop_time, variables, start_time, step_size, algorithm)?;
         session::PySession::start(py, sys, self.fmus.clone(), verbose, isolation, journal)
+    }
+}
+
+impl PySystem {
+    /// `run` paced at `factor` times real time, through the runner of `shipsim run
+    /// --real-time` ([`shipsim::realtime::run_system`]; no `[[io]]`, no journal): the same
+    /// rows, and a summary with the lateness.
+    #[allow(clippy::too_many_arguments)]
+    fn run_paced<'py>(
+        &self,
+        py: Python<'py>,
+        sys: System,
+        plan: shipsim::system::Plan,
+        opts: RunOptions,
+        logs: Logs,
+        interrupt: Arc<AtomicBool>,
+        factor: f64,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        use shipsim::realtime::{run_system, PacedRun, RealTimeOptions};
+        let messages = Arc::new(Mutex::new(Vec::<String>::new()));
+        let sink = messages.clone();
+        let paced = PacedRun {
+            run: opts,
+            journal: shipsim::run::Journaling::Off,
+            io: Vec::new(),
+            rows: None,
+            realtime: RealTimeOptions {
+                factor: Some(factor),
+                interrupt: Some(interrupt.clone()),
+                log: Arc::new(move |m: &str| sink.lock().unwrap().push(m.to_string())),
+                ..RealTimeOptions::default()
+            },
+        };
+        let fmus = self.fmus.clone();
+        let system = sys.clone();
+        let result = run_detached(
+            py,
+            &interrupt,
+            |_| Ok(()),
+            || run_system(system, fmus, paced),
+        );
+        logs.emit(py)?;
+        let (session, report) = result?.map_err(|e| py_err(py, e))?;
+        let out = rows_dict(py, &plan, &sys, &self.mds(), session.rows())?;
+        let mut warnings = plan.warnings.clone();
+        warnings.extend(messages.lock().unwrap().drain(..));
+        out.set_item("warnings", warnings)?;
+        let d = PyDict::new(py);
+        d.set_item("start_time", report.start_time)?;
+        d.set_item("end_time", report.end_time)?;
+        d.set_item("macro_steps", report.macro_steps)?;
+        d.set_item("wall_time", report.wall.as_secs_f64())?;
+        d.set_item("paced_factor", factor)?;
+        d.set_item(
+            "lateness_median",
+            report.lateness.quantile(0.5).as_secs_f64(),
+        )?;
+        d.set_item("lateness_p99", report.lateness.quantile(0.99).as_secs_f64())?;
+        d.set_item("lateness_max", report.lateness.max().as_secs_f64())?;
+        d.set_item("overruns", report.overruns)?;
+        d.set_item("rows", session.rows().time.len())?;
+        out.set_item("summary", d)?;
+        Ok(out)
     }
 }
 

@@ -6,8 +6,8 @@
 
 use clap::Args;
 use shipsim::error::{Error, Result};
-use shipsim::realtime::{self, RealTimeOptions};
-use shipsim::run::{CsvRecorder, Journaling, RunOptions, Session, SessionOptions};
+use shipsim::realtime::{self, PacedRun, RealTimeOptions};
+use shipsim::run::{CsvRecorder, Journaling, Recorder, RunOptions};
 use shipsim::system::System;
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -72,22 +72,15 @@ pub fn run(sys: System, args: &RealTimeArgs, cx: Context) -> Result<()> {
         true => Vec::new(),
         false => sys.io.clone(),
     };
-    let opts = SessionOptions {
-        run: cx.run.clone(),
-        journal: journal.clone().map_or(Journaling::Off, Journaling::File),
-    };
     if let Some(j) = &journal {
         if let Some(dir) = j.parent().filter(|d| !d.as_os_str().is_empty()) {
             let _ = std::fs::create_dir_all(dir);
         }
     }
-    let mut session = Session::start(sys, fmus, opts)?;
-    for w in session.warnings() {
-        eprintln!("warning: {w}");
-    }
-    if let Some(out) = &cx.output {
-        session.record_into(Box::new(CsvRecorder::new(csv_file(out)?)))?;
-    }
+    let rows: Option<Box<dyn Recorder + Send>> = match &cx.output {
+        Some(out) => Some(Box::new(CsvRecorder::new(csv_file(out)?))),
+        None => None,
+    };
     let rt = RealTimeOptions {
         factor,
         interrupt: cx.run.interrupt.clone(),
@@ -101,10 +94,14 @@ pub fn run(sys: System, args: &RealTimeArgs, cx: Context) -> Result<()> {
         log: Arc::new(|m: &str| eprintln!("{m}")),
         ..RealTimeOptions::default()
     };
-    let result = realtime::run(&mut session, &io, &rt);
-    let closed = session.close();
-    let report = result?;
-    closed?;
+    let paced = PacedRun {
+        run: cx.run.clone(),
+        journal: journal.clone().map_or(Journaling::Off, Journaling::File),
+        io,
+        rows,
+        realtime: rt,
+    };
+    let (_, report) = realtime::run_system(sys, fmus, paced)?;
     if !cx.quiet {
         eprintln!("{report}");
         if let Some(o) = &cx.output {

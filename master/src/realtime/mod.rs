@@ -18,8 +18,10 @@ pub mod nmea;
 pub mod pacing;
 
 use crate::error::{Error, Result};
-use crate::run::{Session, State};
+use crate::fmu::Fmu;
+use crate::run::{Journaling, Recorder, RunOptions, Session, SessionOptions, State};
 use crate::system::io::IoSpec;
+use crate::system::System;
 use channels::{inputs::Inputs, inputs::Log, outputs::Outputs};
 use pacing::{Histogram, Pacer, Waited};
 use std::collections::BTreeMap;
@@ -133,6 +135,41 @@ impl std::fmt::Display for Report {
         }
         Ok(())
     }
+}
+
+/// A system's paced run: the one runner of `shipsim run --real-time` and of Python's
+/// `System.run(real_time=...)`.
+pub struct PacedRun {
+    pub run: RunOptions,
+    /// The journal of every input applied (a file for `shipsim replay`; Python: off).
+    pub journal: Journaling,
+    /// The `[[io]]` channels (none: pacing only).
+    pub io: Vec<IoSpec>,
+    /// Where the rows are streamed; None: kept in the session ([`Session::rows`]).
+    pub rows: Option<Box<dyn Recorder + Send>>,
+    pub realtime: RealTimeOptions,
+}
+
+/// Starts a session of `sys` and drives it to its end with [`run`]; the session comes back
+/// closed (its rows in memory unless streamed), with the run's report. The session's warnings
+/// go to the log first.
+pub fn run_system(sys: System, fmus: Vec<Arc<Fmu>>, p: PacedRun) -> Result<(Session, Report)> {
+    let opts = SessionOptions {
+        run: p.run,
+        journal: p.journal,
+    };
+    let mut session = Session::start(sys, fmus, opts)?;
+    for w in session.warnings() {
+        (p.realtime.log)(&format!("warning: {w}"));
+    }
+    if let Some(rows) = p.rows {
+        session.record_into(rows)?;
+    }
+    let result = run(&mut session, &p.io, &p.realtime);
+    let closed = session.close();
+    let report = result?;
+    closed?;
+    Ok((session, report))
 }
 
 /// Drives `session` to its end (or an interrupt, or an input's end rule), paced and with the
