@@ -372,7 +372,7 @@ fn export_ssp() -> Result<()> {
 /// pure-Rust RRS model loop (bench_systems.py), campaign throughput, fixed cost and warm-up
 /// forks (bench_campaign.py), the Python package's overhead over the CLI (bench_python.py),
 /// the cost of stepping a session from Python (bench_session.py), a loop analysis's time
-/// (bench_loop.py),
+/// (bench_loop.py), the lateness of paced real-time runs (bench_realtime.py),
 /// the cost of crash isolation (bench_isolated.py), and what checks compiled into the FMUs
 /// cost: the RRS system against a variant of its FMUs built without per-call logging
 /// (bench_variants.py); printed, and written to docs/bench.md (committed).
@@ -444,6 +444,7 @@ fn bench(extra: &[String]) -> Result<()> {
     let python_pkg = script("bench_python.py", &[])?;
     let session = script("bench_session.py", &[])?;
     let loops = script("bench_loop.py", &[])?;
+    let realtime = script("bench_realtime.py", &[])?;
     let isolated = script("bench_isolated.py", &[])?;
     let events = script("bench_events.py", &[])?;
     let variants = variants()?;
@@ -451,7 +452,7 @@ fn bench(extra: &[String]) -> Result<()> {
         "# Benchmarks\n\nWritten by `cargo xtask bench` (do not edit by hand). Ratios are \
          measured in one run on one machine; absolute times depend on it.\n\n\
          ## Master overhead per FMU-step (master/bench/bench_master.py)\n\n```text\n{master}```\n\n\
-         {systems}\n{campaigns}\n{python_pkg}\n{session}\n{loops}\n{isolated}\n{events}\n{variants}"
+         {systems}\n{campaigns}\n{python_pkg}\n{session}\n{loops}\n{realtime}\n{isolated}\n{events}\n{variants}"
     );
     std::fs::write(root.join("docs/bench.md"), doc)?;
     println!("wrote docs/bench.md");
