@@ -5,7 +5,10 @@
 //!   to the commanded heading, and the journal replays the paced session bit for bit;
 //! - a hostile stream (bad checksums, garbage, NaN fields, 10^5 datagrams, a sender that goes
 //!   quiet) leaves the run to complete with the rejections counted in its summary;
-//! - a paced run of N s takes N s plus start-up.
+//! - a paced run of N s takes N s plus start-up;
+//! - the journal is flushed at most a second apart while a paced run goes, and a replay from a
+//!   checkpoint is the full replay's tail byte for byte;
+//! - nmea-out through a TCP listener, udp-out (binary) and udp-in (JSON) end to end.
 mod common;
 use common::*;
 use std::net::UdpSocket;
@@ -423,4 +426,142 @@ fn a_replay_from_a_checkpoint_is_the_full_replays_tail() {
         &["replay", "short.jsonl", "--from", "hil-10.ckpt"],
     );
     assert!(!ok && e.contains("after the journal's last step"), "{e}");
+}
+
+/// The hil_heading system with its `[[io]]` tables replaced by `io`.
+fn with_io(dir: &Path, io: &str) -> PathBuf {
+    let sys = hil(dir, free_port(), free_port(), None);
+    let text = std::fs::read_to_string(&sys).unwrap();
+    let at = text.find("[[io]]").unwrap();
+    write_system(dir, "hil.toml", &format!("{}{io}\n", &text[..at]))
+}
+
+/// The other channels end to end, on loopback: nmea-out to the clients of a TCP listener (a
+/// client connected while the run goes gets checksummed HDT lines), udp-out's binary datagrams
+/// (layout, consecutive sequence numbers, the CSV's values bit for bit) and udp-in's JSON (a
+/// heading reference in degrees, applied and journaled).
+#[test]
+fn tcp_listener_udp_out_and_udp_in_end_to_end() {
+    let dir = tempfile::tempdir().unwrap();
+    let tcp_port = std::net::TcpListener::bind("127.0.0.1:0")
+        .unwrap()
+        .local_addr()
+        .unwrap()
+        .port();
+    let (out_port, in_port) = (free_port(), free_port());
+    let io = format!(
+        r#"[[io]]
+kind = "nmea-out"
+transport = "tcp"
+listen = "127.0.0.1:{tcp_port}"
+datum = [63.44, 10.30]
+sentences = ["HDT"]
+rate = 2.0
+bind = {{ heading = "ship.heading" }}
+
+[[io]]
+kind = "udp-out"
+to = "127.0.0.1:{out_port}"
+variables = ["ship.heading", "ap.heading_reference_used"]
+rate = 20.0
+
+[[io]]
+kind = "udp-in"
+listen = "127.0.0.1:{in_port}"
+format = "json"
+inputs = [ {{ field = "ref", variable = "ap.heading_reference", unit = "deg" }} ]
+"#
+    );
+    let sys = with_io(dir.path(), &io);
+    let tcp = std::thread::spawn(move || {
+        let end = Instant::now() + Duration::from_secs(30);
+        let mut stream = loop {
+            match std::net::TcpStream::connect(("127.0.0.1", tcp_port)) {
+                Ok(s) => break s,
+                Err(_) if Instant::now() < end => std::thread::sleep(Duration::from_millis(20)),
+                Err(e) => panic!("no TCP listener: {e}"),
+            }
+        };
+        stream
+            .set_read_timeout(Some(Duration::from_secs(10)))
+            .unwrap();
+        let mut text = String::new();
+        let _ = std::io::Read::read_to_string(&mut stream, &mut text);
+        text
+    });
+    let udp = std::thread::spawn(move || {
+        let rx = UdpSocket::bind(("127.0.0.1", out_port)).unwrap();
+        rx.set_read_timeout(Some(Duration::from_secs(3))).unwrap();
+        let tx = UdpSocket::bind("127.0.0.1:0").unwrap();
+        let mut got: Vec<Vec<u8>> = Vec::new();
+        let mut buf = [0u8; 2048];
+        let mut sent = false;
+        let end = Instant::now() + Duration::from_secs(30);
+        while Instant::now() < end {
+            let Ok(n) = rx.recv(&mut buf) else { break };
+            let d = buf[..n].to_vec();
+            let t = f64::from_le_bytes(d[16..24].try_into().unwrap());
+            if !sent && t >= 2.0 {
+                let json = r#"{"seq":1,"time":0,"values":{"ref":20.0}}"#;
+                tx.send_to(json.as_bytes(), ("127.0.0.1", in_port)).unwrap();
+                sent = true;
+            }
+            got.push(d);
+        }
+        got
+    });
+    let (ok, err) = shipsim_in(
+        dir.path(),
+        &[
+            "run",
+            sys.to_str().unwrap(),
+            "--real-time-factor",
+            "4",
+            "--stop-time",
+            "12",
+        ],
+    );
+    assert!(ok, "{err}");
+    assert!(err.contains("1 input values applied"), "{err}");
+    // TCP: checksummed HDT lines, a heading in [0, 360).
+    let text = tcp.join().unwrap();
+    let lines: Vec<&str> = text.split("\r\n").filter(|l| !l.is_empty()).collect();
+    assert!(lines.len() >= 10, "{text}");
+    for l in &lines {
+        let (body, sum) = l[1..].split_once('*').unwrap();
+        assert!(l.starts_with('$') && body.starts_with("IIHDT,"), "{l}");
+        let want = shipsim::realtime::nmea::checksum(body.as_bytes());
+        assert_eq!(u8::from_str_radix(sum, 16).unwrap(), want, "{l}");
+        let h: f64 = body.split(',').nth(1).unwrap().parse().unwrap();
+        assert!((0.0..360.0).contains(&h), "{l}");
+    }
+    // UDP out: SHIP v1, 2 values, consecutive sequence numbers, the CSV's values.
+    let got = udp.join().unwrap();
+    assert!(got.len() >= 200, "{} datagrams", got.len());
+    let (h, rows) = read_csv(&dir.path().join("hil.csv"));
+    let (head, used) = (
+        col(&h, "ship.heading"),
+        col(&h, "ap.heading_reference_used"),
+    );
+    let f = |d: &[u8], at: usize| f64::from_le_bytes(d[at..at + 8].try_into().unwrap());
+    for (i, d) in got.iter().enumerate() {
+        assert_eq!(d.len(), 24 + 16);
+        assert_eq!(&d[..4], b"SHIP");
+        assert_eq!(u16::from_le_bytes([d[4], d[5]]), 1);
+        assert_eq!(u16::from_le_bytes([d[6], d[7]]), 2);
+        let seq = u64::from_le_bytes(d[8..16].try_into().unwrap());
+        if i > 0 {
+            let prev = u64::from_le_bytes(got[i - 1][8..16].try_into().unwrap());
+            assert_eq!(seq, prev + 1);
+        }
+        let t = f(d, 16);
+        let row = rows.iter().find(|r| (r[0] - t).abs() < 1e-9).unwrap();
+        assert_eq!(f(d, 24).to_bits(), row[head].to_bits(), "t = {t}");
+        assert_eq!(f(d, 32).to_bits(), row[used].to_bits(), "t = {t}");
+    }
+    // UDP in: the reference of 20 deg was applied (in rad) and is in the journal.
+    let last = got.last().unwrap();
+    assert!((f(last, 32) - 20f64.to_radians()).abs() < 1e-12);
+    let journal = std::fs::read_to_string(dir.path().join("hil.jsonl")).unwrap();
+    assert!(journal.contains(r#""variable":"ap.heading_reference""#));
 }
