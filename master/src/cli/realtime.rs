@@ -26,7 +26,7 @@ pub struct RealTimeArgs {
     #[arg(long, value_name = "FILE")]
     pub journal: Option<PathBuf>,
     /// With a paced or I/O run: a checkpoint every T s of simulated time, written beside the
-    /// journal as NAME-t.ckpt (shipsim run --resume takes it).
+    /// journal as NAME-t.ckpt (`shipsim replay JOURNAL --from NAME-t.ckpt` replays from it).
     #[arg(long, value_name = "T")]
     pub checkpoint_every: Option<f64>,
     /// Ignore the system file's [[io]] channels.
