@@ -278,6 +278,32 @@ fn a_paced_run_takes_its_simulated_time() {
     assert!(a == b, "the paced run's CSV differs from the plain run's");
 }
 
+/// A paced run that fails before its instances run (a value outside its declared range) leaves
+/// the last run's CSV as it was, as `shipsim run` does (issue 36).
+#[test]
+fn a_paced_run_that_fails_at_start_keeps_the_last_csv() {
+    let dir = tempfile::tempdir().unwrap();
+    let sys = rrs_file(dir.path());
+    std::fs::write(dir.path().join("rrs.csv"), "the last run\n").unwrap();
+    let (ok, err) = shipsim_in(
+        dir.path(),
+        &[
+            "run",
+            sys.to_str().unwrap(),
+            "--real-time",
+            "--stop-time",
+            "1",
+            "--set",
+            "gear.rate_max=-1",
+            "-o",
+            "rrs.csv",
+        ],
+    );
+    assert!(!ok && err.contains("rate_max"), "{err}");
+    let kept = std::fs::read_to_string(dir.path().join("rrs.csv")).unwrap();
+    assert_eq!(kept, "the last run\n");
+}
+
 /// A paced run flushes its journal at most a wall second apart: an HTC sent early in a 6 s run
 /// is in the journal's file 2.5 s later, while the run still goes (a crash loses at most a
 /// second of inputs).

@@ -7,7 +7,7 @@
 use clap::Args;
 use shipsim::error::{Error, Result};
 use shipsim::realtime::{self, PacedRun, RealTimeOptions};
-use shipsim::run::{CsvRecorder, Journaling, Recorder, RunOptions};
+use shipsim::run::{CsvRecorder, Journaling, OpenOnWrite, Recorder, RunOptions};
 use shipsim::system::System;
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -121,14 +121,14 @@ pub fn run(sys: System, args: &RealTimeArgs, cx: Context) -> Result<()> {
     Ok(())
 }
 
-/// The CSV output, its folder created, buffered.
-fn csv_file(out: &std::path::Path) -> Result<std::io::BufWriter<std::fs::File>> {
+/// The CSV output, its folder created, buffered, the file created on the first row: a run
+/// that fails before its instances are initialized leaves the last run's file as it was (as
+/// `shipsim run` does, issue 36).
+fn csv_file(out: &std::path::Path) -> Result<OpenOnWrite> {
     let p = shipsim::output_path::writable(out)?;
     if let Some(dir) = p.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir)
             .map_err(|e| Error::io(format!("cannot create output folder {}", dir.display()), e))?;
     }
-    let f = std::fs::File::create(&p)
-        .map_err(|e| Error::io(format!("cannot create output file {}", p.display()), e))?;
-    Ok(std::io::BufWriter::with_capacity(1 << 16, f))
+    Ok(OpenOnWrite::new(p))
 }

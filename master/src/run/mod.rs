@@ -52,7 +52,9 @@ use checkpoint::Fingerprint;
 pub use checkpoint::{checkpoint_step, Checkpoint};
 use exchange::Exchange;
 pub use profile::{Profile, Sampling};
-pub use recorder::{write_real, ColumnInfo, CsvRecorder, MemoryRecorder, Recorder, Row, Sample};
+pub use recorder::{
+    write_real, ColumnInfo, CsvRecorder, MemoryRecorder, OpenOnWrite, Recorder, Row, Sample,
+};
 pub use session::{
     Journal, JournalHeader, Journaling, Replay, Session, SessionCheckpoint, SessionOptions, Set,
     State,
