@@ -18,23 +18,6 @@ use std::path::Path;
 use std::process::Command;
 use std::sync::Arc;
 
-/// `systems/<name>` with our FMUs from $SHIPSIM_FMU_DIR, stopping at `stop_time`, no output
-/// file.
-fn system(name: &str, stop_time: f64, algorithm: Algorithm) -> System {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../systems")
-        .join(name);
-    let mut sys = System::load(&path).unwrap();
-    for inst in &mut sys.instances {
-        let stem = inst.fmu.file_stem().unwrap().to_string_lossy().into_owned();
-        inst.fmu = our_fmu(&stem);
-    }
-    sys.stop_time = Some(stop_time);
-    sys.algorithm = algorithm;
-    sys.output.file = None;
-    sys
-}
-
 fn plan(sys: &System, fmus: &[Arc<Fmu>]) -> Plan {
     let mds: Vec<_> = fmus.iter().map(|f| &f.model_description).collect();
     sys.validate(&mds).unwrap()
@@ -93,25 +76,25 @@ fn resume_gives_the_uninterrupted_run_bit_for_bit() {
     // RRS (Jacobi, sensors/filter/autopilot at step multiple 2): at an even and an odd step,
     // where the slow instances are mid-step and their published outputs are older than
     // their states.
-    let sys = system("rrs.toml", 60.0, Algorithm::Jacobi);
+    let sys = our_system("rrs.toml", 60.0, Algorithm::Jacobi);
     let fmus = load_fmus(&sys).unwrap();
     let p = plan(&sys, &fmus);
     assert_eq!(p.n_steps, 1200);
     check_resume(&p, &fmus, 400, "rrs jacobi k=400");
     check_resume(&p, &fmus, 401, "rrs jacobi k=401");
     // Gauss-Seidel: the path-keeping system and RRS.
-    let sys = system("path_control_current.toml", 120.0, Algorithm::GaussSeidel);
+    let sys = our_system("path_control_current.toml", 120.0, Algorithm::GaussSeidel);
     let fmus = load_fmus(&sys).unwrap();
     let p = plan(&sys, &fmus);
     check_resume(&p, &fmus, 250, "path control gauss-seidel");
-    let sys = system("rrs.toml", 60.0, Algorithm::GaussSeidel);
+    let sys = our_system("rrs.toml", 60.0, Algorithm::GaussSeidel);
     let fmus = load_fmus(&sys).unwrap();
     check_resume(&plan(&sys, &fmus), &fmus, 333, "rrs gauss-seidel k=333");
 }
 
 #[test]
 fn resume_keeps_the_decimation_phase() {
-    let mut sys = system("rrs.toml", 30.0, Algorithm::Jacobi);
+    let mut sys = our_system("rrs.toml", 30.0, Algorithm::Jacobi);
     let fmus = load_fmus(&sys).unwrap();
     let every = full_run(&plan(&sys, &fmus), &fmus, &RunOptions::default());
     sys.output.decimation = 7;
@@ -143,7 +126,7 @@ fn writing(step: u64, file: &Path) -> RunOptions {
 
 #[test]
 fn writing_a_checkpoint_during_a_run_changes_nothing() {
-    let sys = system("rrs.toml", 40.0, Algorithm::Jacobi);
+    let sys = our_system("rrs.toml", 40.0, Algorithm::Jacobi);
     let fmus = load_fmus(&sys).unwrap();
     let p = plan(&sys, &fmus);
     let d = tempfile::tempdir().unwrap();
@@ -199,7 +182,7 @@ fn check_fork(sys: &System, k: u64, target: &str, values: &[Value], label: &str)
 
 #[test]
 fn a_fork_from_a_warm_up_equals_the_cold_run_with_the_event() {
-    let rrs = system("rrs.toml", 90.0, Algorithm::Jacobi);
+    let rrs = our_system("rrs.toml", 90.0, Algorithm::Jacobi);
     check_fork(
         &rrs,
         601,
@@ -214,7 +197,7 @@ fn a_fork_from_a_warm_up_equals_the_cold_run_with_the_event() {
         &[Value::Real(0.5), Value::Real(2.5)],
         "rrs jacobi",
     );
-    let rrs_gs = system("rrs.toml", 90.0, Algorithm::GaussSeidel);
+    let rrs_gs = our_system("rrs.toml", 90.0, Algorithm::GaussSeidel);
     check_fork(
         &rrs_gs,
         600,
@@ -222,7 +205,7 @@ fn a_fork_from_a_warm_up_equals_the_cold_run_with_the_event() {
         &[Value::Integer(0)],
         "rrs gauss-seidel",
     );
-    let path = system("path_control_current.toml", 150.0, Algorithm::GaussSeidel);
+    let path = our_system("path_control_current.toml", 150.0, Algorithm::GaussSeidel);
     check_fork(
         &path,
         300,
@@ -235,7 +218,7 @@ fn a_fork_from_a_warm_up_equals_the_cold_run_with_the_event() {
 /// A checkpoint is refused by another system, naming the difference.
 #[test]
 fn a_checkpoint_from_another_system_is_refused() {
-    let sys = system("rrs.toml", 30.0, Algorithm::Jacobi);
+    let sys = our_system("rrs.toml", 30.0, Algorithm::Jacobi);
     let fmus = load_fmus(&sys).unwrap();
     let p = plan(&sys, &fmus);
     let cp = run_to_checkpoint(&p, &fmus, 200, None, &RunOptions::default()).unwrap();
@@ -245,14 +228,14 @@ fn a_checkpoint_from_another_system_is_refused() {
         let e = resume_into(&p, &fmus, &cp, None, &RunOptions::default()).unwrap_err();
         e.to_string()
     };
-    let e = refused(&system("rrs.toml", 40.0, Algorithm::Jacobi));
+    let e = refused(&our_system("rrs.toml", 40.0, Algorithm::Jacobi));
     assert!(
         e.contains("different system") && e.contains("600 base steps"),
         "{e}"
     );
-    let e = refused(&system("rrs.toml", 30.0, Algorithm::GaussSeidel));
+    let e = refused(&our_system("rrs.toml", 30.0, Algorithm::GaussSeidel));
     assert!(e.contains("algorithm Jacobi in the checkpoint"), "{e}");
-    let e = refused(&system(
+    let e = refused(&our_system(
         "path_control_current.toml",
         30.0,
         Algorithm::Jacobi,
@@ -323,7 +306,7 @@ fn a_checkpoint_from_another_system_is_refused() {
 #[test]
 fn a_checkpoint_from_another_build_of_an_fmu_is_refused() {
     let d = tempfile::tempdir().unwrap();
-    let sys = system("rrs.toml", 30.0, Algorithm::Jacobi);
+    let sys = our_system("rrs.toml", 30.0, Algorithm::Jacobi);
     let fmus = load_fmus(&sys).unwrap();
     let cp =
         run_to_checkpoint(&plan(&sys, &fmus), &fmus, 200, None, &RunOptions::default()).unwrap();
@@ -366,7 +349,7 @@ fn a_checkpoint_from_another_build_of_an_fmu_is_refused() {
 /// checkpoint's step, so the resumed run is the cold run with that event, bit for bit.
 #[test]
 fn a_new_tunable_value_is_adopted_as_an_event_at_the_checkpoint() {
-    let sys = system("rrs.toml", 30.0, Algorithm::Jacobi);
+    let sys = our_system("rrs.toml", 30.0, Algorithm::Jacobi);
     let fmus = load_fmus(&sys).unwrap();
     let cp =
         run_to_checkpoint(&plan(&sys, &fmus), &fmus, 200, None, &RunOptions::default()).unwrap();
@@ -415,7 +398,7 @@ fn a_new_tunable_value_is_adopted_as_an_event_at_the_checkpoint() {
 
 #[test]
 fn truncated_corrupt_and_hostile_files_are_clear_errors() {
-    let sys = system("rrs.toml", 10.0, Algorithm::Jacobi);
+    let sys = our_system("rrs.toml", 10.0, Algorithm::Jacobi);
     let fmus = load_fmus(&sys).unwrap();
     let p = plan(&sys, &fmus);
     let cp = run_to_checkpoint(&p, &fmus, 100, None, &RunOptions::default()).unwrap();
@@ -482,7 +465,7 @@ fn truncated_corrupt_and_hostile_files_are_clear_errors() {
 
 #[test]
 fn checkpoint_times_must_be_inside_the_grid() {
-    let sys = system("rrs.toml", 10.0, Algorithm::Jacobi);
+    let sys = our_system("rrs.toml", 10.0, Algorithm::Jacobi);
     let fmus = load_fmus(&sys).unwrap();
     let p = plan(&sys, &fmus);
     assert_eq!(checkpoint_step(&p, 5.0).unwrap(), 100);

@@ -12,7 +12,7 @@ use common::*;
 use num_complex::Complex64;
 use shipsim::analysis::{self, Injection, Options};
 use shipsim::run::load_fmus;
-use shipsim::system::System;
+use shipsim::system::{Algorithm, System};
 use std::path::{Path, PathBuf};
 
 fn example_fmu(name: &str) -> PathBuf {
@@ -121,12 +121,8 @@ fn the_rate_limit_has_its_describing_function() {
 
 /// The DDG-51 heading loop of systems/autopilot_current.toml, noiseless.
 fn heading_loop() -> (System, Vec<std::sync::Arc<shipsim::fmu::Fmu>>) {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../systems/autopilot_current.toml");
-    let mut sys = System::load(&path).unwrap();
-    for inst in &mut sys.instances {
-        let stem = inst.fmu.file_stem().unwrap().to_string_lossy().into_owned();
-        inst.fmu = our_fmu(&stem);
-    }
+    // The file's own stop time and algorithm (400 s, Jacobi).
+    let mut sys = our_system("autopilot_current.toml", 400.0, Algorithm::Jacobi);
     sys.apply_overrides(&["sensors.noise_scale=0".into()])
         .unwrap();
     let fmus = load_fmus(&sys).unwrap();

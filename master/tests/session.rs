@@ -15,17 +15,9 @@ use shipsim::system::{Algorithm, System, TypedValue, Value, VarRef};
 use std::path::Path;
 use std::sync::Arc;
 
-/// systems/rrs.toml with our FMUs, stopping at `stop_time`, no output file.
+/// systems/rrs.toml with our FMUs, stopping at `stop_time`, no output file, and its FMUs.
 fn rrs(stop_time: f64, algorithm: Algorithm) -> (System, Vec<Arc<Fmu>>) {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../systems/rrs.toml");
-    let mut sys = System::load(&path).unwrap();
-    for inst in &mut sys.instances {
-        let stem = inst.fmu.file_stem().unwrap().to_string_lossy().into_owned();
-        inst.fmu = our_fmu(&stem);
-    }
-    sys.stop_time = Some(stop_time);
-    sys.algorithm = algorithm;
-    sys.output.file = None;
+    let sys = our_system("rrs.toml", stop_time, algorithm);
     let fmus = load_fmus(&sys).unwrap();
     (sys, fmus)
 }

@@ -256,3 +256,24 @@ pub fn rows(m: &shipsim::run::MemoryRecorder) -> Vec<Vec<u64>> {
         })
         .collect()
 }
+
+/// `systems/<name>` with our FMUs from $SHIPSIM_FMU_DIR, stopping at `stop_time`, no output
+/// file (the checkpoint, session and loop-analysis tests).
+pub fn our_system(
+    name: &str,
+    stop_time: f64,
+    algorithm: shipsim::system::Algorithm,
+) -> shipsim::system::System {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../systems")
+        .join(name);
+    let mut sys = shipsim::system::System::load(&path).unwrap();
+    for inst in &mut sys.instances {
+        let stem = inst.fmu.file_stem().unwrap().to_string_lossy().into_owned();
+        inst.fmu = our_fmu(&stem);
+    }
+    sys.stop_time = Some(stop_time);
+    sys.algorithm = algorithm;
+    sys.output.file = None;
+    sys
+}
