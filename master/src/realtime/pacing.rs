@@ -190,14 +190,17 @@ mod tests {
             std::thread::sleep(Duration::from_micros(500));
             assert_eq!(p.wait(k as f64 * 0.005, None).0, Waited::Done);
         }
+        // Never before the last deadline; the upper bound leaves room for a loaded machine
+        // (the full suite runs tests in parallel), where a point may also come late.
         let el = p.start.elapsed().as_secs_f64();
-        assert!((0.2..0.215).contains(&el), "{el}");
+        assert!((0.2..0.3).contains(&el), "{el}");
+        let before = p.overruns;
         std::thread::sleep(Duration::from_millis(12));
         assert!(p.wait(0.205, None).1);
-        assert_eq!(p.overruns, 1);
+        assert_eq!(p.overruns, before + 1);
         let mut fast = Pacer::new(0.0, 10.0);
         fast.wait(1.0, None);
         let el = fast.start.elapsed().as_secs_f64();
-        assert!((0.1..0.115).contains(&el), "{el}");
+        assert!((0.1..0.2).contains(&el), "{el}");
     }
 }
